@@ -1,0 +1,257 @@
+//! `forest bake` and `forest info`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use forest_format::{Atlas, BakeParams, ColourEncoding};
+
+/// Arguments of `forest bake`.
+#[derive(Args, Debug)]
+pub struct BakeArgs {
+    /// The tree model: an OBJ file with its MTL and textures beside it.
+    pub model: PathBuf,
+    /// Output atlas folder (conventionally NAME.atlas); an existing atlas there is replaced.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Sampling directions over the upper hemisphere.
+    #[arg(long, default_value_t = 15)]
+    pub directions: u32,
+    /// Parallel slabs per direction.
+    #[arg(long, default_value_t = 2)]
+    pub slabs: u32,
+    /// Slab image side in pixels (a power of two).
+    #[arg(long, default_value_t = 512)]
+    pub resolution: u32,
+    /// Smallest quad side in pixels (a power of two below the resolution).
+    #[arg(long, default_value_t = 4)]
+    pub min_quad: u32,
+    /// Jittered samples per pixel.
+    #[arg(long, default_value_t = 4)]
+    pub spp: u32,
+    /// Sun direction as AZIMUTH,ELEVATION in degrees (azimuth from +Z towards +X).
+    #[arg(long, default_value = "30,55", value_parser = parse_sun)]
+    pub sun: (f32, f32),
+    /// JPEG quality of the colour mosaic (1–100).
+    #[arg(long, default_value_t = 75, conflicts_with = "lossless")]
+    pub quality: u8,
+    /// Store colour losslessly (PNG) instead of JPEG.
+    #[arg(long)]
+    pub lossless: bool,
+    /// Also write every slab image side by side to this PNG.
+    #[arg(long, value_name = "PNG")]
+    pub contact_sheet: Option<PathBuf>,
+    /// Also write per-pixel depth and coverage of every slab image to this EXR.
+    #[arg(long, value_name = "EXR")]
+    pub depth_exr: Option<PathBuf>,
+    /// Print one JSON line of figures instead of the human summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `forest info`.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Atlas folder.
+    pub atlas: PathBuf,
+    /// Print the figures as one JSON line.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_sun(s: &str) -> Result<(f32, f32), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [az, el] = parts.as_slice() else {
+        return Err(format!("{s:?}: expected AZIMUTH,ELEVATION in degrees, e.g. 30,55"));
+    };
+    let num = |x: &str| {
+        x.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{x:?} is not a finite number of degrees"))
+    };
+    Ok((num(az)?, num(el)?))
+}
+
+impl BakeArgs {
+    fn params(&self) -> BakeParams {
+        BakeParams {
+            directions: self.directions,
+            slabs: self.slabs,
+            resolution: self.resolution,
+            min_quad: self.min_quad,
+            spp: self.spp,
+            sun_azimuth_deg: self.sun.0,
+            sun_elevation_deg: self.sun.1,
+            colour: if self.lossless {
+                ColourEncoding::Png
+            } else {
+                ColourEncoding::Jpeg {
+                    quality: self.quality,
+                }
+            },
+        }
+    }
+}
+
+/// Refuse outputs that cannot be written before spending time on the bake.
+fn check_output_file(path: &Path, what: &str) -> Result<()> {
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(p) = parent
+        && !p.is_dir()
+    {
+        bail!("{what} {}: folder {} does not exist", path.display(), p.display());
+    }
+    if path.is_dir() {
+        bail!("{what} {} is a folder", path.display());
+    }
+    Ok(())
+}
+
+/// Run `forest bake`.
+pub fn run(args: &BakeArgs) -> Result<()> {
+    let params = args.params();
+    params.validate()?;
+    if args.output.exists() && !args.output.join(forest_format::atlas::MANIFEST_FILE).is_file() {
+        bail!(
+            "{} exists and is not an atlas folder: refusing to overwrite it",
+            args.output.display()
+        );
+    }
+    let out_parent = args.output.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(p) = out_parent
+        && !p.is_dir()
+    {
+        bail!("output folder {} does not exist", p.display());
+    }
+    if let Some(p) = &args.contact_sheet {
+        check_output_file(p, "contact sheet")?;
+    }
+    if let Some(p) = &args.depth_exr {
+        check_output_file(p, "depth EXR")?;
+    }
+
+    let bar = indicatif::ProgressBar::new(0);
+    if args.json {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:40}] {pos}/{len} rows, {elapsed} elapsed, ~{eta} left",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_message(format!("tracing {}", args.model.display()));
+    let progress = |done: u64, total: u64| {
+        bar.set_length(total);
+        bar.set_position(done);
+    };
+    let out = forest_bake::bake_file(&args.model, &params, &progress)?;
+    bar.finish_and_clear();
+
+    let disk = out.atlas.save(&args.output)?;
+    let layers = out
+        .atlas
+        .decode_layers(&args.output)
+        .context("decoding the atlas just written")?;
+    if let Some(p) = &args.contact_sheet {
+        forest_bake::contact_sheet::write(p, &layers, params.mosaic_columns())?;
+    }
+    if let Some(p) = &args.depth_exr {
+        forest_bake::write_depth_exr(p, &out)?;
+    }
+
+    let m = &out.atlas.manifest;
+    let report = serde_json::json!({
+        "model": args.model.display().to_string(),
+        "output": args.output.display().to_string(),
+        "triangles": out.triangles,
+        "degenerate_triangles": m.source.degenerate_triangles,
+        "seconds": (out.seconds * 1000.0).round() / 1000.0,
+        "disk_bytes": disk,
+        "colour_bytes": out.atlas.colour_file.len(),
+        "alpha_bytes": out.atlas.alpha_file.len(),
+        "gpu_bytes": m.gpu_bytes(),
+        "layers": params.layers(),
+        "resolution": params.resolution,
+        "levels": m.levels,
+        "nodes_per_level": m.nodes_per_level,
+        "node_count": m.node_count,
+        "bounding_radius": m.bounding_sphere.radius,
+    });
+    if args.json {
+        println!("{report}");
+    } else {
+        let mb = |b: u64| b as f64 / 1e6;
+        println!(
+            "baked {} -> {} in {:.1} s",
+            args.model.display(),
+            args.output.display(),
+            out.seconds
+        );
+        println!(
+            "  {} triangles ({} degenerate skipped), bounding radius {:.2} m",
+            out.triangles, m.source.degenerate_triangles, m.bounding_sphere.radius
+        );
+        println!(
+            "  {} directions x {} slabs of {}² px, {} levels (smallest quad {} px), {} spp",
+            params.directions,
+            params.slabs,
+            params.resolution,
+            m.levels,
+            params.min_quad,
+            params.spp
+        );
+        println!(
+            "  nodes per level {:?}, {} in all",
+            m.nodes_per_level, m.node_count
+        );
+        println!(
+            "  disk {:.2} MB (colour {:.2}, alpha {:.2}), GPU {:.2} MB (BC7 colour with mips + nodes)",
+            mb(disk),
+            mb(out.atlas.colour_file.len() as u64),
+            mb(out.atlas.alpha_file.len() as u64),
+            mb(m.gpu_bytes())
+        );
+        if let Some(p) = &args.contact_sheet {
+            println!("  contact sheet {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+/// Run `forest info`.
+pub fn info(args: &InfoArgs) -> Result<()> {
+    let atlas = Atlas::load(&args.atlas)?;
+    let m = &atlas.manifest;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::json!({
+                "source": m.source,
+                "params": m.params,
+                "levels": m.levels,
+                "nodes_per_level": m.nodes_per_level,
+                "node_count": m.node_count,
+                "gpu_bytes": m.gpu_bytes(),
+                "bounding_sphere": m.bounding_sphere,
+            })
+        );
+    } else {
+        println!(
+            "{}: {} ({} triangles), {} directions x {} slabs of {}² px, {} levels, {} nodes, GPU {:.2} MB",
+            args.atlas.display(),
+            m.source.file,
+            m.source.triangles,
+            m.params.directions,
+            m.params.slabs,
+            m.params.resolution,
+            m.levels,
+            m.node_count,
+            m.gpu_bytes() as f64 / 1e6
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,266 @@
+//! The offline bake: a tree model (OBJ) → slab images from sampling directions over the upper
+//! hemisphere → a quad hierarchy per slab image → an [`Atlas`].
+//!
+//! ```text
+//! Mesh::load ─► Scene::new (BVH) ─► ldi::trace_layers ─► quadtree::build_layer (per layer)
+//!            ─► number nodes level by level ─► Atlas::from_layers ─► Atlas::save (atomic)
+//! ```
+//! Everything is deterministic: the same input gives a byte-identical atlas.
+
+pub mod contact_sheet;
+pub mod error;
+pub mod ldi;
+pub mod mesh;
+pub mod quadtree;
+pub mod texture;
+pub mod trace;
+
+use std::path::Path;
+use std::time::Instant;
+
+use forest_format::atlas::{Layers, SourceInfo, manifest_for};
+use forest_format::node::{MAX_NODES, QuadNode};
+use forest_format::slab::{Sphere, sphere_to_slab_depth};
+use forest_format::{Atlas, BakeParams, FormatError};
+use glam::Vec3;
+use rayon::prelude::*;
+
+pub use error::BakeError;
+pub use mesh::Mesh;
+
+/// Memory the bake may use for its images before it refuses (bytes).
+pub const MAX_BAKE_MEMORY: u64 = 12 << 30;
+
+/// What a bake produced, with the figures the CLI reports.
+pub struct BakeOutput {
+    /// The atlas (not yet saved).
+    pub atlas: Atlas,
+    /// The traced slab images, including per-pixel depth.
+    pub images: ldi::SlabImages,
+    /// Triangles baked.
+    pub triangles: u64,
+    /// Seconds spent (load, BVH, trace, hierarchy, encode).
+    pub seconds: f64,
+}
+
+/// Bounding sphere of the triangles: the centre of their box and the farthest vertex from it
+/// (grown by a millionth so every vertex is strictly inside).
+pub fn bounding_sphere(mesh: &Mesh) -> Sphere {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for t in &mesh.tris {
+        for p in t.p {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    let center = 0.5 * (lo + hi);
+    let radius = mesh
+        .tris
+        .iter()
+        .flat_map(|t| t.p)
+        .map(|p| p.distance(center))
+        .fold(0.0f32, f32::max);
+    Sphere {
+        center,
+        radius: (radius * (1.0 + 1e-6)).max(1e-6),
+    }
+}
+
+/// Bake a model file. `progress(done, total)` reports traced image rows.
+pub fn bake_file(
+    path: &Path,
+    params: &BakeParams,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<BakeOutput, BakeError> {
+    params.validate()?;
+    check_memory(params)?;
+    let start = Instant::now();
+    let mesh = Mesh::load(path)?;
+    let file = path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut out = bake_mesh(&mesh, &file, params, progress)?;
+    out.seconds = start.elapsed().as_secs_f64();
+    Ok(out)
+}
+
+fn check_memory(params: &BakeParams) -> Result<(), BakeError> {
+    // RGBA8 + f32 depth per layer pixel, twice over (rows, then layers), plus the mosaics.
+    let pixels = u64::from(params.layers()) * u64::from(params.resolution).pow(2);
+    let bytes = pixels * (8 + 8 + 4);
+    if bytes > MAX_BAKE_MEMORY {
+        return Err(FormatError::Param(format!(
+            "{} layers of {}² pixels need about {} GiB of memory, above the bake's {} GiB: lower \
+             --resolution, --directions or --slabs",
+            params.layers(),
+            params.resolution,
+            bytes >> 30,
+            MAX_BAKE_MEMORY >> 30
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Bake an already loaded mesh (`file` is recorded in the manifest).
+pub fn bake_mesh(
+    mesh: &Mesh,
+    file: &str,
+    params: &BakeParams,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<BakeOutput, BakeError> {
+    params.validate()?;
+    check_memory(params)?;
+    let start = Instant::now();
+    let sphere = bounding_sphere(mesh);
+    let scene = trace::Scene::new(mesh);
+    let dirs = forest_format::directions::hemisphere_directions(params.directions);
+    let frames: Vec<_> = dirs
+        .iter()
+        .map(|&d| forest_format::slab::DirectionFrame::new(d))
+        .collect();
+    let lighting = params.lighting();
+    let images = ldi::trace_layers(
+        &scene,
+        &sphere,
+        &frames,
+        params.slabs,
+        params.resolution,
+        params.spp,
+        &lighting,
+        progress,
+    );
+
+    // Quad hierarchies, one per layer, in parallel.
+    let r2 = (params.resolution as usize).pow(2);
+    let trees: Vec<quadtree::LayerTree> = (0..params.layers())
+        .into_par_iter()
+        .map(|layer| {
+            let slab = layer % params.slabs;
+            let range = layer as usize * r2..(layer as usize + 1) * r2;
+            let alpha: Vec<u8> = images.rgba[range.start * 4..range.end * 4]
+                .iter()
+                .skip(3)
+                .step_by(4)
+                .copied()
+                .collect();
+            let depth: Vec<f32> = images.depth[range]
+                .iter()
+                .map(|&d| sphere_to_slab_depth(d, slab, params.slabs).clamp(0.0, 1.0))
+                .collect();
+            quadtree::build_layer(&alpha, &depth, params.resolution, params.min_quad)
+        })
+        .collect();
+
+    // Number the nodes level by level across layers; first children follow from the masks.
+    let levels = params.levels() as usize;
+    let total: u64 = trees
+        .iter()
+        .map(|t| t.levels.iter().map(|l| l.len() as u64).sum::<u64>())
+        .sum();
+    if total > MAX_NODES {
+        return Err(FormatError::Param(format!(
+            "the bake produced {total} nodes, more than the format's {MAX_NODES}: lower \
+             --resolution or raise --min-quad"
+        ))
+        .into());
+    }
+    let mut layer_roots = Vec::with_capacity(trees.len());
+    let mut roots = 0u32;
+    for t in &trees {
+        layer_roots.push((!t.levels.is_empty()).then(|| {
+            roots += 1;
+            roots - 1
+        }));
+    }
+    let mut nodes = Vec::with_capacity(total as usize);
+    let mut nodes_per_level = vec![0u64; levels];
+    let mut next_child = u64::from(roots);
+    for (k, count) in nodes_per_level.iter_mut().enumerate() {
+        for t in &trees {
+            if let Some(level) = t.levels.get(k) {
+                for n in level {
+                    nodes.push(QuadNode::new(n.mask, next_child as u32, n.depth));
+                    next_child += u64::from(n.mask.count_ones());
+                }
+                *count += level.len() as u64;
+            }
+        }
+    }
+    debug_assert_eq!(next_child, total);
+
+    let source = SourceInfo {
+        file: file.into(),
+        hash: format!("{:016x}", mesh.hash),
+        triangles: mesh.tris.len() as u64,
+        degenerate_triangles: mesh.degenerate,
+        materials: mesh.materials.iter().map(|m| m.name.clone()).collect(),
+    };
+    let manifest = manifest_for(*params, source, sphere, layer_roots, nodes_per_level);
+    let layers = Layers {
+        resolution: params.resolution,
+        count: params.layers(),
+        rgba: images.rgba.clone(),
+    };
+    let atlas = Atlas::from_layers(manifest, &layers, nodes)?;
+    Ok(BakeOutput {
+        atlas,
+        images,
+        triangles: mesh.tris.len() as u64,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Write per-pixel sphere depth (RGB) and coverage (A) of every layer as one EXR mosaic, laid
+/// out like the colour mosaic. Written to a temporary name, then renamed.
+pub fn write_depth_exr(path: &Path, out: &BakeOutput) -> Result<(), BakeError> {
+    let p = &out.atlas.manifest.params;
+    let (cols, res) = (p.mosaic_columns(), p.resolution as usize);
+    let (w, h) = (cols as usize * res, p.mosaic_rows() as usize * res);
+    let images = &out.images;
+    let tmp = tmp_name(path);
+    let result = exr::prelude::write_rgba_file(&tmp, w, h, |x, y| {
+        let (tx, ty) = (x / res, y / res);
+        let layer = ty * cols as usize + tx;
+        if layer >= images.layers as usize {
+            return (0.0f32, 0.0f32, 0.0f32, 0.0f32);
+        }
+        let i = (layer * res + y % res) * res + x % res;
+        let d = images.depth[i];
+        (d, d, d, f32::from(images.rgba[i * 4 + 3]) / 255.0)
+    });
+    finish_tmp(result.map_err(|e| e.to_string()), &tmp, path)
+}
+
+/// A sibling temporary name for atomic writes.
+pub fn tmp_name(path: &Path) -> std::path::PathBuf {
+    let name = path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+}
+
+/// Rename a finished temporary file into place, or remove it on error.
+pub fn finish_tmp(
+    result: Result<(), String>,
+    tmp: &Path,
+    path: &Path,
+) -> Result<(), BakeError> {
+    let result = result
+        .map_err(|e| FormatError::Image {
+            path: path.into(),
+            what: e,
+        })
+        .and_then(|()| {
+            std::fs::rename(tmp, path).map_err(|source| FormatError::Io {
+                path: path.into(),
+                source,
+            })
+        });
+    if result.is_err() {
+        let _ = std::fs::remove_file(tmp);
+    }
+    Ok(result?)
+}

@@ -1,0 +1,285 @@
+//! Loading a tree model (OBJ + MTL + textures) into flat triangles for the ray tracer.
+//!
+//! Polygons are triangulated by tobj. Texture alpha comes from `map_d` (its alpha channel, or
+//! its grey level when it has none) or else from the alpha channel of `map_Kd`; a material with
+//! either is *alpha-tested* at 0.5 and shaded as a leaf (translucent, see
+//! [`forest_format::shading`]). A missing or unreadable texture is an error naming the material
+//! and the file: silently drawing leaf cards as opaque squares would ruin the bake.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use forest_format::shading::{LEAF_TRANSLUCENCY, srgb_decode};
+use glam::{Vec2, Vec3};
+
+use crate::error::BakeError;
+use crate::texture::Texture;
+
+/// Alpha below this is a hole in an alpha-tested material.
+pub const ALPHA_CUTOFF: f32 = 0.5;
+
+/// A material as the bake uses it.
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// Name from the MTL.
+    pub name: String,
+    /// `Kd` as a linear multiplier (sRGB-decoded; white when absent).
+    pub kd: Vec3,
+    /// Index of the colour texture (`map_Kd`).
+    pub colour: Option<usize>,
+    /// Index of the texture giving alpha, and whether to read its alpha channel (else grey).
+    pub alpha: Option<(usize, bool)>,
+    /// Translucency of the shading model (leaves: [`LEAF_TRANSLUCENCY`]).
+    pub translucency: f32,
+}
+
+/// One triangle with its attributes.
+#[derive(Clone, Copy, Debug)]
+pub struct Tri {
+    /// Object-space positions (metres).
+    pub p: [Vec3; 3],
+    /// Texture coordinates (zero when the model has none).
+    pub uv: [Vec2; 3],
+    /// Vertex normals (the face normal when the model has none), unit length.
+    pub n: [Vec3; 3],
+    /// Material index.
+    pub material: u32,
+}
+
+/// A loaded model.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    /// Usable triangles.
+    pub tris: Vec<Tri>,
+    /// Materials (at least one: a grey default when the OBJ names none).
+    pub materials: Vec<Material>,
+    /// Textures referenced by materials.
+    pub textures: Vec<Texture>,
+    /// Zero-area triangles skipped.
+    pub degenerate: u64,
+    /// FNV-1a 64 hash of the OBJ, MTL and texture bytes.
+    pub hash: u64,
+}
+
+/// FNV-1a 64-bit hash, continued from `h`.
+pub fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+fn texture_path(obj_dir: &Path, spec: &str) -> PathBuf {
+    // MTL map statements may carry options before the file name (`-bm 1 file.png`): the file
+    // is the last word.
+    let file = spec.split_whitespace().last().unwrap_or(spec);
+    obj_dir.join(file.replace('\\', "/"))
+}
+
+impl Mesh {
+    /// Load an OBJ file with its materials and textures.
+    pub fn load(path: &Path) -> Result<Self, BakeError> {
+        let obj_bytes = std::fs::read(path).map_err(|source| BakeError::Io {
+            path: path.into(),
+            source,
+        })?;
+        let mut hash = fnv1a(FNV_OFFSET, &obj_bytes);
+        let obj_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        // Hash the material libraries too (tobj does not expose their bytes).
+        for line in String::from_utf8_lossy(&obj_bytes).lines() {
+            if let Some(rest) = line.trim_start().strip_prefix("mtllib")
+                && let Ok(b) = std::fs::read(obj_dir.join(rest.trim()))
+            {
+                hash = fnv1a(hash, &b);
+            }
+        }
+        let (models, materials) = tobj::load_obj_buf(
+            &mut std::io::Cursor::new(&obj_bytes),
+            &tobj::GPU_LOAD_OPTIONS,
+            |p| tobj::load_mtl(obj_dir.join(p)),
+        )
+        .map_err(|e| BakeError::Parse {
+            path: path.into(),
+            what: "OBJ",
+            reason: e.to_string(),
+        })?;
+        let materials = materials.map_err(|e| BakeError::Parse {
+            path: path.into(),
+            what: "material library",
+            reason: e.to_string(),
+        })?;
+
+        let mut textures: Vec<Texture> = Vec::new();
+        let mut by_path: HashMap<PathBuf, (usize, bool)> = HashMap::new();
+        let mut load_texture = |material: &str, spec: &str, hash: &mut u64| {
+            let file = texture_path(&obj_dir, spec);
+            if let Some(&i) = by_path.get(&file) {
+                return Ok(i);
+            }
+            let err = |reason: String| BakeError::Texture {
+                path: path.into(),
+                material: material.into(),
+                texture: file.clone(),
+                reason,
+            };
+            let bytes = std::fs::read(&file).map_err(|e| err(e.to_string()))?;
+            *hash = fnv1a(*hash, &bytes);
+            let img = image::load_from_memory(&bytes).map_err(|e| err(e.to_string()))?;
+            let img = img.to_rgba8();
+            if img.width() == 0 || img.height() == 0 {
+                return Err(err("empty image".into()));
+            }
+            let t = Texture::new(img.width(), img.height(), img.into_raw());
+            let i = (textures.len(), t.has_alpha);
+            textures.push(t);
+            by_path.insert(file, i);
+            Ok(i)
+        };
+
+        let mut mats = Vec::with_capacity(materials.len().max(1));
+        for m in &materials {
+            let kd = m
+                .diffuse
+                .map(|c| Vec3::from_array(c.map(srgb_decode)))
+                .unwrap_or(Vec3::ONE);
+            let colour = match &m.diffuse_texture {
+                Some(t) => Some(load_texture(&m.name, t, &mut hash)?),
+                None => None,
+            };
+            let alpha = match (&m.dissolve_texture, colour) {
+                (Some(t), _) => Some(load_texture(&m.name, t, &mut hash)?),
+                (None, Some((c, true))) => Some((c, true)),
+                _ => None,
+            };
+            let colour = colour.map(|(i, _)| i);
+            mats.push(Material {
+                name: m.name.clone(),
+                kd,
+                colour,
+                alpha,
+                translucency: if alpha.is_some() {
+                    LEAF_TRANSLUCENCY
+                } else {
+                    0.0
+                },
+            });
+        }
+        if mats.is_empty() {
+            mats.push(Material {
+                name: "default".into(),
+                kd: Vec3::splat(0.5),
+                colour: None,
+                alpha: None,
+                translucency: 0.0,
+            });
+        }
+
+        let mut tris = Vec::new();
+        let mut degenerate = 0u64;
+        let mut extent = 0.0f32;
+        for model in &models {
+            let mesh = &model.mesh;
+            if let Some(i) = mesh.positions.iter().position(|x| !x.is_finite()) {
+                return Err(BakeError::Model {
+                    path: path.into(),
+                    what: format!(
+                        "object {:?}: vertex {} has a non-finite coordinate ({})",
+                        model.name,
+                        i / 3 + 1,
+                        mesh.positions[i]
+                    ),
+                });
+            }
+            for p in mesh.positions.chunks_exact(3) {
+                extent = extent.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
+            }
+        }
+        // Zero-area test relative to the model's size.
+        let min_area2 = (extent * 1e-7).powi(4);
+        for model in &models {
+            let mesh = &model.mesh;
+            let pos = |i: u32| {
+                let i = i as usize * 3;
+                Vec3::new(
+                    mesh.positions[i],
+                    mesh.positions[i + 1],
+                    mesh.positions[i + 2],
+                )
+            };
+            let has_uv = mesh.texcoords.len() * 3 == mesh.positions.len() * 2;
+            let has_n = mesh.normals.len() == mesh.positions.len();
+            let material = mesh
+                .material_id
+                .filter(|&m| m < mats.len())
+                .unwrap_or(0) as u32;
+            for f in mesh.indices.chunks_exact(3) {
+                let f: [u32; 3] = [f[0], f[1], f[2]];
+                let p = f.map(pos);
+                let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+                if cross.length_squared() <= min_area2 || !cross.is_finite() {
+                    degenerate += 1;
+                    continue;
+                }
+                let face_n = cross.normalize();
+                let uv = f.map(|i| {
+                    let i = i as usize * 2;
+                    if has_uv {
+                        Vec2::new(mesh.texcoords[i], mesh.texcoords[i + 1])
+                    } else {
+                        Vec2::ZERO
+                    }
+                });
+                let n = f.map(|i| {
+                    let i = i as usize * 3;
+                    let n = if has_n {
+                        Vec3::new(mesh.normals[i], mesh.normals[i + 1], mesh.normals[i + 2])
+                    } else {
+                        face_n
+                    };
+                    n.try_normalize().unwrap_or(face_n)
+                });
+                tris.push(Tri {
+                    p,
+                    uv,
+                    n,
+                    material,
+                });
+            }
+        }
+        if tris.is_empty() {
+            return Err(BakeError::Model {
+                path: path.into(),
+                what: if degenerate > 0 {
+                    format!("all {degenerate} triangles are degenerate (zero area)")
+                } else {
+                    "no faces: the model has no triangles to bake".into()
+                },
+            });
+        }
+        Ok(Self {
+            tris,
+            materials: mats,
+            textures,
+            degenerate,
+            hash,
+        })
+    }
+
+    /// Alpha of material `m` at `uv` (1 for materials without alpha).
+    pub fn alpha(&self, m: u32, uv: Vec2) -> f32 {
+        match self.materials[m as usize].alpha {
+            None => 1.0,
+            Some((t, channel)) => {
+                let texel = self.textures[t].fetch(uv);
+                let a = if channel {
+                    texel[3]
+                } else {
+                    ((u32::from(texel[0]) + u32::from(texel[1]) + u32::from(texel[2])) / 3) as u8
+                };
+                f32::from(a) / 255.0
+            }
+        }
+    }
+}
