@@ -1,0 +1,236 @@
+//! End-to-end tests of `forest bake` and `forest info`: figures, outputs, and every bad input
+//! giving one clear error line, a non-zero exit and nothing written.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn forest(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_forest"))
+        .args(args)
+        .output()
+        .expect("the forest binary runs")
+}
+
+fn bush() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets/trees/bush/bush.obj")
+        .display()
+        .to_string()
+}
+
+const SMALL: [&str; 6] = ["--resolution", "64", "--directions", "4", "--spp", "2"];
+
+/// Run a bake that must fail; returns stderr after checking the exit code, that stderr is one
+/// line, and that nothing was written to the output folder.
+fn fails(model: &str, extra: &[&str], dir: &Path) -> String {
+    let out_path = dir.join("out.atlas");
+    let mut args = vec!["bake", model, "-o", out_path.to_str().unwrap()];
+    // The small settings, unless the case sets that option itself.
+    for pair in SMALL.chunks(2) {
+        if !extra.contains(&pair[0]) {
+            args.extend_from_slice(pair);
+        }
+    }
+    args.extend_from_slice(extra);
+    let before: Vec<PathBuf> = listing(dir);
+    let out = forest(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
+    assert!(!out_path.exists(), "{args:?} wrote {}", out_path.display());
+    assert_eq!(listing(dir), before, "{args:?} left files behind");
+    stderr
+}
+
+fn listing(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let atlas = dir.path().join("bush.atlas");
+    let sheet = dir.path().join("sheet.png");
+    let exr = dir.path().join("depth.exr");
+    let mut args = vec![
+        "bake",
+        &bush(),
+        "-o",
+        atlas.to_str().unwrap(),
+        "--json",
+        "--contact-sheet",
+        sheet.to_str().unwrap(),
+        "--depth-exr",
+        exr.to_str().unwrap(),
+    ]
+    .into_iter()
+    .map(String::from)
+    .collect::<Vec<_>>();
+    args.extend(SMALL.iter().map(|s| s.to_string()));
+    let out = forest(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(line.lines().count(), 1);
+    let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+    for key in [
+        "triangles",
+        "seconds",
+        "disk_bytes",
+        "gpu_bytes",
+        "levels",
+        "nodes_per_level",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key} in {line}");
+    }
+    assert_eq!(v["levels"], 5);
+    assert_eq!(v["nodes_per_level"].as_array().unwrap().len(), 5);
+    assert_eq!(
+        v["nodes_per_level"][0], 8,
+        "every one of the 8 layers has a root"
+    );
+    let on_disk: u64 = std::fs::read_dir(&atlas)
+        .unwrap()
+        .map(|e| e.unwrap().metadata().unwrap().len())
+        .sum();
+    assert_eq!(v["disk_bytes"].as_u64().unwrap(), on_disk);
+    let img = image::open(&sheet).unwrap();
+    assert!(img.width() > 64 && img.height() > 64);
+    assert!(exr.is_file());
+
+    let info = forest(&["info", atlas.to_str().unwrap(), "--json"]);
+    assert!(info.status.success());
+    let v2: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(v2["node_count"], v["node_count"]);
+    assert_eq!(v2["gpu_bytes"], v["gpu_bytes"]);
+}
+
+#[test]
+fn bad_parameters_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let b = bush();
+    let cases: [(&[&str], &str); 7] = [
+        (&["--resolution", "100"], "resolution = 100"),
+        (
+            &["--resolution", "64", "--min-quad", "64"],
+            "smaller than the resolution",
+        ),
+        (&["--min-quad", "3"], "min-quad = 3"),
+        (&["--directions", "0"], "directions = 0"),
+        (&["--slabs", "0"], "slabs = 0"),
+        (&["--spp", "0"], "spp = 0"),
+        (&["--sun", "10,95"], "elevation"),
+    ];
+    for (extra, want) in cases {
+        let err = fails(&b, extra, dir.path());
+        assert!(err.contains(want), "{extra:?}: {err}");
+    }
+    let err = fails(&b, &["--sun", "north"], dir.path());
+    assert!(err.contains("AZIMUTH,ELEVATION"), "{err}");
+}
+
+#[test]
+fn bad_models_give_one_clear_error_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let write = |name: &str, text: &str| {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    let missing = d.join("missing.obj").display().to_string();
+    assert!(fails(&missing, &[], d).contains("missing.obj"));
+
+    let garbage = write("garbage.obj", "v 1 2\nf 1 2 3\n");
+    assert!(fails(&garbage, &[], d).contains("cannot parse OBJ"));
+
+    let no_faces = write("nofaces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    assert!(fails(&no_faces, &[], d).contains("no faces"));
+
+    let nan = write("nan.obj", "v 0 0 0\nv 1 NaN 0\nv 0 1 0\nf 1 2 3\n");
+    assert!(fails(&nan, &[], d).contains("non-finite"));
+
+    let inf = write("inf.obj", "v 0 0 0\nv 1 inf 0\nv 0 1 0\nf 1 2 3\n");
+    assert!(fails(&inf, &[], d).contains("non-finite"));
+
+    let degenerate = write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+    assert!(fails(&degenerate, &[], d).contains("degenerate"));
+
+    write("nomtl.mtl", "newmtl leaf\nKd 1 1 1\nmap_Kd nowhere.png\n");
+    let missing_tex = write(
+        "tex.obj",
+        "mtllib nomtl.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\n",
+    );
+    let err = fails(&missing_tex, &[], d);
+    assert!(err.contains("nowhere.png") && err.contains("leaf"), "{err}");
+
+    let missing_mtl = write(
+        "lib.obj",
+        "mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    assert!(fails(&missing_mtl, &[], d).contains("material library"));
+
+    // Cleanup of the fixtures is the tempdir's; the listing check in `fails` covers outputs.
+}
+
+#[test]
+fn degenerate_triangles_are_skipped_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("mixed.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    let atlas = dir.path().join("mixed.atlas");
+    let mut args = vec![
+        "bake",
+        obj.to_str().unwrap(),
+        "-o",
+        atlas.to_str().unwrap(),
+        "--json",
+    ];
+    args.extend_from_slice(&SMALL);
+    let out = forest(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["triangles"], 1);
+    assert_eq!(v["degenerate_triangles"], 1);
+}
+
+#[test]
+fn outputs_that_cannot_be_written_are_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let b = bush();
+    let not_atlas = dir.path().join("keep");
+    std::fs::create_dir(&not_atlas).unwrap();
+    std::fs::write(not_atlas.join("precious.txt"), "x").unwrap();
+    let out = forest(&["bake", &b, "-o", not_atlas.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("refusing to overwrite"));
+    assert!(not_atlas.join("precious.txt").is_file());
+
+    let sheet = dir.path().join("no/such/dir/sheet.png");
+    let err = fails(
+        &b,
+        &["--contact-sheet", sheet.to_str().unwrap()],
+        dir.path(),
+    );
+    assert!(err.contains("does not exist"), "{err}");
+
+    let info = forest(&["info", dir.path().join("nothing.atlas").to_str().unwrap()]);
+    assert!(!info.status.success());
+    assert!(String::from_utf8_lossy(&info.stderr).contains("no such atlas"));
+}

@@ -42,7 +42,11 @@ pub fn compose(layers: &Layers, columns: u32) -> image::RgbImage {
                     }
                 }
                 let n = (scale * scale) as f32;
-                let check = if ((tx / 16) + (ty / 16)) % 2 == 0 { 0.55 } else { 0.35 };
+                let check = if ((tx / 16) + (ty / 16)) % 2 == 0 {
+                    0.55
+                } else {
+                    0.35
+                };
                 let bg = table[(check * 255.0) as usize];
                 let px = std::array::from_fn(|c| {
                     let v = acc[c] / n + bg * (1.0 - acc[3] / n);

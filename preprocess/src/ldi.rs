@@ -61,17 +61,38 @@ pub fn sample_offset(seed: u32, k: u32, spp: u32) -> Vec2 {
     }
 }
 
+/// What to trace: the framing sphere, the direction frames, the slab layout and the light.
+#[derive(Clone, Copy, Debug)]
+pub struct SlabSetup<'a> {
+    /// The sphere every image frames.
+    pub sphere: Sphere,
+    /// One frame per sampling direction.
+    pub frames: &'a [DirectionFrame],
+    /// Slabs per direction.
+    pub slabs: u32,
+    /// Image side in pixels.
+    pub resolution: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Lighting of the shading model.
+    pub lighting: Lighting,
+}
+
 /// Trace every layer. `progress(done, total)` is called as image rows complete.
 pub fn trace_layers(
     scene: &Scene,
-    sphere: &Sphere,
-    frames: &[DirectionFrame],
-    slabs: u32,
-    resolution: u32,
-    spp: u32,
-    lighting: &Lighting,
+    setup: &SlabSetup,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> SlabImages {
+    let SlabSetup {
+        sphere,
+        frames,
+        slabs,
+        resolution,
+        spp,
+        ref lighting,
+    } = *setup;
+    let sphere = &sphere;
     let r = resolution as usize;
     let layers = frames.len() as u32 * slabs;
     let total_rows = (frames.len() * r) as u64;
@@ -130,7 +151,7 @@ pub fn trace_layers(
                 }
             }
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if n % 64 == 0 || n == total_rows {
+            if n.is_multiple_of(64) || n == total_rows {
                 progress(n, total_rows);
             }
             (rgba, depth)
@@ -183,10 +204,27 @@ fn shade_hit(
     };
     let p = origin + dir * hit.t;
     // The shadow ray leaves from the side of the surface facing the sun.
-    let geo = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize_or_zero();
-    let side = if geo.dot(lighting.sun_dir) >= 0.0 { geo } else { -geo };
-    let lit = !scene.occluded(p + side * eps, lighting.sun_dir, eps, f32::INFINITY, hit.tri);
-    lighting.shade(albedo, n, if lit { 1.0 } else { 0.0 }, material.translucency)
+    let geo = (tri.p[1] - tri.p[0])
+        .cross(tri.p[2] - tri.p[0])
+        .normalize_or_zero();
+    let side = if geo.dot(lighting.sun_dir) >= 0.0 {
+        geo
+    } else {
+        -geo
+    };
+    let lit = !scene.occluded(
+        p + side * eps,
+        lighting.sun_dir,
+        eps,
+        f32::INFINITY,
+        hit.tri,
+    );
+    lighting.shade(
+        albedo,
+        n,
+        if lit { 1.0 } else { 0.0 },
+        material.translucency,
+    )
 }
 
 #[cfg(test)]

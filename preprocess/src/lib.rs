@@ -121,16 +121,15 @@ pub fn bake_mesh(
         .map(|&d| forest_format::slab::DirectionFrame::new(d))
         .collect();
     let lighting = params.lighting();
-    let images = ldi::trace_layers(
-        &scene,
-        &sphere,
-        &frames,
-        params.slabs,
-        params.resolution,
-        params.spp,
-        &lighting,
-        progress,
-    );
+    let setup = ldi::SlabSetup {
+        sphere,
+        frames: &frames,
+        slabs: params.slabs,
+        resolution: params.resolution,
+        spp: params.spp,
+        lighting,
+    };
+    let images = ldi::trace_layers(&scene, &setup, progress);
 
     // Quad hierarchies, one per layer, in parallel.
     let r2 = (params.resolution as usize).pow(2);
@@ -243,11 +242,7 @@ pub fn tmp_name(path: &Path) -> std::path::PathBuf {
 }
 
 /// Rename a finished temporary file into place, or remove it on error.
-pub fn finish_tmp(
-    result: Result<(), String>,
-    tmp: &Path,
-    path: &Path,
-) -> Result<(), BakeError> {
+pub fn finish_tmp(result: Result<(), String>, tmp: &Path, path: &Path) -> Result<(), BakeError> {
     let result = result
         .map_err(|e| FormatError::Image {
             path: path.into(),

@@ -210,10 +210,7 @@ impl Mesh {
             };
             let has_uv = mesh.texcoords.len() * 3 == mesh.positions.len() * 2;
             let has_n = mesh.normals.len() == mesh.positions.len();
-            let material = mesh
-                .material_id
-                .filter(|&m| m < mats.len())
-                .unwrap_or(0) as u32;
+            let material = mesh.material_id.filter(|&m| m < mats.len()).unwrap_or(0) as u32;
             for f in mesh.indices.chunks_exact(3) {
                 let f: [u32; 3] = [f[0], f[1], f[2]];
                 let p = f.map(pos);
@@ -240,12 +237,7 @@ impl Mesh {
                     };
                     n.try_normalize().unwrap_or(face_n)
                 });
-                tris.push(Tri {
-                    p,
-                    uv,
-                    n,
-                    material,
-                });
+                tris.push(Tri { p, uv, n, material });
             }
         }
         if tris.is_empty() {

@@ -292,11 +292,22 @@ mod tests {
         for y in 0..r {
             for x in 0..r {
                 let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
-                m.add(f64::from(alpha[y * r + x]) / 255.0, px, py, f64::from(depth[y * r + x]));
+                m.add(
+                    f64::from(alpha[y * r + x]) / 255.0,
+                    px,
+                    py,
+                    f64::from(depth[y * r + x]),
+                );
             }
         }
         let p = m.plane().unwrap();
-        for (x, y) in [(0.0, 0.0), (64.0, 0.0), (0.0, 64.0), (64.0, 64.0), (13.0, 40.0)] {
+        for (x, y) in [
+            (0.0, 0.0),
+            (64.0, 0.0),
+            (0.0, 64.0),
+            (64.0, 64.0),
+            (13.0, 40.0),
+        ] {
             assert!((p.at(x, y) - plane(x, y)).abs() < 1e-6, "({x},{y})");
         }
     }

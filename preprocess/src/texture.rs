@@ -78,7 +78,8 @@ mod tests {
         assert!(t.has_alpha);
         assert_eq!(t.fetch(Vec2::new(0.25, 0.75)), [255, 0, 0, 255]);
         assert_eq!(t.fetch(Vec2::new(0.75, 0.25)), [255, 255, 255, 128]);
-        assert_eq!(t.fetch(Vec2::new(1.25, -0.25)), [0, 0, 255, 0]);
+        assert_eq!(t.fetch(Vec2::new(1.25, 1.25)), [0, 0, 255, 0]);
+        assert_eq!(t.fetch(Vec2::new(-0.75, -0.25)), [255, 0, 0, 255]);
         assert_eq!(t.fetch(Vec2::new(f32::NAN, 0.0)), [255, 0, 0, 255]);
     }
 }

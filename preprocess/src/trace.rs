@@ -74,11 +74,7 @@ impl<'a> Scene<'a> {
             })
             .collect();
         let mut build_time = std::time::Duration::ZERO;
-        let bvh = build_cwbvh_from_tris(
-            &bvh_tris,
-            BvhBuildParams::medium_build(),
-            &mut build_time,
-        );
+        let bvh = build_cwbvh_from_tris(&bvh_tris, BvhBuildParams::medium_build(), &mut build_time);
         let tris = bvh
             .primitive_indices
             .iter()

@@ -33,7 +33,7 @@ pub struct BakeArgs {
     #[arg(long, default_value = "30,55", value_parser = parse_sun)]
     pub sun: (f32, f32),
     /// JPEG quality of the colour mosaic (1–100).
-    #[arg(long, default_value_t = 75, conflicts_with = "lossless")]
+    #[arg(long, default_value_t = 80, conflicts_with = "lossless")]
     pub quality: u8,
     /// Store colour losslessly (PNG) instead of JPEG.
     #[arg(long)]
@@ -62,7 +62,9 @@ pub struct InfoArgs {
 fn parse_sun(s: &str) -> Result<(f32, f32), String> {
     let parts: Vec<&str> = s.split(',').collect();
     let [az, el] = parts.as_slice() else {
-        return Err(format!("{s:?}: expected AZIMUTH,ELEVATION in degrees, e.g. 30,55"));
+        return Err(format!(
+            "{s:?}: expected AZIMUTH,ELEVATION in degrees, e.g. 30,55"
+        ));
     };
     let num = |x: &str| {
         x.trim()
@@ -101,7 +103,11 @@ fn check_output_file(path: &Path, what: &str) -> Result<()> {
     if let Some(p) = parent
         && !p.is_dir()
     {
-        bail!("{what} {}: folder {} does not exist", path.display(), p.display());
+        bail!(
+            "{what} {}: folder {} does not exist",
+            path.display(),
+            p.display()
+        );
     }
     if path.is_dir() {
         bail!("{what} {} is a folder", path.display());
@@ -113,7 +119,12 @@ fn check_output_file(path: &Path, what: &str) -> Result<()> {
 pub fn run(args: &BakeArgs) -> Result<()> {
     let params = args.params();
     params.validate()?;
-    if args.output.exists() && !args.output.join(forest_format::atlas::MANIFEST_FILE).is_file() {
+    if args.output.exists()
+        && !args
+            .output
+            .join(forest_format::atlas::MANIFEST_FILE)
+            .is_file()
+    {
         bail!(
             "{} exists and is not an atlas folder: refusing to overwrite it",
             args.output.display()

@@ -17,7 +17,17 @@ enum Cli {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => e.exit(), // --help, --version
+        Err(e) => {
+            // One line: clap's message without its usage block and hint.
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            eprintln!("forest: {first} (see forest --help)");
+            return ExitCode::from(2);
+        }
+    };
     let result = match cli {
         Cli::Bake(args) => bake::run(&args),
         Cli::Info(args) => bake::info(&args),

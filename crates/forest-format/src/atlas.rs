@@ -91,7 +91,7 @@ impl Default for BakeParams {
             spp: 4,
             sun_azimuth_deg: 30.0,
             sun_elevation_deg: 55.0,
-            colour: ColourEncoding::Jpeg { quality: 75 },
+            colour: ColourEncoding::Jpeg { quality: 80 },
         }
     }
 }
@@ -121,7 +121,10 @@ impl BakeParams {
     pub fn validate(&self) -> Result<(), FormatError> {
         let p = |s: String| Err(FormatError::Param(s));
         if !(1..=256).contains(&self.directions) {
-            return p(format!("directions = {}: must be 1 to 256", self.directions));
+            return p(format!(
+                "directions = {}: must be 1 to 256",
+                self.directions
+            ));
         }
         if !(1..=16).contains(&self.slabs) {
             return p(format!("slabs = {}: must be 1 to 16", self.slabs));
@@ -168,7 +171,8 @@ impl BakeParams {
         {
             return p(format!("quality = {quality}: must be 1 to 100"));
         }
-        let side = u64::from(self.resolution) * u64::from(self.mosaic_columns().max(self.mosaic_rows()));
+        let side =
+            u64::from(self.resolution) * u64::from(self.mosaic_columns().max(self.mosaic_rows()));
         if side > MAX_MOSAIC_SIDE {
             return p(format!(
                 "the colour mosaic would be {side} pixels wide, above {MAX_MOSAIC_SIDE}: lower \
@@ -244,7 +248,10 @@ impl AtlasManifest {
             }
             side /= 2;
         }
-        let rows = self.node_count.div_ceil(u64::from(NODE_TEXTURE_WIDTH)).max(1);
+        let rows = self
+            .node_count
+            .div_ceil(u64::from(NODE_TEXTURE_WIDTH))
+            .max(1);
         per_layer * u64::from(self.params.layers()) + rows * u64::from(NODE_TEXTURE_WIDTH) * 8
     }
 
@@ -310,7 +317,7 @@ impl AtlasManifest {
             ));
         }
         let s = &self.bounding_sphere;
-        if !s.center.is_finite() || !(s.radius.is_finite() && s.radius > 0.0) {
+        if !(s.center.is_finite() && s.radius.is_finite() && s.radius > 0.0) {
             return bad(format!("bounding sphere {s:?} is not finite and positive"));
         }
         if self.layer_roots.len() != self.params.layers() as usize {
@@ -334,9 +341,14 @@ impl AtlasManifest {
                 self.node_count
             ));
         }
-        let lighting_ok = [self.lighting.sun_dir, self.lighting.sun, self.lighting.sky, self.lighting.ground]
-            .iter()
-            .all(|v| v.is_finite());
+        let lighting_ok = [
+            self.lighting.sun_dir,
+            self.lighting.sun,
+            self.lighting.sky,
+            self.lighting.ground,
+        ]
+        .iter()
+        .all(|v| v.is_finite());
         if !lighting_ok {
             return bad("lighting has a non-finite value".into());
         }
@@ -414,6 +426,73 @@ fn encode_png(w: u32, h: u32, data: &[u8], colour: image::ExtendedColorType) -> 
     out
 }
 
+/// Fill the colour of blank pixels (alpha 0) with the average of nearby fully covered ones
+/// (push-pull over a 2×2 pyramid). Decoding clamps colour to alpha, so blank pixels read back
+/// black whatever they hold; filling them keeps JPEG from ringing and darkening the
+/// silhouettes against a black background, and makes the file smaller.
+pub fn fill_blank(w: u32, h: u32, rgb: &mut [u8], alpha: &[u8]) {
+    let (w, h) = (w as usize, h as usize);
+    // Level 0: colour sums and weights of fully covered pixels.
+    let mut levels: Vec<(usize, usize, Vec<[f32; 4]>)> = vec![(
+        w,
+        h,
+        (0..w * h)
+            .map(|i| {
+                if alpha[i] == 255 {
+                    let c = &rgb[i * 3..i * 3 + 3];
+                    [f32::from(c[0]), f32::from(c[1]), f32::from(c[2]), 1.0]
+                } else {
+                    [0.0; 4]
+                }
+            })
+            .collect(),
+    )];
+    while levels.last().is_some_and(|l| l.0 > 1 || l.1 > 1) {
+        let (pw, ph, prev) = levels.last().unwrap();
+        let (nw, nh) = (pw.div_ceil(2), ph.div_ceil(2));
+        let mut next = vec![[0f32; 4]; nw * nh];
+        for y in 0..*ph {
+            for x in 0..*pw {
+                let s = prev[y * pw + x];
+                let d = &mut next[(y / 2) * nw + x / 2];
+                for k in 0..4 {
+                    d[k] += s[k];
+                }
+            }
+        }
+        levels.push((nw, nh, next));
+    }
+    // Pull, coarsest first: a cell becomes its average (weight 1) or, when empty, its
+    // parent's (already pulled) value.
+    let normalise = |c: &mut [f32; 4]| {
+        if c[3] > 0.0 {
+            *c = [c[0] / c[3], c[1] / c[3], c[2] / c[3], 1.0];
+        }
+    };
+    levels.last_mut().unwrap().2.iter_mut().for_each(normalise);
+    for k in (0..levels.len() - 1).rev() {
+        let (upper, lower) = levels.split_at_mut(k + 1);
+        let (lw, _, cells) = &mut upper[k];
+        let (pw, _, parents) = &lower[0];
+        for (i, cell) in cells.iter_mut().enumerate() {
+            if cell[3] > 0.0 {
+                normalise(cell);
+            } else {
+                let (x, y) = (i % *lw, i / *lw);
+                *cell = parents[(y / 2) * pw + x / 2];
+            }
+        }
+    }
+    let (_, _, fine) = &levels[0];
+    for i in 0..w * h {
+        if alpha[i] == 0 {
+            for c in 0..3 {
+                rgb[i * 3 + c] = fine[i][c].round().clamp(0.0, 255.0) as u8;
+            }
+        }
+    }
+}
+
 /// Encode 8-bit coverage as the smallest PNG: indexed with 1, 2 or 4 bits per pixel when it
 /// has at most 2, 4 or 16 distinct values (as it does with up to 15 samples per pixel: coverage
 /// takes `spp + 1` values), else 8-bit grey. The palette holds grey `(v, v, v)` entries.
@@ -459,7 +538,9 @@ pub fn encode_alpha_png(w: u32, h: u32, alpha: &[u8]) -> Vec<u8> {
     writer
         .write_image_data(&packed)
         .expect("PNG data of the declared size cannot fail");
-    writer.finish().expect("finishing an in-memory PNG cannot fail");
+    writer
+        .finish()
+        .expect("finishing an in-memory PNG cannot fail");
     out
 }
 
@@ -475,7 +556,11 @@ impl Atlas {
         assert_eq!(layers.count, p.layers(), "one layer per direction and slab");
         assert_eq!(layers.resolution, p.resolution);
         let cols = p.mosaic_columns();
-        let (w, h, rgb) = layers.mosaic(cols, &[0, 1, 2]);
+        let (w, h, mut rgb) = layers.mosaic(cols, &[0, 1, 2]);
+        let (_, _, alpha) = layers.mosaic(cols, &[3]);
+        if matches!(p.colour, ColourEncoding::Jpeg { .. }) {
+            fill_blank(w, h, &mut rgb, &alpha);
+        }
         let colour_file = match p.colour {
             ColourEncoding::Png => encode_png(w, h, &rgb, image::ExtendedColorType::Rgb8),
             ColourEncoding::Jpeg { quality } => {
@@ -493,7 +578,6 @@ impl Atlas {
                 out
             }
         };
-        let (_, _, alpha) = layers.mosaic(cols, &[3]);
         let alpha_file = encode_alpha_png(w, h, &alpha);
         Ok(Self {
             manifest,
@@ -526,7 +610,9 @@ impl Atlas {
         // 8-bit grey, or a grey palette (which decodes to RGB with equal channels).
         let alpha = match alpha {
             image::DynamicImage::ImageLuma8(a) => a,
-            image::DynamicImage::ImageRgb8(rgb) if rgb.pixels().all(|p| p[0] == p[1] && p[1] == p[2]) => {
+            image::DynamicImage::ImageRgb8(rgb)
+                if rgb.pixels().all(|p| p[0] == p[1] && p[1] == p[2]) =>
+            {
                 image::GrayImage::from_fn(rgb.width(), rgb.height(), |x, y| {
                     image::Luma([rgb.get_pixel(x, y)[0]])
                 })
@@ -540,7 +626,10 @@ impl Atlas {
         };
         let (cols, rows) = (p.mosaic_columns(), p.mosaic_rows());
         let (w, h) = (cols * p.resolution, rows * p.resolution);
-        for (file, dims) in [(&colour_path, colour.dimensions()), (&alpha_path, alpha.dimensions())] {
+        for (file, dims) in [
+            (&colour_path, colour.dimensions()),
+            (&alpha_path, alpha.dimensions()),
+        ] {
             if dims != (w, h) {
                 return Err(FormatError::invalid(
                     file,
@@ -553,7 +642,9 @@ impl Atlas {
         }
         // Largest encoded colour allowed for each alpha: srgb_encode(alpha).
         let limit: [u8; 256] = std::array::from_fn(|a| {
-            (srgb_encode(a as f32 / 255.0) * 255.0).floor().clamp(0.0, 255.0) as u8
+            (srgb_encode(a as f32 / 255.0) * 255.0)
+                .floor()
+                .clamp(0.0, 255.0) as u8
         });
         let _ = srgb_decode; // the clamp is the encoded form of `srgb_decode(c) ≤ a`
         let r = p.resolution as usize;
@@ -602,13 +693,16 @@ impl Atlas {
         let _ = std::fs::remove_dir_all(&tmp);
         let result = (|| {
             std::fs::create_dir_all(&tmp).map_err(|e| FormatError::io(&tmp, e))?;
-            let manifest = serde_json::to_vec_pretty(&self.manifest)
-                .expect("the manifest serialises to JSON");
+            let manifest =
+                serde_json::to_vec_pretty(&self.manifest).expect("the manifest serialises to JSON");
             let files: [(&str, &[u8]); 4] = [
                 (MANIFEST_FILE, &manifest),
                 (self.manifest.params.colour.file_name(), &self.colour_file),
                 (ALPHA_FILE, &self.alpha_file),
-                (NODES_FILE, &nodes_codec::encode(&self.nodes, self.root_count())),
+                (
+                    NODES_FILE,
+                    &nodes_codec::encode(&self.nodes, self.root_count()),
+                ),
             ];
             let mut total = 0u64;
             for (file, bytes) in files {
@@ -663,8 +757,8 @@ impl Atlas {
         let colour_file = read(manifest.params.colour.file_name())?;
         let alpha_file = read(ALPHA_FILE)?;
         let npath = path.join(NODES_FILE);
-        let (nodes, roots) = nodes_codec::decode(&read(NODES_FILE)?)
-            .map_err(|e| FormatError::invalid(&npath, e))?;
+        let (nodes, roots) =
+            nodes_codec::decode(&read(NODES_FILE)?).map_err(|e| FormatError::invalid(&npath, e))?;
         if nodes.len() as u64 != manifest.node_count {
             return Err(FormatError::invalid(
                 &npath,

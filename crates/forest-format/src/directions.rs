@@ -46,7 +46,10 @@ pub fn hemisphere_directions(count: u32) -> Vec<Vec3> {
             counts[i] += 1;
         }
         while counts.iter().sum::<u32>() > rest {
-            let i = counts.iter().rposition(|&c| c > 1).unwrap_or(counts.len() - 1);
+            let i = counts
+                .iter()
+                .rposition(|&c| c > 1)
+                .unwrap_or(counts.len() - 1);
             counts[i] -= 1;
         }
         for (i, (&e, &n)) in elev.iter().zip(&counts).enumerate() {
@@ -71,7 +74,10 @@ pub fn hemisphere_directions(count: u32) -> Vec<Vec3> {
 /// Disk projection of a direction (below-horizon directions are clamped onto the horizon).
 pub fn disk_point(dir: Vec3) -> Vec2 {
     let horiz = Vec2::new(dir.x, dir.z);
-    let elevation = dir.y.atan2(horiz.length()).clamp(0.0, std::f32::consts::FRAC_PI_2);
+    let elevation = dir
+        .y
+        .atan2(horiz.length())
+        .clamp(0.0, std::f32::consts::FRAC_PI_2);
     let r = 1.0 - elevation / std::f32::consts::FRAC_PI_2;
     if horiz.length_squared() == 0.0 {
         return Vec2::ZERO;
@@ -179,7 +185,10 @@ mod tests {
     fn default_set_has_15_unit_upper_directions() {
         let d = hemisphere_directions(15);
         assert_eq!(d.len(), 15);
-        assert!(d.iter().all(|v| (v.length() - 1.0).abs() < 1e-6 && v.y >= 0.0));
+        assert!(
+            d.iter()
+                .all(|v| (v.length() - 1.0).abs() < 1e-6 && v.y >= 0.0)
+        );
         assert_eq!(d.iter().filter(|v| v.y.abs() < 1e-6).count(), 8);
         assert_eq!(*d.last().unwrap(), Vec3::Y);
         for n in 1..=64 {

@@ -40,7 +40,10 @@ impl QuadNode {
     /// If `first_child` does not fit 28 bits or `mask` has bits above the 4th (caller bugs).
     pub fn new(mask: u8, first_child: u32, depth: [u8; 4]) -> Self {
         assert!(mask < 16, "child mask has 4 bits");
-        assert!(u64::from(first_child) < MAX_NODES, "first child index fits 28 bits");
+        assert!(
+            u64::from(first_child) < MAX_NODES,
+            "first child index fits 28 bits"
+        );
         let first_child = if mask == 0 { 0 } else { first_child };
         Self {
             child: first_child | (u32::from(mask) << FIRST_CHILD_BITS),

@@ -16,10 +16,10 @@ const MAGIC: &[u8; 4] = b"FQN1";
 /// Predicted corner depths of child `i` from its parent's corners (integer bilinear).
 pub fn predict_child(parent: [u8; 4], i: u32) -> [u8; 4] {
     let p = parent.map(u32::from);
-    let top = (p[0] + p[1] + 1) / 2;
-    let left = (p[0] + p[2] + 1) / 2;
-    let right = (p[1] + p[3] + 1) / 2;
-    let bottom = (p[2] + p[3] + 1) / 2;
+    let top = (p[0] + p[1]).div_ceil(2);
+    let left = (p[0] + p[2]).div_ceil(2);
+    let right = (p[1] + p[3]).div_ceil(2);
+    let bottom = (p[2] + p[3]).div_ceil(2);
     let centre = (p[0] + p[1] + p[2] + p[3] + 2) / 4;
     let c = match i {
         0 => [p[0], top, left, centre],
@@ -75,8 +75,8 @@ pub fn encode(nodes: &[QuadNode], roots: usize) -> Vec<u8> {
             None => [128; 4],
             Some((p, i)) => predict_child(nodes[p as usize].depth, i),
         };
-        for c in 0..4 {
-            payload.push(node.depth[c].wrapping_sub(pred[c]));
+        for (d, p) in node.depth.iter().zip(pred) {
+            payload.push(d.wrapping_sub(p));
         }
     }
     let mut out = Vec::with_capacity(payload.len() / 3 + 12);

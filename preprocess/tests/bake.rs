@@ -1,0 +1,299 @@
+//! Bake tests with answers known in advance.
+
+use std::path::{Path, PathBuf};
+
+use forest_bake::{Mesh, ldi, trace::Scene};
+use forest_format::shading::{Lighting, srgb_decode, srgb_encode};
+use forest_format::slab::{DirectionFrame, Sphere};
+use forest_format::{Atlas, BakeParams, ColourEncoding};
+use glam::Vec3;
+
+/// Write a 1×1-metre-per-unit quad model: a horizontal square `[-1,1]²` at height 0, its
+/// texture opaque (white) for u ≥ 0.5 and transparent for u < 0.5.
+fn alpha_quad(dir: &Path) -> PathBuf {
+    let tex = image::RgbaImage::from_fn(2, 2, |x, _| {
+        if x == 1 {
+            image::Rgba([255, 255, 255, 255])
+        } else {
+            image::Rgba([255, 0, 0, 0])
+        }
+    });
+    tex.save(dir.join("card.png")).unwrap();
+    std::fs::write(
+        dir.join("quad.mtl"),
+        "newmtl card\nKd 0.5 0.5 0.5\nmap_Kd card.png\nmap_d card.png\n",
+    )
+    .unwrap();
+    let obj = dir.join("quad.obj");
+    std::fs::write(
+        &obj,
+        "mtllib quad.mtl\n\
+         v -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\n\
+         vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         vn 0 1 0\n\
+         usemtl card\nf 1/1/1 2/2/1 3/3/1 4/4/1\n",
+    )
+    .unwrap();
+    obj
+}
+
+#[test]
+fn alpha_textured_quad_seen_head_on_covers_exactly_the_expected_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = Mesh::load(&alpha_quad(dir.path())).unwrap();
+    assert_eq!(mesh.tris.len(), 2, "the quad is triangulated");
+    let scene = Scene::new(&mesh);
+    // The zenith view of a sphere of radius 2: 32 pixels span [-2, 2], 0.125 m each, so the
+    // quad covers pixels 8..24 and its opaque half (x ≥ 0) pixels 16..24 in x.
+    let sphere = Sphere {
+        center: Vec3::ZERO,
+        radius: 2.0,
+    };
+    let frames = [DirectionFrame::new(Vec3::Y)];
+    let lighting = Lighting::with_sun(0.0, 90.0);
+    let setup = ldi::SlabSetup {
+        sphere,
+        frames: &frames,
+        slabs: 1,
+        resolution: 32,
+        spp: 4,
+        lighting,
+    };
+    let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
+    // Expected colour: Kd 0.5 (sRGB) × white texture, facing the sun, lit, no translucency.
+    let albedo = Vec3::splat(srgb_decode(0.5));
+    let radiance = lighting.shade(albedo, Vec3::Y, 1.0, 0.35);
+    let want = radiance
+        .to_array()
+        .map(|c| (srgb_encode(c) * 255.0).round() as u8);
+    let frame = &frames[0];
+    let mut covered = 0;
+    for y in 0..32usize {
+        for x in 0..32usize {
+            let i = y * 32 + x;
+            let px = &img.rgba[i * 4..i * 4 + 4];
+            // Pixel centre in object space: image x runs along `right`, y down along `up`.
+            let p = sphere.image_to_object(
+                frame,
+                (x as f32 + 0.5) / 32.0,
+                (y as f32 + 0.5) / 32.0,
+                0.5,
+            );
+            let inside_quad = p.x.abs() < 1.0 && p.z.abs() < 1.0;
+            let u = 0.5 * (p.x + 1.0);
+            if inside_quad && u >= 0.5 {
+                covered += 1;
+                assert_eq!(px[3], 255, "pixel ({x},{y}) at {p} is covered");
+                for c in 0..3 {
+                    assert!(
+                        px[c].abs_diff(want[c]) <= 1,
+                        "pixel ({x},{y}): {px:?} vs {want:?}"
+                    );
+                }
+                assert!((img.depth[i] - 0.5).abs() < 1e-6, "depth {}", img.depth[i]);
+            } else {
+                assert_eq!(px, &[0, 0, 0, 0], "pixel ({x},{y}) at {p} is blank");
+            }
+        }
+    }
+    assert_eq!(covered, 8 * 16);
+}
+
+#[test]
+fn shadows_darken_a_card_under_another() {
+    // Two stacked horizontal squares, the lower one in the upper one's shadow (sun overhead).
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("two.obj");
+    std::fs::write(
+        &obj,
+        "v -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\n\
+         v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n\
+         f 1 2 3 4\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    let mesh = Mesh::load(&obj).unwrap();
+    let scene = Scene::new(&mesh);
+    let sphere = Sphere {
+        center: Vec3::new(0.0, 0.5, 0.0),
+        radius: 4.0,
+    };
+    let lighting = Lighting::with_sun(0.0, 90.0);
+    // Two slabs seen from the zenith: the upper square in slab 0, the lower one in slab 1.
+    let frames = [DirectionFrame::new(Vec3::Y)];
+    let setup = ldi::SlabSetup {
+        sphere,
+        frames: &frames,
+        slabs: 2,
+        resolution: 16,
+        spp: 1,
+        lighting,
+    };
+    let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
+    let grey = Vec3::splat(0.5);
+    let lit = lighting.shade(grey, Vec3::Y, 1.0, 0.0);
+    let shadowed = lighting.shade(grey, Vec3::Y, 0.0, 0.0);
+    let enc = |v: Vec3| (srgb_encode(v.x) * 255.0).round() as u8;
+    let centre = 8 * 16 + 8;
+    let back = 16 * 16 + centre;
+    assert_eq!(img.rgba[centre * 4], enc(lit), "upper square lit");
+    assert_eq!(
+        img.rgba[back * 4],
+        enc(shadowed),
+        "lower square shadowed under it"
+    );
+    // Beside the upper square (pixel 5 is at x = -1.25 m) the lower square is lit.
+    let edge = 16 * 16 + 8 * 16 + 5;
+    assert_eq!(img.rgba[edge * 4], enc(lit));
+    // The lower square lies at sphere depth (4 - (0 - 0.5)) / 8 = 0.5625.
+    assert!((img.depth[back] - 0.5625).abs() < 1e-6);
+}
+
+fn small_params() -> BakeParams {
+    BakeParams {
+        directions: 5,
+        resolution: 64,
+        min_quad: 4,
+        spp: 2,
+        ..BakeParams::default()
+    }
+}
+
+fn bush() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/trees/bush/bush.obj")
+}
+
+#[test]
+fn save_then_load_gives_identical_data() {
+    let out = forest_bake::bake_file(&bush(), &small_params(), &|_, _| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bush.atlas");
+    out.atlas.save(&path).unwrap();
+    let back = Atlas::load(&path).unwrap();
+    assert_eq!(back, out.atlas);
+    assert!(back.manifest.node_count > 0);
+    assert_eq!(back.manifest.levels, 5);
+    // Saving over an existing atlas replaces it and leaves no temporary folders.
+    out.atlas.save(&path).unwrap();
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("bush.atlas")]);
+}
+
+#[test]
+fn the_same_input_gives_a_byte_identical_atlas() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut files = Vec::new();
+    for name in ["a.atlas", "b.atlas"] {
+        let out = forest_bake::bake_file(&bush(), &small_params(), &|_, _| {}).unwrap();
+        let path = dir.path().join(name);
+        out.atlas.save(&path).unwrap();
+        let mut listing: Vec<(String, Vec<u8>)> = std::fs::read_dir(&path)
+            .unwrap()
+            .map(|e| {
+                let e = e.unwrap();
+                (
+                    e.file_name().to_string_lossy().into(),
+                    std::fs::read(e.path()).unwrap(),
+                )
+            })
+            .collect();
+        listing.sort();
+        files.push(listing);
+    }
+    assert_eq!(files[0].len(), 4);
+    assert_eq!(files[0], files[1]);
+}
+
+#[test]
+fn jpeg_colour_decodes_close_to_the_lossless_bake() {
+    // At a realistic resolution: JPEG on 64-pixel images is all edges.
+    let jpeg = BakeParams {
+        directions: 2,
+        resolution: 256,
+        ..small_params()
+    };
+    let lossless = BakeParams {
+        colour: ColourEncoding::Png,
+        ..jpeg
+    };
+    let a = forest_bake::bake_file(&bush(), &lossless, &|_, _| {}).unwrap();
+    let b = forest_bake::bake_file(&bush(), &jpeg, &|_, _| {}).unwrap();
+    let dir = Path::new("unused");
+    let la = a.atlas.decode_layers(dir).unwrap();
+    let lb = b.atlas.decode_layers(dir).unwrap();
+    // Lossless is exact (the clamp to alpha changes nothing in a valid bake).
+    assert_eq!(la.rgba, a.images.rgba);
+    // JPEG: PSNR over fully covered pixels (edges against the black, premultiplied
+    // background ring most); alpha is lossless.
+    let (mut se, mut bias, mut n) = (0f64, [0f64; 3], 0u64);
+    for (p, q) in la.rgba.chunks_exact(4).zip(lb.rgba.chunks_exact(4)) {
+        assert_eq!(p[3], q[3]);
+        if p[3] == 255 {
+            for c in 0..3 {
+                let d = f64::from(q[c]) - f64::from(p[c]);
+                se += d * d;
+                bias[c] += d;
+            }
+            n += 1;
+        }
+    }
+    // Foliage is all high frequencies: q80 JPEG measures about 25 dB here (the loss is masked
+    // by the texture; the benchmarks measure it with FLIP). A decoder that shifts colours (as
+    // zune-jpeg did with optimised Huffman tables) gives a large bias.
+    let psnr = 10.0 * (255f64.powi(2) / (se / (3 * n) as f64)).log10();
+    let bias = bias.map(|b| b / n as f64);
+    eprintln!("JPEG colour PSNR {psnr:.1} dB, bias {bias:.2?}");
+    assert!(psnr > 20.0, "JPEG colour PSNR {psnr:.1} dB");
+    // Noise clipped at 0 biases dark channels upwards by a few levels; a hue shift is tens.
+    for (c, b) in bias.iter().enumerate() {
+        assert!(b.abs() < 8.0, "channel {c} biased by {b:.2}");
+    }
+}
+
+#[test]
+fn the_loader_says_what_is_wrong() {
+    let out = forest_bake::bake_file(&bush(), &small_params(), &|_, _| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.atlas");
+    let reset = || {
+        out.atlas.save(&path).unwrap();
+    };
+    let err = |path: &Path| Atlas::load(path).unwrap_err().to_string();
+
+    reset();
+    let manifest = path.join("manifest.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 1", "\"version\": 99")).unwrap();
+    assert!(err(&path).contains("atlas version 99"), "{}", err(&path));
+
+    reset();
+    std::fs::write(&manifest, text.replace("\"levels\": 5", "\"levels\": 6")).unwrap();
+    assert!(err(&path).contains("levels = 6"), "{}", err(&path));
+
+    reset();
+    std::fs::write(&manifest, &text[..text.len() / 2]).unwrap();
+    assert!(
+        err(&path).contains("not a valid atlas manifest"),
+        "{}",
+        err(&path)
+    );
+
+    reset();
+    let nodes = path.join("nodes.bin");
+    let bytes = std::fs::read(&nodes).unwrap();
+    std::fs::write(&nodes, &bytes[..bytes.len() - 10]).unwrap();
+    assert!(err(&path).contains("nodes.bin"), "{}", err(&path));
+
+    reset();
+    std::fs::remove_file(path.join("alpha.png")).unwrap();
+    assert!(err(&path).contains("alpha.png"), "{}", err(&path));
+
+    reset();
+    let small = image::GrayImage::new(8, 8);
+    small.save(path.join("alpha.png")).unwrap();
+    assert!(err(&path).contains("expected"), "{}", err(&path));
+
+    assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
+}
