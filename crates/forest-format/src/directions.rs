@@ -3,9 +3,11 @@
 //! Directions lie on rings of constant elevation, the first ring on the horizon and the last
 //! point at the zenith, with points per ring proportional to the ring's circumference, so the
 //! set covers the whole hemisphere (views from below the horizon are clamped onto it). They
-//! are triangulated (Delaunay) in the disk projection `p = (1 − elevation/90°)·(sin φ, cos φ)`,
-//! `φ` the azimuth from +Z towards +X; the blend of a view direction is its barycentric
-//! coordinates in the triangle that contains its projection.
+//! are triangulated (Delaunay) in the octahedral projection `p = (x, z)/(|x| + max(y,0) + |z|)`
+//! (the zenith at the centre, the horizon on the diamond `|p.x| + |p.y| = 1`); the blend of a
+//! view direction is its barycentric coordinates in the triangle that contains its projection.
+//! The projection needs no trigonometry and is scale-invariant, so the GPU computes exactly the
+//! same weights as this CPU code from an unnormalised view vector.
 
 use glam::{Vec2, Vec3};
 
@@ -71,19 +73,15 @@ pub fn hemisphere_directions(count: u32) -> Vec<Vec3> {
     dirs
 }
 
-/// Disk projection of a direction (below-horizon directions are clamped onto the horizon).
+/// Octahedral projection of a direction (any length); below-horizon directions are clamped
+/// onto the horizon, and straight down (or zero) maps to the zenith's point.
 pub fn disk_point(dir: Vec3) -> Vec2 {
-    let horiz = Vec2::new(dir.x, dir.z);
-    let elevation = dir
-        .y
-        .atan2(horiz.length())
-        .clamp(0.0, std::f32::consts::FRAC_PI_2);
-    let r = 1.0 - elevation / std::f32::consts::FRAC_PI_2;
-    if horiz.length_squared() == 0.0 {
-        return Vec2::ZERO;
+    let den = dir.x.abs() + dir.y.max(0.0) + dir.z.abs();
+    if den > 0.0 {
+        Vec2::new(dir.x / den, dir.z / den)
+    } else {
+        Vec2::ZERO
     }
-    let h = horiz.normalize();
-    r * h
 }
 
 /// Delaunay triangles (counter-clockwise index triples) of the directions' disk projections.
@@ -209,8 +207,8 @@ mod tests {
                 0.5 * (b - a).perp_dot(c - a).abs()
             })
             .sum();
-        // A regular octagon inscribed in the unit circle has area 2√2.
-        assert!((area - 2.0 * 2f32.sqrt()).abs() < 1e-4, "area {area}");
+        // The 8 horizon points span the whole diamond |x| + |y| ≤ 1, of area 2.
+        assert!((area - 2.0).abs() < 1e-4, "area {area}");
     }
 
     #[test]
@@ -244,8 +242,8 @@ mod tests {
                 .map(|k| disk_point(d[b.index[k] as usize]) * b.weight[k])
                 .sum();
             let target = disk_point(view.normalize());
-            // Inside the hull exact; outside, the nearest hull point (within the octagon gap).
-            assert!((p - target).length() < 0.08, "{view}: {p} vs {target}");
+            // The hull is the whole diamond: barycentric weights reproduce the point.
+            assert!((p - target).length() < 1e-5, "{view}: {p} vs {target}");
         }
     }
 

@@ -12,6 +12,8 @@
 pub mod atlas;
 pub mod directions;
 pub mod error;
+pub mod forest;
+pub mod generate;
 pub mod node;
 pub mod nodes_codec;
 pub mod shading;

@@ -1,0 +1,441 @@
+//! Forest scenes: tree instances, their species (atlases), and presorted back-to-front orders.
+//!
+//! Two file forms:
+//! - **binary** (`.forest`): magic `FRST`, version, species names, instances as raw
+//!   little-endian [`Instance`] records, then the presort directions and orders. Compact enough
+//!   for 1M instances (24 bytes per instance plus 4 bytes per instance per presort direction).
+//! - **JSON** (`.json`), for small hand-made scenes: `{"species": [...], "instances": [{"species":
+//!   0, "position": [x, y, z], "rotation_deg": 0, "scale": 1}]}`; presorts are computed on load.
+//!
+//! Writers go through a temporary name and a rename; readers check every count and value.
+
+use std::io::Write;
+use std::path::Path;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::directions::hemisphere_directions;
+use crate::error::FormatError;
+
+/// Binary forest format version.
+pub const FOREST_VERSION: u32 = 1;
+const MAGIC: &[u8; 4] = b"FRST";
+/// Default number of presort directions.
+pub const DEFAULT_PRESORT_DIRECTIONS: u32 = 15;
+/// Most instances a forest may hold (indices must fit the GPU's quad records).
+pub const MAX_INSTANCES: usize = 1 << 24;
+
+/// One tree: 24 bytes, uploaded as is.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable, Serialize, Deserialize)]
+pub struct Instance {
+    /// Base of the tree in world space (metres); the model's origin goes here.
+    pub position: [f32; 3],
+    /// Rotation about +Y in radians (counter-clockwise seen from above).
+    pub rotation: f32,
+    /// Uniform scale (> 0).
+    pub scale: f32,
+    /// Index into [`Forest::species`].
+    pub species: u32,
+}
+
+/// Back-to-front instance orders along fixed directions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Presort {
+    /// Unit directions over the upper hemisphere (towards the viewer).
+    pub directions: Vec<Vec3>,
+    /// For each direction, every instance index once, farthest from a viewer in that direction
+    /// first (ascending `position · direction`, ties by index).
+    pub orders: Vec<Vec<u32>>,
+}
+
+impl Presort {
+    /// Presort `instances` along `count` hemisphere directions.
+    pub fn new(instances: &[Instance], count: u32) -> Self {
+        let directions = hemisphere_directions(count);
+        let orders = directions
+            .iter()
+            .map(|&d| {
+                let key: Vec<f32> = instances
+                    .iter()
+                    .map(|i| Vec3::from_array(i.position).dot(d))
+                    .collect();
+                let mut order: Vec<u32> = (0..instances.len() as u32).collect();
+                order.sort_by(|&a, &b| {
+                    key[a as usize]
+                        .total_cmp(&key[b as usize])
+                        .then(a.cmp(&b))
+                });
+                order
+            })
+            .collect();
+        Self { directions, orders }
+    }
+
+    /// Index of the presort direction nearest `towards_viewer` (largest dot product; the first
+    /// on ties), as the GPU chooses it.
+    pub fn nearest(directions: &[Vec3], towards_viewer: Vec3) -> usize {
+        let mut best = 0;
+        let mut best_dot = f32::NEG_INFINITY;
+        for (i, d) in directions.iter().enumerate() {
+            let c = d.dot(towards_viewer);
+            if c > best_dot {
+                best = i;
+                best_dot = c;
+            }
+        }
+        best
+    }
+}
+
+/// A forest: species (atlas names), instances and presorts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Forest {
+    /// Atlas of each species: a path, relative to the forest file's folder unless absolute.
+    pub species: Vec<String>,
+    /// The trees.
+    pub instances: Vec<Instance>,
+    /// Presorted orders (one per presort direction).
+    pub presort: Presort,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonInstance {
+    species: u32,
+    position: [f32; 3],
+    #[serde(default)]
+    rotation_deg: f32,
+    #[serde(default = "one")]
+    scale: f32,
+}
+fn one() -> f32 {
+    1.0
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonForest {
+    species: Vec<String>,
+    instances: Vec<JsonInstance>,
+    #[serde(default)]
+    presort_directions: Option<u32>,
+}
+
+impl Forest {
+    /// A forest with presorts computed along `presort_directions` directions.
+    pub fn new(species: Vec<String>, instances: Vec<Instance>, presort_directions: u32) -> Self {
+        let presort = Presort::new(&instances, presort_directions);
+        Self {
+            species,
+            instances,
+            presort,
+        }
+    }
+
+    /// Check values: species indices in range, finite positions, positive finite scales,
+    /// presort orders that are permutations.
+    pub fn check(&self, path: &Path) -> Result<(), FormatError> {
+        let bad = |what: String| Err(FormatError::invalid(path, what));
+        if self.species.is_empty() && !self.instances.is_empty() {
+            return bad("instances but no species".into());
+        }
+        if self.instances.len() > MAX_INSTANCES {
+            return bad(format!(
+                "{} instances, more than the supported {MAX_INSTANCES}",
+                self.instances.len()
+            ));
+        }
+        for (k, i) in self.instances.iter().enumerate() {
+            if i.species as usize >= self.species.len() {
+                return bad(format!(
+                    "instance {k} has species {} but there are {} species",
+                    i.species,
+                    self.species.len()
+                ));
+            }
+            if !(i.position.iter().all(|x| x.is_finite()) && i.rotation.is_finite()) {
+                return bad(format!("instance {k} has a non-finite position or rotation"));
+            }
+            if !(i.scale.is_finite() && i.scale > 0.0) {
+                return bad(format!("instance {k} has scale {}, not positive", i.scale));
+            }
+        }
+        let p = &self.presort;
+        if p.directions.is_empty() || p.directions.len() != p.orders.len() {
+            return bad(format!(
+                "{} presort directions with {} orders",
+                p.directions.len(),
+                p.orders.len()
+            ));
+        }
+        let n = self.instances.len();
+        for (k, order) in p.orders.iter().enumerate() {
+            let mut seen = vec![false; n];
+            let ok = order.len() == n
+                && order.iter().all(|&i| {
+                    (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true)
+                });
+            if !ok {
+                return bad(format!(
+                    "presort order {k} is not a permutation of the {n} instances"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Read a forest: JSON when the name ends in `.json`, else binary.
+    pub fn load(path: &Path) -> Result<Self, FormatError> {
+        let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+        let forest = if path.extension().is_some_and(|e| e == "json") {
+            let j: JsonForest = serde_json::from_slice(&bytes).map_err(|e| {
+                FormatError::invalid(path, format!("not a valid forest JSON: {e}"))
+            })?;
+            let instances = j
+                .instances
+                .iter()
+                .map(|i| Instance {
+                    position: i.position,
+                    rotation: i.rotation_deg.to_radians(),
+                    scale: i.scale,
+                    species: i.species,
+                })
+                .collect();
+            let k = j.presort_directions.unwrap_or(DEFAULT_PRESORT_DIRECTIONS);
+            if !(1..=256).contains(&k) {
+                return Err(FormatError::invalid(
+                    path,
+                    format!("presort_directions = {k}: must be 1 to 256"),
+                ));
+            }
+            Self::new(j.species, instances, k)
+        } else {
+            Self::from_bytes(&bytes).map_err(|e| FormatError::invalid(path, e))?
+        };
+        forest.check(path)?;
+        Ok(forest)
+    }
+
+    /// Write a forest (JSON when the name ends in `.json`, else binary), atomically.
+    pub fn save(&self, path: &Path) -> Result<(), FormatError> {
+        let bytes = if path.extension().is_some_and(|e| e == "json") {
+            let j = JsonForest {
+                species: self.species.clone(),
+                instances: self
+                    .instances
+                    .iter()
+                    .map(|i| JsonInstance {
+                        species: i.species,
+                        position: i.position,
+                        rotation_deg: i.rotation.to_degrees(),
+                        scale: i.scale,
+                    })
+                    .collect(),
+                presort_directions: Some(self.presort.directions.len() as u32),
+            };
+            serde_json::to_vec_pretty(&j).expect("a forest serialises")
+        } else {
+            self.to_bytes()
+        };
+        write_atomic(path, &bytes)
+    }
+
+    /// The binary form.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&FOREST_VERSION.to_le_bytes());
+        out.extend_from_slice(&(self.species.len() as u32).to_le_bytes());
+        for s in &self.species {
+            out.extend_from_slice(&(s.len() as u32).to_le_bytes());
+            out.extend_from_slice(s.as_bytes());
+        }
+        out.extend_from_slice(&(self.instances.len() as u32).to_le_bytes());
+        out.extend_from_slice(bytemuck::cast_slice(&self.instances));
+        out.extend_from_slice(&(self.presort.directions.len() as u32).to_le_bytes());
+        for d in &self.presort.directions {
+            out.extend_from_slice(bytemuck::cast_slice(&d.to_array()));
+        }
+        for o in &self.presort.orders {
+            out.extend_from_slice(bytemuck::cast_slice(o));
+        }
+        out
+    }
+
+    /// Parse the binary form; the error says what is wrong.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, String> {
+        let mut r = Reader { bytes, at: 0 };
+        if r.take(4)? != MAGIC {
+            return Err("not a forest file (missing the FRST header)".into());
+        }
+        let version = r.u32()?;
+        if version != FOREST_VERSION {
+            return Err(format!(
+                "forest version {version} but this program reads version {FOREST_VERSION}"
+            ));
+        }
+        let ns = r.u32()? as usize;
+        let mut species = Vec::with_capacity(ns.min(1024));
+        for _ in 0..ns {
+            let len = r.u32()? as usize;
+            let s = std::str::from_utf8(r.take(len)?)
+                .map_err(|_| "a species name is not UTF-8".to_string())?;
+            species.push(s.to_string());
+        }
+        let n = r.u32()? as usize;
+        if n > MAX_INSTANCES {
+            return Err(format!("{n} instances, more than the supported {MAX_INSTANCES}"));
+        }
+        let instances: Vec<Instance> = bytemuck::pod_collect_to_vec(r.take(n * 24)?);
+        let k = r.u32()? as usize;
+        if k == 0 || k > 256 {
+            return Err(format!("{k} presort directions (must be 1 to 256)"));
+        }
+        let dirs: Vec<f32> = bytemuck::pod_collect_to_vec(r.take(k * 12)?);
+        let directions = dirs.chunks_exact(3).map(Vec3::from_slice).collect();
+        let mut orders = Vec::with_capacity(k);
+        for _ in 0..k {
+            orders.push(bytemuck::pod_collect_to_vec(r.take(n * 4)?));
+        }
+        if r.at != bytes.len() {
+            return Err(format!(
+                "{} bytes of trailing data after the presorts",
+                bytes.len() - r.at
+            ));
+        }
+        Ok(Self {
+            species,
+            instances,
+            presort: Presort { directions, orders },
+        })
+    }
+
+    /// Largest distance of any instance position from the origin of the forest (metres).
+    pub fn extent(&self) -> f32 {
+        self.instances
+            .iter()
+            .map(|i| Vec3::from_array(i.position).length())
+            .fold(0.0, f32::max)
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let end = end.ok_or_else(|| {
+            format!(
+                "truncated: needs {n} bytes at offset {}, the file has {}",
+                self.at,
+                self.bytes.len()
+            )
+        })?;
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
+    }
+}
+
+/// Write `bytes` to `path` through a temporary sibling and a rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| FormatError::invalid(path, "not a file name"))?
+        .to_string_lossy()
+        .into_owned();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(FormatError::io(path, e));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Forest {
+        let instances = (0..50)
+            .map(|i| Instance {
+                position: [(i % 7) as f32 * 3.0, 0.0, (i / 7) as f32 * 4.0 - 10.0],
+                rotation: i as f32 * 0.3,
+                scale: 0.8 + (i % 3) as f32 * 0.1,
+                species: i % 2,
+            })
+            .collect();
+        Forest::new(vec!["a.atlas".into(), "b.atlas".into()], instances, 15)
+    }
+
+    #[test]
+    fn presort_orders_are_back_to_front() {
+        let f = sample();
+        for (d, order) in f.presort.directions.iter().zip(&f.presort.orders) {
+            let keys: Vec<f32> = order
+                .iter()
+                .map(|&i| Vec3::from_array(f.instances[i as usize].position).dot(*d))
+                .collect();
+            assert!(keys.windows(2).all(|w| w[0] <= w[1]));
+        }
+        // Seen from +Z (the horizon direction at azimuth 0), the first tree is the one with
+        // the smallest z.
+        let k = Presort::nearest(&f.presort.directions, Vec3::Z);
+        assert!(f.presort.directions[k].z > 0.99);
+        let first = f.instances[f.presort.orders[k][0] as usize];
+        assert_eq!(first.position[2], -10.0);
+    }
+
+    #[test]
+    fn binary_and_json_round_trip() {
+        let f = sample();
+        let dir = tempfile::tempdir().unwrap();
+        let bin = dir.path().join("f.forest");
+        f.save(&bin).unwrap();
+        assert_eq!(Forest::load(&bin).unwrap(), f);
+        let json = dir.path().join("f.json");
+        f.save(&json).unwrap();
+        let back = Forest::load(&json).unwrap();
+        assert_eq!(back.species, f.species);
+        assert_eq!(back.instances.len(), f.instances.len());
+        for (a, b) in back.instances.iter().zip(&f.instances) {
+            assert!((a.rotation - b.rotation).abs() < 1e-5);
+            assert_eq!(a.position, b.position);
+        }
+    }
+
+    #[test]
+    fn bad_forests_are_rejected_with_a_reason() {
+        let f = sample();
+        let bytes = f.to_bytes();
+        assert!(Forest::from_bytes(&bytes[..bytes.len() - 1]).unwrap_err().contains("truncated"));
+        assert!(Forest::from_bytes(b"nope").unwrap_err().contains("FRST"));
+        let mut g = f.clone();
+        g.instances[3].species = 9;
+        assert!(g.check(Path::new("x")).unwrap_err().to_string().contains("species 9"));
+        let mut g = f.clone();
+        g.instances[1].scale = 0.0;
+        assert!(g.check(Path::new("x")).is_err());
+        let mut g = f.clone();
+        g.presort.orders[2][0] = g.presort.orders[2][1];
+        assert!(g.check(Path::new("x")).unwrap_err().to_string().contains("permutation"));
+        let mut g = f;
+        g.instances[0].position[1] = f32::NAN;
+        assert!(g.check(Path::new("x")).is_err());
+    }
+}

@@ -1,0 +1,196 @@
+//! Forest generation: trees in natural clumps, after "Seeing the Wood for the Trees" (2011).
+//!
+//! Candidate points are drawn uniformly over a square; each is kept with probability given by
+//! an exponential turbulence map `t(p) = Σ_o |n(p·2^o/λ)|/2^o` (value noise `n ∈ [−1, 1]`,
+//! 4 octaves, normalised to `[0,1]`), after `t` is raised to the power 3: low values leave gaps
+//! between clumps, high values fill them, with organic, vein-like edges. Species come from a
+//! second, coarser noise so that each species also grows in patches. Deterministic per seed.
+
+use crate::forest::{Forest, Instance};
+
+/// Parameters of [`generate`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenerateParams {
+    /// Number of trees (≥ 1).
+    pub trees: u32,
+    /// Species names (atlas paths); at least one.
+    pub species: Vec<String>,
+    /// Mean ground area per tree over the whole square, m² (sets the square's side).
+    pub area_per_tree: f32,
+    /// Clump feature size λ in metres.
+    pub clump_size: f32,
+    /// Uniform scale range.
+    pub scale: (f32, f32),
+    /// Random seed.
+    pub seed: u64,
+    /// Presort directions.
+    pub presort_directions: u32,
+}
+
+impl Default for GenerateParams {
+    fn default() -> Self {
+        Self {
+            trees: 1000,
+            species: Vec::new(),
+            area_per_tree: 30.0,
+            clump_size: 60.0,
+            scale: (0.8, 1.25),
+            seed: 1,
+            presort_directions: crate::forest::DEFAULT_PRESORT_DIRECTIONS,
+        }
+    }
+}
+
+/// SplitMix64: a small, fast, well-mixed generator (deterministic across platforms).
+#[derive(Clone, Debug)]
+pub struct SplitMix64(pub u64);
+
+impl SplitMix64 {
+    /// Next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[0, 1)`.
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+fn lattice(ix: i32, iy: i32, seed: u64) -> f32 {
+    let mut h = SplitMix64(seed ^ (ix as u32 as u64) << 32 ^ iy as u32 as u64);
+    h.next_f32() * 2.0 - 1.0
+}
+
+/// Smooth value noise in `[−1, 1]` with unit lattice spacing.
+pub fn value_noise(x: f32, y: f32, seed: u64) -> f32 {
+    let (fx, fy) = (x.floor(), y.floor());
+    let (ix, iy) = (fx as i32, fy as i32);
+    let s = |t: f32| t * t * (3.0 - 2.0 * t);
+    let (tx, ty) = (s(x - fx), s(y - fy));
+    let a = lattice(ix, iy, seed) * (1.0 - tx) + lattice(ix + 1, iy, seed) * tx;
+    let b = lattice(ix, iy + 1, seed) * (1.0 - tx) + lattice(ix + 1, iy + 1, seed) * tx;
+    a * (1.0 - ty) + b * ty
+}
+
+/// Turbulence in `[0, 1]`: 4 octaves of |value noise|.
+pub fn turbulence(x: f32, y: f32, seed: u64) -> f32 {
+    let mut sum = 0.0;
+    let mut norm = 0.0;
+    for o in 0..4 {
+        let f = (1 << o) as f32;
+        sum += value_noise(x * f, y * f, seed.wrapping_add(o as u64)).abs() / f;
+        norm += 1.0 / f;
+    }
+    sum / norm
+}
+
+/// Generate a forest; the error says which parameter is wrong.
+pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
+    if p.trees == 0 || p.trees as usize > crate::forest::MAX_INSTANCES {
+        return Err(format!(
+            "trees = {}: must be 1 to {}",
+            p.trees,
+            crate::forest::MAX_INSTANCES
+        ));
+    }
+    if p.species.is_empty() {
+        return Err("at least one species (atlas) is needed".into());
+    }
+    if !(p.area_per_tree.is_finite() && p.area_per_tree > 0.0) {
+        return Err(format!("area per tree = {}: must be positive", p.area_per_tree));
+    }
+    if !(p.clump_size.is_finite() && p.clump_size > 0.0) {
+        return Err(format!("clump size = {}: must be positive", p.clump_size));
+    }
+    if !(p.scale.0 > 0.0 && p.scale.1 >= p.scale.0 && p.scale.1.is_finite()) {
+        return Err(format!("scale range {:?}: must be 0 < min ≤ max", p.scale));
+    }
+    if !(1..=256).contains(&p.presort_directions) {
+        return Err(format!(
+            "presort directions = {}: must be 1 to 256",
+            p.presort_directions
+        ));
+    }
+    let side = (p.trees as f32 * p.area_per_tree).sqrt();
+    let mut rng = SplitMix64(p.seed);
+    let mut instances = Vec::with_capacity(p.trees as usize);
+    let max_attempts = 1000u64 * u64::from(p.trees);
+    let mut attempts = 0u64;
+    while instances.len() < p.trees as usize {
+        attempts += 1;
+        if attempts > max_attempts {
+            return Err("the clump map accepts too few points; raise the clump size".into());
+        }
+        let x = (rng.next_f32() - 0.5) * side;
+        let z = (rng.next_f32() - 0.5) * side;
+        let t = turbulence(x / p.clump_size, z / p.clump_size, p.seed).powi(3) * 8.0;
+        if rng.next_f32() >= t.min(1.0) {
+            continue;
+        }
+        let patch = value_noise(x / (p.clump_size * 3.0), z / (p.clump_size * 3.0), p.seed ^ 0xabc);
+        let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
+            .floor()
+            .clamp(0.0, (p.species.len() - 1) as f32) as u32;
+        instances.push(Instance {
+            position: [x, 0.0, z],
+            rotation: rng.next_f32() * std::f32::consts::TAU,
+            scale: p.scale.0 + (p.scale.1 - p.scale.0) * rng.next_f32(),
+            species: pick,
+        });
+    }
+    Ok(Forest::new(p.species.clone(), instances, p.presort_directions))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params(trees: u32, seed: u64) -> GenerateParams {
+        GenerateParams {
+            trees,
+            species: vec!["a".into(), "b".into(), "c".into()],
+            seed,
+            ..GenerateParams::default()
+        }
+    }
+
+    #[test]
+    fn generation_is_deterministic_per_seed() {
+        let a = generate(&params(500, 7)).unwrap();
+        assert_eq!(a, generate(&params(500, 7)).unwrap());
+        assert_ne!(a.instances, generate(&params(500, 8)).unwrap().instances);
+        assert_eq!(a.instances.len(), 500);
+        assert!(a.instances.iter().all(|i| i.species < 3));
+        let used: std::collections::HashSet<u32> = a.instances.iter().map(|i| i.species).collect();
+        assert!(used.len() >= 2, "several species: {used:?}");
+    }
+
+    #[test]
+    fn trees_are_clumped() {
+        // Count trees per 20 m cell: clumps make the variance well above Poisson's (= mean).
+        let f = generate(&params(4000, 3)).unwrap();
+        let side = (4000.0f32 * 30.0).sqrt();
+        let cells = (side / 20.0).ceil() as usize;
+        let mut counts = vec![0f64; cells * cells];
+        for i in &f.instances {
+            let cx = (((i.position[0] / side) + 0.5) * cells as f32) as usize;
+            let cz = (((i.position[2] / side) + 0.5) * cells as f32) as usize;
+            counts[cz.min(cells - 1) * cells + cx.min(cells - 1)] += 1.0;
+        }
+        let mean = counts.iter().sum::<f64>() / counts.len() as f64;
+        let var = counts.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / counts.len() as f64;
+        assert!(var > 3.0 * mean, "variance {var:.1} vs mean {mean:.1}");
+    }
+
+    #[test]
+    fn bad_parameters_are_named() {
+        assert!(generate(&params(0, 1)).unwrap_err().contains("trees = 0"));
+        let mut p = params(10, 1);
+        p.species.clear();
+        assert!(generate(&p).unwrap_err().contains("species"));
+    }
+}
