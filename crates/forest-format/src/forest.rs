@@ -63,11 +63,7 @@ impl Presort {
                     .map(|i| Vec3::from_array(i.position).dot(d))
                     .collect();
                 let mut order: Vec<u32> = (0..instances.len() as u32).collect();
-                order.sort_by(|&a, &b| {
-                    key[a as usize]
-                        .total_cmp(&key[b as usize])
-                        .then(a.cmp(&b))
-                });
+                order.sort_by(|&a, &b| key[a as usize].total_cmp(&key[b as usize]).then(a.cmp(&b)));
                 order
             })
             .collect();
@@ -157,7 +153,9 @@ impl Forest {
                 ));
             }
             if !(i.position.iter().all(|x| x.is_finite()) && i.rotation.is_finite()) {
-                return bad(format!("instance {k} has a non-finite position or rotation"));
+                return bad(format!(
+                    "instance {k} has a non-finite position or rotation"
+                ));
             }
             if !(i.scale.is_finite() && i.scale > 0.0) {
                 return bad(format!("instance {k} has scale {}, not positive", i.scale));
@@ -175,9 +173,9 @@ impl Forest {
         for (k, order) in p.orders.iter().enumerate() {
             let mut seen = vec![false; n];
             let ok = order.len() == n
-                && order.iter().all(|&i| {
-                    (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true)
-                });
+                && order
+                    .iter()
+                    .all(|&i| (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true));
             if !ok {
                 return bad(format!(
                     "presort order {k} is not a permutation of the {n} instances"
@@ -191,9 +189,8 @@ impl Forest {
     pub fn load(path: &Path) -> Result<Self, FormatError> {
         let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
         let forest = if path.extension().is_some_and(|e| e == "json") {
-            let j: JsonForest = serde_json::from_slice(&bytes).map_err(|e| {
-                FormatError::invalid(path, format!("not a valid forest JSON: {e}"))
-            })?;
+            let j: JsonForest = serde_json::from_slice(&bytes)
+                .map_err(|e| FormatError::invalid(path, format!("not a valid forest JSON: {e}")))?;
             let instances = j
                 .instances
                 .iter()
@@ -287,7 +284,9 @@ impl Forest {
         }
         let n = r.u32()? as usize;
         if n > MAX_INSTANCES {
-            return Err(format!("{n} instances, more than the supported {MAX_INSTANCES}"));
+            return Err(format!(
+                "{n} instances, more than the supported {MAX_INSTANCES}"
+            ));
         }
         let instances: Vec<Instance> = bytemuck::pod_collect_to_vec(r.take(n * 24)?);
         let k = r.u32()? as usize;
@@ -423,17 +422,31 @@ mod tests {
     fn bad_forests_are_rejected_with_a_reason() {
         let f = sample();
         let bytes = f.to_bytes();
-        assert!(Forest::from_bytes(&bytes[..bytes.len() - 1]).unwrap_err().contains("truncated"));
+        assert!(
+            Forest::from_bytes(&bytes[..bytes.len() - 1])
+                .unwrap_err()
+                .contains("truncated")
+        );
         assert!(Forest::from_bytes(b"nope").unwrap_err().contains("FRST"));
         let mut g = f.clone();
         g.instances[3].species = 9;
-        assert!(g.check(Path::new("x")).unwrap_err().to_string().contains("species 9"));
+        assert!(
+            g.check(Path::new("x"))
+                .unwrap_err()
+                .to_string()
+                .contains("species 9")
+        );
         let mut g = f.clone();
         g.instances[1].scale = 0.0;
         assert!(g.check(Path::new("x")).is_err());
         let mut g = f.clone();
         g.presort.orders[2][0] = g.presort.orders[2][1];
-        assert!(g.check(Path::new("x")).unwrap_err().to_string().contains("permutation"));
+        assert!(
+            g.check(Path::new("x"))
+                .unwrap_err()
+                .to_string()
+                .contains("permutation")
+        );
         let mut g = f;
         g.instances[0].position[1] = f32::NAN;
         assert!(g.check(Path::new("x")).is_err());

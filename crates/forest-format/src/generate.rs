@@ -101,7 +101,10 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         return Err("at least one species (atlas) is needed".into());
     }
     if !(p.area_per_tree.is_finite() && p.area_per_tree > 0.0) {
-        return Err(format!("area per tree = {}: must be positive", p.area_per_tree));
+        return Err(format!(
+            "area per tree = {}: must be positive",
+            p.area_per_tree
+        ));
     }
     if !(p.clump_size.is_finite() && p.clump_size > 0.0) {
         return Err(format!("clump size = {}: must be positive", p.clump_size));
@@ -131,7 +134,11 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         if rng.next_f32() >= t.min(1.0) {
             continue;
         }
-        let patch = value_noise(x / (p.clump_size * 3.0), z / (p.clump_size * 3.0), p.seed ^ 0xabc);
+        let patch = value_noise(
+            x / (p.clump_size * 3.0),
+            z / (p.clump_size * 3.0),
+            p.seed ^ 0xabc,
+        );
         let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
             .floor()
             .clamp(0.0, (p.species.len() - 1) as f32) as u32;
@@ -142,7 +149,11 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             species: pick,
         });
     }
-    Ok(Forest::new(p.species.clone(), instances, p.presort_directions))
+    Ok(Forest::new(
+        p.species.clone(),
+        instances,
+        p.presort_directions,
+    ))
 }
 
 #[cfg(test)]

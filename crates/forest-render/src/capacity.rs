@@ -1,0 +1,105 @@
+//! The one place that sizes every GPU buffer of the runtime.
+
+use crate::gpu_types::{GpuArgs, GpuState, Quad};
+
+/// Workgroup size of per-item passes.
+pub const WG: u32 = 256;
+/// Scan block (two items per thread).
+pub const BLOCK: u32 = 512;
+/// Most items one scan handles (three levels of blocks).
+pub const MAX_SCAN: u64 = (BLOCK as u64).pow(3);
+
+/// What the buffer sizes are computed from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CapacityInput {
+    /// Tree instances in the forest.
+    pub instances: u32,
+    /// Largest `3 × slabs` over the species: level-0 quads one tree can emit.
+    pub quads_per_tree: u32,
+    /// Viewport in pixels.
+    pub viewport: (u32, u32),
+    /// Smallest ε (pixels) the scene will be refined with.
+    pub min_epsilon: f32,
+    /// Mean number of quad layers covering a pixel that refinement must afford.
+    pub overdraw: f32,
+    /// Explicit quad capacity, overriding the formula.
+    pub max_quads: Option<u32>,
+}
+
+/// Buffer sizes in elements and bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Capacity {
+    /// Quads each of the two stream buffers holds: `Q`.
+    pub quads: u32,
+    /// Elements of the scan/count and flag buffers: `max(N, Q)`.
+    pub items: u32,
+    /// Elements of the scan's block-sum buffer: `ceil(items/512) + 512`.
+    pub sums: u32,
+}
+
+impl Capacity {
+    /// `Q = min(N · quads_per_tree, 2^23) + overdraw · W · H / (ε_min / 2)²`, unless given.
+    ///
+    /// The first term holds the level-0 quads of every tree at once (a bird's-eye view of the
+    /// whole forest), the second the quads refinement adds: each refined quad is at least
+    /// `ε/2` pixels on a side, so a screen covered `overdraw` times holds at most that many.
+    /// When a frame needs more, the overflow policy applies (farthest trees and quads first)
+    /// and counters report it; nothing is written out of bounds.
+    pub fn new(c: &CapacityInput) -> Self {
+        let quads = c.max_quads.unwrap_or_else(|| {
+            let level0 = (u64::from(c.instances) * u64::from(c.quads_per_tree)).min(1 << 23);
+            let half = f64::from(c.min_epsilon.max(1.0)) / 2.0;
+            let refine = f64::from(c.overdraw) * f64::from(c.viewport.0) * f64::from(c.viewport.1)
+                / (half * half);
+            (level0 + refine as u64).clamp(1, MAX_SCAN.min(WG as u64 * 65_535)) as u32
+        });
+        let items = quads.max(c.instances).max(1);
+        Self {
+            quads,
+            items,
+            sums: items.div_ceil(BLOCK) + BLOCK,
+        }
+    }
+
+    /// Bytes of each buffer the runtime allocates per renderer (not counting scene data).
+    pub fn bytes(&self) -> u64 {
+        let quad = std::mem::size_of::<Quad>() as u64;
+        2 * u64::from(self.quads) * quad
+            + 2 * u64::from(self.items) * 4
+            + u64::from(self.sums) * 4
+            + (std::mem::size_of::<GpuState>() + std::mem::size_of::<GpuArgs>()) as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formula_matches_the_documentation() {
+        let c = Capacity::new(&CapacityInput {
+            instances: 100_000,
+            quads_per_tree: 6,
+            viewport: (800, 600),
+            min_epsilon: 8.0,
+            overdraw: 16.0,
+            max_quads: None,
+        });
+        assert_eq!(c.quads, 600_000 + 480_000);
+        assert_eq!(c.items, 1_080_000);
+        assert_eq!(c.sums, 1_080_000u32.div_ceil(512) + 512);
+        let fixed = Capacity::new(&CapacityInput {
+            max_quads: Some(10),
+            instances: 3,
+            ..CapacityInput {
+                instances: 0,
+                quads_per_tree: 6,
+                viewport: (8, 8),
+                min_epsilon: 8.0,
+                overdraw: 1.0,
+                max_quads: None,
+            }
+        });
+        assert_eq!((fixed.quads, fixed.items), (10, 10));
+    }
+}

@@ -1,0 +1,89 @@
+//! A headless wgpu device with the features the renderer uses, and validation-error capture.
+
+use std::sync::{Arc, Mutex};
+
+/// Why the renderer cannot start or load a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// No usable GPU adapter.
+    #[error(
+        "no GPU adapter found ({0}). Without a GPU, install a software Vulkan driver: \
+         `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu)"
+    )]
+    NoAdapter(String),
+    /// The adapter refused the device.
+    #[error("cannot open the GPU device: {0}")]
+    Device(String),
+    /// The scene does not fit the device or is inconsistent.
+    #[error("{0}")]
+    Scene(String),
+    /// An atlas or forest file problem.
+    #[error(transparent)]
+    Format(#[from] forest_format::FormatError),
+}
+
+/// Device, queue and the validation errors wgpu reported so far.
+pub struct GpuContext {
+    /// The adapter's description (name, backend, type).
+    pub adapter_info: wgpu::AdapterInfo,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuContext {
+    /// Open the first adapter that `WGPU_BACKEND` (default: all) offers, preferring a
+    /// high-performance one, with timestamp queries and BC textures where available and the
+    /// adapter's own limits.
+    pub fn headless() -> Result<Self, RenderError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        Self::from_adapter(&adapter)
+    }
+
+    /// Open a device on a given adapter (for windows with a surface).
+    pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Self, RenderError> {
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::TEXTURE_COMPRESSION_BC;
+        let features = adapter.features() & wanted;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("forest"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().unwrap().push(e.to_string());
+        }));
+        Ok(Self {
+            adapter_info: adapter.get_info(),
+            device,
+            queue,
+            errors,
+        })
+    }
+
+    /// Validation and out-of-memory errors reported since the last call (drained).
+    pub fn take_errors(&self) -> Vec<String> {
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+        std::mem::take(&mut *self.errors.lock().unwrap())
+    }
+
+    /// Whether BC textures are available (else colour is uploaded as RGBA8).
+    pub fn has_bc(&self) -> bool {
+        self.device
+            .features()
+            .contains(wgpu::Features::TEXTURE_COMPRESSION_BC)
+    }
+}

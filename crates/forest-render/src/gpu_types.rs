@@ -1,0 +1,181 @@
+//! Host mirrors of the WGSL structs in `shaders/common.wgsl`, `bindings.wgsl` and `draw.wgsl`.
+//! A test reflects the WGSL with naga and checks every size and member offset against these.
+
+use bytemuck::{Pod, Zeroable};
+
+/// The camera: the only data written to the GPU per frame (208 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuCamera {
+    /// Projection × view, column-major.
+    pub view_proj: [[f32; 4]; 4],
+    /// Eye position (world, metres) and, in `w`, ε in pixels.
+    pub eye: [f32; 4],
+    /// Unit view direction (world).
+    pub forward: [f32; 4],
+    /// Viewport width and height in pixels.
+    pub viewport: [f32; 4],
+    /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
+    pub planes: [[f32; 4]; 6],
+}
+
+/// A tree instance on the GPU (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// Base position (world).
+    pub position: [f32; 3],
+    /// Uniform scale.
+    pub scale: f32,
+    /// cos of the rotation about +Y.
+    pub cos_rot: f32,
+    /// sin of the rotation about +Y.
+    pub sin_rot: f32,
+    /// Species index.
+    pub species: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// Per-species table entry (48 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuSpecies {
+    /// Bounding sphere centre (object space) and radius.
+    pub sphere: [f32; 4],
+    /// Sampling directions.
+    pub directions: u32,
+    /// Slabs per direction.
+    pub slabs: u32,
+    /// Quad levels.
+    pub levels: u32,
+    /// First entry in the frame table.
+    pub dir_base: u32,
+    /// First entry in the direction-triangle table.
+    pub tri_base: u32,
+    /// Direction triangles.
+    pub tri_count: u32,
+    /// First layer in the colour array and the root table.
+    pub layer_base: u32,
+    /// First node in the node texture.
+    pub node_base: u32,
+}
+
+/// A sampling direction's frame (48 bytes; `w` unused).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuFrame {
+    /// Towards the sampling camera.
+    pub dir: [f32; 4],
+    /// Image x axis.
+    pub right: [f32; 4],
+    /// Image up axis.
+    pub up: [f32; 4],
+}
+
+/// One quad of the stream (16 bytes); see `shaders/common.wgsl` for the bit layout.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Pod, Zeroable)]
+pub struct Quad {
+    /// Instance index.
+    pub instance: u32,
+    /// Global node index.
+    pub node: u32,
+    /// level | x << 4 | y << 16 | slab << 28.
+    pub pos: u32,
+    /// direction | alpha (unorm16) << 16.
+    pub dir_weight: u32,
+}
+
+impl Quad {
+    /// Pack the position word.
+    pub fn pack_pos(level: u32, x: u32, y: u32, slab: u32) -> u32 {
+        level | (x << 4) | (y << 16) | (slab << 28)
+    }
+    /// Quad level.
+    pub fn level(&self) -> u32 {
+        self.pos & 15
+    }
+    /// Quad column.
+    pub fn x(&self) -> u32 {
+        (self.pos >> 4) & 4095
+    }
+    /// Quad row.
+    pub fn y(&self) -> u32 {
+        (self.pos >> 16) & 4095
+    }
+    /// Slab.
+    pub fn slab(&self) -> u32 {
+        self.pos >> 28
+    }
+    /// Direction index within the species.
+    pub fn dir(&self) -> u32 {
+        self.dir_weight & 0xffff
+    }
+    /// Blend alpha.
+    pub fn weight(&self) -> f32 {
+        (self.dir_weight >> 16) as f32 / 65535.0
+    }
+}
+
+/// Frame state written by the GPU (96 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct GpuState {
+    /// Chosen presort direction.
+    pub presort: u32,
+    /// Items of the pass being run; after the frame, quads in the final stream.
+    pub n: u32,
+    /// Last scan total.
+    pub total: u32,
+    /// Refine bookkeeping.
+    pub pmin: u32,
+    /// Level-0 quads dropped because the stream was full.
+    pub overflow_cull: u32,
+    /// Quads left unrefined because the stream was full (summed over iterations).
+    pub overflow_refine: u32,
+    /// Trees passing the frustum test.
+    pub visible: u32,
+    /// Quads drawn.
+    pub quads: u32,
+    /// Quads per level in the final stream.
+    pub per_level: [u32; 16],
+}
+
+/// Indirect arguments (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct GpuArgs {
+    /// Per-item dispatches.
+    pub items: [u32; 4],
+    /// Scan level-0 blocks.
+    pub blocks0: [u32; 4],
+    /// Scan level-1 blocks.
+    pub blocks1: [u32; 4],
+    /// One workgroup.
+    pub one: [u32; 4],
+    /// Draw: vertex count, instance count, first vertex, first instance.
+    pub draw: [u32; 4],
+}
+
+/// Scene constants (16 bytes), written once.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct SceneConsts {
+    /// Instances.
+    pub instances: u32,
+    /// Presort directions.
+    pub presort_dirs: u32,
+    /// Quad capacity of each stream buffer.
+    pub capacity: u32,
+    /// Species.
+    pub species: u32,
+}
+
+/// Ground colour and size (16 bytes), written once.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuGround {
+    /// Lit colour (linear) and the half side of the ground square (metres).
+    pub colour: [f32; 4],
+}

@@ -1,0 +1,23 @@
+//! The runtime of the quad-stream forest renderer (Liu, Hua & Bao 2010) on wgpu.
+//!
+//! ```text
+//! SpeciesData::load (atlases) + Forest ─► GpuScene (uploaded once) ─► QuadStream
+//! per frame: set_camera (the one upload) ─► encode: cull ─► refine × (l − 1) ─► draw
+//! ```
+//! [`reference`] computes passes 1 and 2 on the CPU over the same tables; tests require the
+//! GPU's stream to equal it quad for quad.
+
+pub mod camera;
+pub mod capacity;
+pub mod context;
+pub mod gpu_types;
+pub mod passes;
+pub mod reference;
+pub mod renderer;
+pub mod scene;
+pub mod target;
+
+pub use camera::Camera;
+pub use context::{GpuContext, RenderError};
+pub use renderer::{FrameStats, QuadStream, RendererOptions};
+pub use scene::{GpuScene, SpeciesData};

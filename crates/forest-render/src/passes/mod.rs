@@ -1,0 +1,194 @@
+//! The GPU passes, one struct each, and the layout they share.
+//!
+//! All compute entry points live in one WGSL module (common + bindings + scan + cull +
+//! refine) and share one bind-group layout, so the ping-pong stream buffers are swapped by
+//! swapping bind groups. The draw pass has its own module (common + draw).
+
+pub mod cull;
+pub mod draw;
+pub mod refine;
+pub mod scan;
+
+/// WGSL of the compute passes.
+pub const COMPUTE_WGSL: [&str; 5] = [
+    include_str!("../../../../shaders/common.wgsl"),
+    include_str!("../../../../shaders/bindings.wgsl"),
+    include_str!("../../../../shaders/scan.wgsl"),
+    include_str!("../../../../shaders/cull.wgsl"),
+    include_str!("../../../../shaders/refine.wgsl"),
+];
+
+/// WGSL of the draw pass.
+pub const DRAW_WGSL: [&str; 2] = [
+    include_str!("../../../../shaders/common.wgsl"),
+    include_str!("../../../../shaders/draw.wgsl"),
+];
+
+/// The compute module's source.
+pub fn compute_source() -> String {
+    COMPUTE_WGSL.concat()
+}
+
+/// The draw module's source.
+pub fn draw_source() -> String {
+    DRAW_WGSL.concat()
+}
+
+/// Bindings of the compute layout, in order: (binding, kind).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// Uniform buffer.
+    Uniform,
+    /// Read-only storage buffer.
+    Read,
+    /// Read-write storage buffer.
+    ReadWrite,
+    /// `texture_2d<u32>`.
+    UintTexture,
+}
+
+/// The compute layout's group 0: 17 bindings (see `shaders/bindings.wgsl`); binding 11 is
+/// unused (the arguments are group 1, bound only for the entry points that write them).
+pub const COMPUTE_SLOTS: [Slot; 17] = [
+    Slot::Uniform,     // 0 camera
+    Slot::Uniform,     // 1 scene constants
+    Slot::Read,        // 2 instances
+    Slot::Read,        // 3 species
+    Slot::Read,        // 4 frames
+    Slot::Read,        // 5 direction triangles
+    Slot::Read,        // 6 roots
+    Slot::Read,        // 7 presort directions
+    Slot::UintTexture, // 8 presort
+    Slot::UintTexture, // 9 nodes
+    Slot::ReadWrite,   // 10 state
+    Slot::Read,        // 11 unused (a spare read-only slot)
+    Slot::ReadWrite,   // 12 data (scan)
+    Slot::ReadWrite,   // 13 block sums
+    Slot::ReadWrite,   // 14 want flags
+    Slot::Read,        // 15 quads in
+    Slot::ReadWrite,   // 16 quads out
+];
+
+/// Layout entries for slots.
+pub fn layout_entries(
+    slots: &[Slot],
+    visibility: wgpu::ShaderStages,
+) -> Vec<wgpu::BindGroupLayoutEntry> {
+    slots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| wgpu::BindGroupLayoutEntry {
+            binding: i as u32,
+            visibility,
+            ty: match s {
+                Slot::Uniform => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                Slot::Read | Slot::ReadWrite => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage {
+                        read_only: *s == Slot::Read,
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                Slot::UintTexture => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+            },
+            count: None,
+        })
+        .collect()
+}
+
+/// The shared compute layout and module.
+pub struct ComputeShared {
+    /// Bind-group layout of all compute passes (group 0).
+    pub bind_layout: wgpu::BindGroupLayout,
+    /// Group 1: the indirect-argument buffer, for the entry points that write it.
+    pub args_layout: wgpu::BindGroupLayout,
+    /// Pipeline layout of the passes that read their arguments (group 0 only).
+    pub pipeline_layout: wgpu::PipelineLayout,
+    /// Pipeline layout of the argument writers (groups 0 and 1).
+    pub writer_layout: wgpu::PipelineLayout,
+    /// The compute module.
+    pub module: wgpu::ShaderModule,
+}
+
+impl ComputeShared {
+    /// Create the layout and compile the module.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("compute"),
+            entries: &layout_entries(&COMPUTE_SLOTS, wgpu::ShaderStages::COMPUTE),
+        });
+        let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("indirect arguments"),
+            entries: &layout_entries(&[Slot::ReadWrite], wgpu::ShaderStages::COMPUTE),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("compute"),
+            bind_group_layouts: &[Some(&bind_layout)],
+            immediate_size: 0,
+        });
+        let writer_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("compute, argument writers"),
+            bind_group_layouts: &[Some(&bind_layout), Some(&args_layout)],
+            immediate_size: 0,
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("compute passes"),
+            source: wgpu::ShaderSource::Wgsl(compute_source().into()),
+        });
+        Self {
+            bind_layout,
+            args_layout,
+            pipeline_layout,
+            writer_layout,
+            module,
+        }
+    }
+
+    /// A pipeline for one entry point that reads its dispatch arguments.
+    pub fn pipeline(&self, device: &wgpu::Device, entry: &str) -> wgpu::ComputePipeline {
+        self.make(device, entry, &self.pipeline_layout)
+    }
+
+    /// A pipeline for one entry point that writes the dispatch arguments (group 1).
+    pub fn writer(&self, device: &wgpu::Device, entry: &str) -> wgpu::ComputePipeline {
+        self.make(device, entry, &self.writer_layout)
+    }
+
+    fn make(
+        &self,
+        device: &wgpu::Device,
+        entry: &str,
+        layout: &wgpu::PipelineLayout,
+    ) -> wgpu::ComputePipeline {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(layout),
+            module: &self.module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    }
+}
+
+/// Byte offsets of the dispatch arguments in the args buffer (see `GpuArgs`).
+pub mod args {
+    /// `ceil(n/256)` workgroups.
+    pub const ITEMS: u64 = 0;
+    /// `ceil(n/512)`.
+    pub const BLOCKS0: u64 = 16;
+    /// `ceil(n/512²)`.
+    pub const BLOCKS1: u64 = 32;
+    /// One workgroup.
+    pub const ONE: u64 = 48;
+    /// Draw arguments.
+    pub const DRAW: u64 = 64;
+}

@@ -1,0 +1,58 @@
+//! Pass 2, refine (`shaders/refine.wgsl`): `l − 1` order-preserving subdivision steps
+//! between the two stream buffers, then per-level statistics of the final stream.
+
+use super::scan::ScanPass;
+use super::{ComputeShared, args};
+
+/// The refine pass's pipelines.
+pub struct RefinePass {
+    count: wgpu::ComputePipeline,
+    decide: wgpu::ComputePipeline,
+    emit: wgpu::ComputePipeline,
+    finish: wgpu::ComputePipeline,
+    stats: wgpu::ComputePipeline,
+}
+
+impl RefinePass {
+    /// Create the pipelines.
+    pub fn new(device: &wgpu::Device, shared: &ComputeShared) -> Self {
+        Self {
+            count: shared.pipeline(device, "refine_count"),
+            decide: shared.pipeline(device, "refine_decide"),
+            emit: shared.pipeline(device, "refine_emit"),
+            finish: shared.writer(device, "refine_finish"),
+            stats: shared.pipeline(device, "stats"),
+        }
+    }
+
+    /// Record `iterations` steps alternating `ping` (A → B) and `pong` (B → A), then the
+    /// statistics over the final buffer through `final_in` (a bind group reading it).
+    pub fn record(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        iterations: u32,
+        ping: &wgpu::BindGroup,
+        pong: &wgpu::BindGroup,
+        args_group: &wgpu::BindGroup,
+        args_buf: &wgpu::Buffer,
+        scan: &ScanPass,
+    ) {
+        pass.set_bind_group(1, args_group, &[]);
+        for it in 0..iterations {
+            pass.set_bind_group(0, if it % 2 == 0 { ping } else { pong }, &[]);
+            pass.set_pipeline(&self.count);
+            pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+            scan.record(pass, args_buf);
+            for p in [&self.decide, &self.emit] {
+                pass.set_pipeline(p);
+                pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+            }
+            pass.set_pipeline(&self.finish);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        // The final stream is A after an even number of steps (read it through `ping`).
+        pass.set_bind_group(0, if iterations % 2 == 0 { ping } else { pong }, &[]);
+        pass.set_pipeline(&self.stats);
+        pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+    }
+}

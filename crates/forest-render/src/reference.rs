@@ -1,0 +1,254 @@
+//! CPU reference of passes 1 (cull) and 2 (refine) over the same tables the GPU gets, with
+//! the same arithmetic in the same order, so the GPU's quad stream must equal it exactly.
+
+use forest_format::directions::blend;
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad};
+use crate::scene::SceneTables;
+
+/// Result of the reference: the final stream and the frame's counters.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reference {
+    /// Presort direction chosen.
+    pub presort: u32,
+    /// Trees passing the frustum test.
+    pub visible: u32,
+    /// The final stream.
+    pub quads: Vec<Quad>,
+    /// Quads per level (first `levels` entries).
+    pub per_level: Vec<u32>,
+    /// Level-0 quads dropped.
+    pub overflow_cull: u32,
+    /// Quads left unrefined for lack of room.
+    pub overflow_refine: u32,
+}
+
+fn to_world(inst: &GpuInstance, p: Vec3) -> Vec3 {
+    let s = p * inst.scale;
+    Vec3::new(
+        inst.cos_rot * s.x + inst.sin_rot * s.z,
+        s.y,
+        -inst.sin_rot * s.x + inst.cos_rot * s.z,
+    ) + Vec3::from_array(inst.position)
+}
+
+fn to_object_dir(inst: &GpuInstance, d: Vec3) -> Vec3 {
+    Vec3::new(
+        inst.cos_rot * d.x - inst.sin_rot * d.z,
+        d.y,
+        inst.sin_rot * d.x + inst.cos_rot * d.z,
+    )
+}
+
+fn unorm16(x: f32) -> u32 {
+    (x.clamp(0.0, 1.0) * 65535.0 + 0.5).floor() as u32
+}
+
+fn xyz(v: [f32; 4]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> bool {
+    let c = to_world(inst, xyz(sp.sphere));
+    let r = sp.sphere[3] * inst.scale;
+    cam.planes
+        .iter()
+        .all(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] >= -r)
+}
+
+/// Level-0 quads of one tree (see `tree_quads` in `shaders/cull.wgsl`).
+fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
+    let inst = &t.instances[inst_id as usize];
+    let sp = &t.species[inst.species as usize];
+    let eye_obj = to_object_dir(inst, xyz(cam.eye) - to_world(inst, xyz(sp.sphere)));
+    let base = sp.dir_base as usize;
+    let dirs: Vec<Vec3> = t.frames[base..base + sp.directions as usize]
+        .iter()
+        .map(|f| xyz(f.dir))
+        .collect();
+    let tris: Vec<[u32; 3]> = t.tris[sp.tri_base as usize..(sp.tri_base + sp.tri_count) as usize]
+        .iter()
+        .map(|x| [x[0], x[1], x[2]])
+        .collect();
+    let bl = blend(&dirs, &tris, eye_obj);
+    let w16 = bl.weight.map(unorm16);
+    let mut out = Vec::new();
+    for s in 0..sp.slabs {
+        let slab = sp.slabs - 1 - s;
+        let mut acc = 0u32;
+        for a in 0..3 {
+            let w = w16[a];
+            if w == 0 {
+                continue;
+            }
+            let root = t.roots[(sp.layer_base + bl.index[a] * sp.slabs + slab) as usize];
+            if root == u32::MAX {
+                continue;
+            }
+            acc += w;
+            out.push(Quad {
+                instance: inst_id,
+                node: root,
+                pos: Quad::pack_pos(0, 0, 0, slab),
+                dir_weight: bl.index[a] | (unorm16(w as f32 / acc as f32) << 16),
+            });
+        }
+    }
+    out
+}
+
+fn clip_corner(t: &SceneTables, cam: &GpuCamera, q: &Quad, depth: [u8; 4], c: u32) -> Vec4 {
+    let inst = &t.instances[q.instance as usize];
+    let sp = &t.species[inst.species as usize];
+    let f = &t.frames[(sp.dir_base + q.dir()) as usize];
+    let size = 1.0 / (1u32 << q.level()) as f32;
+    let u = (q.x() as f32 + (c & 1) as f32) * size;
+    let v = (q.y() as f32 + (c >> 1) as f32) * size;
+    let tt = f32::from(depth[c as usize]) / 255.0;
+    let r = sp.sphere[3];
+    let d = (q.slab() as f32 + tt) / sp.slabs as f32;
+    let p = xyz(sp.sphere)
+        + xyz(f.right) * ((2.0 * u - 1.0) * r)
+        + xyz(f.up) * ((1.0 - 2.0 * v) * r)
+        + xyz(f.dir) * ((1.0 - 2.0 * d) * r);
+    let w = to_world(inst, p);
+    let m = cam.view_proj.map(Vec4::from_array);
+    m[0] * w.x + m[1] * w.y + m[2] * w.z + m[3]
+}
+
+fn edge_long(cam: &GpuCamera, a: Vec4, b: Vec4) -> bool {
+    let sx = cam.viewport[0] * 0.5;
+    let sy = cam.viewport[1] * 0.5;
+    let dx = (a.x * b.w - b.x * a.w) * sx;
+    let dy = (a.y * b.w - b.y * a.w) * sy;
+    let lim = cam.eye[3] * a.w * b.w;
+    dx * dx + dy * dy > lim * lim
+}
+
+/// 0: keep; else 1 + extra quads (see `wants` in `shaders/refine.wgsl`).
+fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
+    let node = t.nodes[q.node as usize];
+    let mask = u32::from(node.mask());
+    if mask == 0 {
+        return 0;
+    }
+    let clip: Vec<Vec4> = (0..4)
+        .map(|c| clip_corner(t, cam, q, node.depth, c))
+        .collect();
+    let behind = clip.iter().filter(|c| c.w <= 0.0).count();
+    if behind == 4 {
+        return 0;
+    }
+    let long = behind > 0
+        || edge_long(cam, clip[0], clip[1])
+        || edge_long(cam, clip[1], clip[3])
+        || edge_long(cam, clip[3], clip[2])
+        || edge_long(cam, clip[2], clip[0]);
+    if long { mask.count_ones() } else { 0 }
+}
+
+/// Exclusive prefix sums and total.
+fn scan(v: &[u32]) -> (Vec<u32>, u32) {
+    let mut acc = 0u32;
+    let p = v
+        .iter()
+        .map(|&x| {
+            let e = acc;
+            acc += x;
+            e
+        })
+        .collect();
+    (p, acc)
+}
+
+/// Run passes 1 and 2 for a camera with stream capacity `capacity`.
+pub fn run(t: &SceneTables, cam: &GpuCamera, capacity: u32) -> Reference {
+    let towards = -xyz(cam.forward);
+    let mut presort = 0usize;
+    let mut best = f32::NEG_INFINITY;
+    for (k, d) in t.presort_dirs.iter().enumerate() {
+        let c = d[0] * towards.x + d[1] * towards.y + d[2] * towards.z;
+        if c > best {
+            presort = k;
+            best = c;
+        }
+    }
+    let n = t.instances.len();
+    let mut r = Reference {
+        presort: presort as u32,
+        ..Default::default()
+    };
+    // Pass 1.
+    let mut level0 = Vec::new();
+    for i in 0..n {
+        let id = if n == 0 {
+            0
+        } else {
+            t.presort[presort * n + i]
+        };
+        let inst = &t.instances[id as usize];
+        if visible(cam, inst, &t.species[inst.species as usize]) {
+            r.visible += 1;
+            level0.extend(tree_quads(t, cam, id));
+        }
+    }
+    let total = level0.len() as u32;
+    let skip = total.saturating_sub(capacity);
+    r.overflow_cull = skip;
+    let mut quads: Vec<Quad> = level0[skip as usize..].to_vec();
+    // Pass 2.
+    for _ in 0..t.max_levels.saturating_sub(1) {
+        let want: Vec<u32> = quads.iter().map(|q| wants(t, cam, q)).collect();
+        let extra: Vec<u32> = want.iter().map(|&w| w.saturating_sub(1)).collect();
+        let (p, total) = scan(&extra);
+        let budget = capacity - quads.len() as u32;
+        let refined: Vec<bool> = (0..quads.len())
+            .map(|i| want[i] > 0 && total - p[i] <= budget)
+            .collect();
+        r.overflow_refine += (0..quads.len())
+            .filter(|&i| want[i] > 0 && !refined[i])
+            .count() as u32;
+        let mut next = Vec::with_capacity(quads.len() + total as usize);
+        for (i, q) in quads.iter().enumerate() {
+            if !refined[i] {
+                next.push(*q);
+                continue;
+            }
+            let inst = &t.instances[q.instance as usize];
+            let node_base = t.species[inst.species as usize].node_base;
+            let node = t.nodes[q.node as usize];
+            let mut child = node_base + node.first_child();
+            for c in 0..4u32 {
+                if node.mask() & (1 << c) == 0 {
+                    continue;
+                }
+                next.push(Quad {
+                    instance: q.instance,
+                    node: child,
+                    pos: Quad::pack_pos(
+                        q.level() + 1,
+                        q.x() * 2 + (c & 1),
+                        q.y() * 2 + (c >> 1),
+                        q.slab(),
+                    ),
+                    dir_weight: q.dir_weight,
+                });
+                child += 1;
+            }
+        }
+        quads = next;
+    }
+    let levels = t.max_levels.max(1) as usize;
+    r.per_level = vec![0; levels];
+    for q in &quads {
+        r.per_level[q.level() as usize] += 1;
+    }
+    r.quads = quads;
+    r
+}
+
+/// The disk point used by the blend (re-exported for tests).
+pub fn disk(v: Vec3) -> Vec2 {
+    forest_format::directions::disk_point(v)
+}

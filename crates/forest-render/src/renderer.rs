@@ -1,0 +1,517 @@
+//! The quad-stream renderer: buffers, bind groups, and the frame function that records the
+//! three passes in order. Per frame the CPU writes the camera and nothing else.
+
+use std::cell::Cell;
+
+use forest_format::shading::Lighting;
+use wgpu::util::DeviceExt;
+
+use crate::camera::{Camera, CameraError};
+use crate::capacity::{Capacity, CapacityInput};
+use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::{GpuArgs, GpuCamera, GpuGround, GpuState, Quad, SceneConsts};
+use crate::passes::ComputeShared;
+use crate::passes::cull::CullPass;
+use crate::passes::draw::DrawPass;
+use crate::passes::refine::RefinePass;
+use crate::passes::scan::ScanPass;
+use crate::scene::GpuScene;
+
+/// Options of a renderer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RendererOptions {
+    /// Colour target format.
+    pub format: wgpu::TextureFormat,
+    /// Largest viewport the renderer will draw (sizes the stream).
+    pub viewport: (u32, u32),
+    /// Smallest ε that will be used (sizes the stream).
+    pub min_epsilon: f32,
+    /// Quad layers per pixel the stream affords.
+    pub overdraw: f32,
+    /// Explicit quad capacity (overrides the formula; tests use small ones to force overflow).
+    pub max_quads: Option<u32>,
+    /// Lighting for the ground (the atlases carry their own baked lighting).
+    pub lighting: Lighting,
+}
+
+impl Default for RendererOptions {
+    fn default() -> Self {
+        Self {
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            viewport: (800, 600),
+            min_epsilon: 8.0,
+            overdraw: 16.0,
+            max_quads: None,
+            lighting: Lighting::with_sun(30.0, 55.0),
+        }
+    }
+}
+
+/// Per-pass GPU times in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimes {
+    /// Cull.
+    pub cull_ms: f64,
+    /// Refine (all iterations and statistics).
+    pub refine_ms: f64,
+    /// Draw (ground and quads).
+    pub draw_ms: f64,
+}
+
+/// Counters of the last frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Presort direction used.
+    pub presort: u32,
+    /// Trees that passed the frustum test.
+    pub visible_trees: u32,
+    /// Quads drawn.
+    pub quads: u32,
+    /// Quads per level.
+    pub per_level: Vec<u32>,
+    /// Level-0 quads dropped for lack of room.
+    pub overflow_cull: u32,
+    /// Quads left unrefined for lack of room.
+    pub overflow_refine: u32,
+    /// GPU pass times, where the adapter has timestamp queries.
+    pub times: Option<PassTimes>,
+}
+
+/// Background colour (sky) the demo clears to, linear RGB.
+pub const SKY: wgpu::Color = wgpu::Color {
+    r: 0.45,
+    g: 0.62,
+    b: 0.85,
+    a: 1.0,
+};
+
+/// The renderer of one scene.
+pub struct QuadStream {
+    /// The uploaded scene.
+    pub scene: GpuScene,
+    /// Buffer sizes.
+    pub capacity: Capacity,
+    shared: ComputeShared,
+    cull: CullPass,
+    scan: ScanPass,
+    refine: RefinePass,
+    draw: DrawPass,
+    camera: wgpu::Buffer,
+    state: wgpu::Buffer,
+    args: wgpu::Buffer,
+    quads: [wgpu::Buffer; 2],
+    bg_cull: wgpu::BindGroup,
+    bg_ab: wgpu::BindGroup,
+    bg_ba: wgpu::BindGroup,
+    bg_draw: wgpu::BindGroup,
+    args_group: wgpu::BindGroup,
+    iterations: u32,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
+    writes: Cell<(u64, u64)>,
+    camera_set: Cell<bool>,
+}
+
+fn buffer(ctx: &GpuContext, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage,
+        mapped_at_creation: false,
+    })
+}
+
+impl QuadStream {
+    /// Create the renderer of an uploaded scene.
+    pub fn new(
+        ctx: &GpuContext,
+        scene: GpuScene,
+        opts: &RendererOptions,
+    ) -> Result<Self, RenderError> {
+        let t = &scene.tables;
+        let capacity = Capacity::new(&CapacityInput {
+            instances: t.instances.len() as u32,
+            quads_per_tree: t.quads_per_tree.max(1),
+            viewport: opts.viewport,
+            min_epsilon: opts.min_epsilon,
+            overdraw: opts.overdraw,
+            max_quads: opts.max_quads,
+        });
+        let limit = ctx.device.limits().max_storage_buffer_binding_size as u64;
+        let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
+        if quad_bytes > limit {
+            return Err(RenderError::Scene(format!(
+                "a stream of {} quads needs {quad_bytes} bytes per buffer, above the device's \
+                 {limit}: lower the viewport or raise the minimum epsilon",
+                capacity.quads
+            )));
+        }
+        let device = &ctx.device;
+        let shared = ComputeShared::new(device);
+        let cull = CullPass::new(device, &shared);
+        let scan = ScanPass::new(device, &shared);
+        let refine = RefinePass::new(device, &shared);
+        let draw = DrawPass::new(device, opts.format);
+
+        use wgpu::BufferUsages as U;
+        let camera = buffer(
+            ctx,
+            "camera",
+            std::mem::size_of::<GpuCamera>() as u64,
+            U::UNIFORM | U::COPY_DST,
+        );
+        let consts = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene constants"),
+            contents: bytemuck::bytes_of(&SceneConsts {
+                instances: t.instances.len() as u32,
+                presort_dirs: t.presort_dirs.len() as u32,
+                capacity: capacity.quads,
+                species: t.species.len() as u32,
+            }),
+            usage: U::UNIFORM,
+        });
+        let extent = t
+            .instances
+            .iter()
+            .map(|i| glam::Vec3::from_array(i.position).length())
+            .fold(0.0f32, f32::max);
+        let l = &opts.lighting;
+        let ground_albedo = glam::Vec3::new(0.16, 0.14, 0.09);
+        let lit = l.shade(ground_albedo, glam::Vec3::Y, 1.0, 0.0);
+        let ground = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("ground"),
+            contents: bytemuck::bytes_of(&GpuGround {
+                colour: [lit.x, lit.y, lit.z, extent + 5000.0],
+            }),
+            usage: U::UNIFORM,
+        });
+        let state = buffer(
+            ctx,
+            "state",
+            std::mem::size_of::<GpuState>() as u64,
+            U::STORAGE | U::COPY_SRC,
+        );
+        let args = buffer(
+            ctx,
+            "args",
+            std::mem::size_of::<GpuArgs>() as u64,
+            U::STORAGE | U::INDIRECT,
+        );
+        let spare = buffer(ctx, "spare", 16, U::STORAGE);
+        let args_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("indirect arguments"),
+            layout: &shared.args_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: args.as_entire_binding(),
+            }],
+        });
+        let data = buffer(ctx, "scan data", u64::from(capacity.items) * 4, U::STORAGE);
+        let want = buffer(ctx, "want", u64::from(capacity.items) * 4, U::STORAGE);
+        let sums = buffer(ctx, "block sums", u64::from(capacity.sums) * 4, U::STORAGE);
+        let quads = [0, 1].map(|k| {
+            buffer(
+                ctx,
+                if k == 0 { "stream A" } else { "stream B" },
+                quad_bytes,
+                U::STORAGE | U::COPY_SRC,
+            )
+        });
+        let presort_view = scene.presort.create_view(&Default::default());
+        let nodes_view = scene.nodes.create_view(&Default::default());
+        let compute_bg = |label: &str, q_in: &wgpu::Buffer, q_out: &wgpu::Buffer| {
+            let res: [wgpu::BindingResource; 17] = [
+                camera.as_entire_binding(),
+                consts.as_entire_binding(),
+                scene.instances.as_entire_binding(),
+                scene.species.as_entire_binding(),
+                scene.frames.as_entire_binding(),
+                scene.tris.as_entire_binding(),
+                scene.roots.as_entire_binding(),
+                scene.presort_dirs.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&presort_view),
+                wgpu::BindingResource::TextureView(&nodes_view),
+                state.as_entire_binding(),
+                spare.as_entire_binding(),
+                data.as_entire_binding(),
+                sums.as_entire_binding(),
+                want.as_entire_binding(),
+                q_in.as_entire_binding(),
+                q_out.as_entire_binding(),
+            ];
+            let entries: Vec<wgpu::BindGroupEntry> = res
+                .into_iter()
+                .enumerate()
+                .map(|(i, resource)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource,
+                })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &shared.bind_layout,
+                entries: &entries,
+            })
+        };
+        let bg_cull = compute_bg("cull", &quads[1], &quads[0]);
+        let bg_ab = compute_bg("refine A->B", &quads[0], &quads[1]);
+        let bg_ba = compute_bg("refine B->A", &quads[1], &quads[0]);
+        let iterations = t.max_levels.saturating_sub(1);
+        let final_quads = &quads[(iterations % 2) as usize];
+        let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("colour"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let bg_draw = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("draw"),
+            layout: &draw.bind_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: scene.instances.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: scene.species.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: scene.frames.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: final_quads.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&nodes_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&colour_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: ground.as_entire_binding(),
+                },
+            ],
+        });
+        let queries = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| {
+                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass times"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 6,
+                });
+                let resolve = buffer(ctx, "timestamps", 48, U::QUERY_RESOLVE | U::COPY_SRC);
+                (set, resolve, f64::from(ctx.queue.get_timestamp_period()))
+            });
+        Ok(Self {
+            scene,
+            capacity,
+            shared,
+            cull,
+            scan,
+            refine,
+            draw,
+            camera,
+            state,
+            args,
+            quads,
+            bg_cull,
+            bg_ab,
+            bg_ba,
+            bg_draw,
+            args_group,
+            iterations,
+            queries,
+            writes: Cell::new((0, 0)),
+            camera_set: Cell::new(false),
+        })
+    }
+
+    /// Number of refinement iterations per frame (`max levels − 1`).
+    pub fn iterations(&self) -> u32 {
+        self.iterations
+    }
+
+    /// Write the camera: the one upload of a frame.
+    pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
+        camera.validate()?;
+        let g = camera.to_gpu();
+        ctx.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
+        let (n, bytes) = self.writes.get();
+        self.writes
+            .set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));
+        self.camera_set.set(true);
+        Ok(())
+    }
+
+    /// Queue writes made by this renderer since it was created: (count, bytes).
+    pub fn uploads(&self) -> (u64, u64) {
+        self.writes.get()
+    }
+
+    /// The frame function: cull, refine and draw into `colour` (cleared to the sky) and
+    /// `depth` (cleared to 1). `set_camera` must have been called once before.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        assert!(self.camera_set.get(), "set_camera before the first frame");
+        let ts = |b: u32| {
+            self.queries
+                .as_ref()
+                .map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(b),
+                    end_of_pass_write_index: Some(b + 1),
+                })
+        };
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cull"),
+                timestamp_writes: ts(0),
+            });
+            self.cull.record(
+                &mut pass,
+                &self.bg_cull,
+                &self.args_group,
+                &self.args,
+                &self.scan,
+            );
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("refine"),
+                timestamp_writes: ts(2),
+            });
+            self.refine.record(
+                &mut pass,
+                self.iterations,
+                &self.bg_ab,
+                &self.bg_ba,
+                &self.args_group,
+                &self.args,
+                &self.scan,
+            );
+        }
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("draw"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: colour,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(SKY),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: self.queries.as_ref().map(|(set, _, _)| {
+                    wgpu::RenderPassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(4),
+                        end_of_pass_write_index: Some(5),
+                    }
+                }),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.draw.record(&mut pass, &self.bg_draw, &self.args);
+        }
+        if let Some((set, resolve, _)) = &self.queries {
+            encoder.resolve_query_set(set, 0..6, resolve, 0);
+        }
+    }
+
+    fn read_buffer(&self, ctx: &GpuContext, src: &wgpu::Buffer, size: u64) -> Vec<u8> {
+        let size = size.max(4).next_multiple_of(4);
+        let staging = buffer(
+            ctx,
+            "readback",
+            size,
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        );
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        ctx.queue.submit([enc.finish()]);
+        staging.map_async(wgpu::MapMode::Read, .., |r| {
+            r.expect("map the readback buffer")
+        });
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("the device answers");
+        let bytes = staging.get_mapped_range(..).expect("mapped").to_vec();
+        staging.unmap();
+        bytes
+    }
+
+    /// Counters (and pass times) of the last submitted frame; waits for the GPU.
+    pub fn read_stats(&self, ctx: &GpuContext) -> FrameStats {
+        let s: GpuState = bytemuck::pod_read_unaligned(&self.read_buffer(
+            ctx,
+            &self.state,
+            std::mem::size_of::<GpuState>() as u64,
+        ));
+        let levels = self.scene.tables.max_levels.max(1) as usize;
+        let times = self.queries.as_ref().map(|(_, resolve, period)| {
+            let t: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read_buffer(ctx, resolve, 48));
+            let ms = |a: usize| t[a + 1].saturating_sub(t[a]) as f64 * period / 1e6;
+            PassTimes {
+                cull_ms: ms(0),
+                refine_ms: ms(2),
+                draw_ms: ms(4),
+            }
+        });
+        FrameStats {
+            presort: s.presort,
+            visible_trees: s.visible,
+            quads: s.quads,
+            per_level: s.per_level[..levels].to_vec(),
+            overflow_cull: s.overflow_cull,
+            overflow_refine: s.overflow_refine,
+            times,
+        }
+    }
+
+    /// The final quad stream of the last submitted frame; waits for the GPU.
+    pub fn read_quads(&self, ctx: &GpuContext) -> Vec<Quad> {
+        let n = self.read_stats(ctx).quads as usize;
+        let buf = &self.quads[(self.iterations % 2) as usize];
+        let bytes = self.read_buffer(ctx, buf, (n * std::mem::size_of::<Quad>()) as u64);
+        bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<Quad>()])
+    }
+
+    /// The shared compute layout (for inspection in tests).
+    pub fn compute_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.shared.bind_layout
+    }
+}

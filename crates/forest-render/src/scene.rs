@@ -1,0 +1,373 @@
+//! Scene data uploaded once: atlas textures, direction tables, instances, presorted orders.
+
+use forest_format::atlas::{Layers, NODE_TEXTURE_WIDTH};
+use forest_format::forest::Forest;
+use forest_format::shading::{srgb_decode_table, srgb_encode};
+use forest_format::{Atlas, QuadNode};
+use wgpu::util::DeviceExt;
+
+use crate::context::{GpuContext, RenderError};
+use crate::gpu_types::{GpuFrame, GpuInstance, GpuSpecies};
+
+/// Width of the presort texture (one instance index per texel, orders one after another).
+pub const PRESORT_TEXTURE_WIDTH: u32 = 4096;
+
+/// One species ready for upload: its atlas and decoded slab images.
+pub struct SpeciesData {
+    /// The atlas.
+    pub atlas: Atlas,
+    /// Its decoded colour layers.
+    pub layers: Layers,
+}
+
+impl SpeciesData {
+    /// Load and decode an atlas folder.
+    pub fn load(path: &std::path::Path) -> Result<Self, RenderError> {
+        let atlas = Atlas::load(path)?;
+        let layers = atlas.decode_layers(path)?;
+        Ok(Self { atlas, layers })
+    }
+}
+
+/// CPU-side tables the GPU also gets; the CPU reference works on these.
+#[derive(Clone, Debug, Default)]
+pub struct SceneTables {
+    /// Instances (rotation as cos/sin).
+    pub instances: Vec<GpuInstance>,
+    /// Species table.
+    pub species: Vec<GpuSpecies>,
+    /// All direction frames.
+    pub frames: Vec<GpuFrame>,
+    /// All direction triangles (xyz; w unused).
+    pub tris: Vec<[u32; 4]>,
+    /// Root node (global index) of every layer, `u32::MAX` when blank.
+    pub roots: Vec<u32>,
+    /// All nodes, species after species.
+    pub nodes: Vec<QuadNode>,
+    /// Presort directions (xyz; w unused).
+    pub presort_dirs: Vec<[f32; 4]>,
+    /// Presort orders, one after another (`K × N`).
+    pub presort: Vec<u32>,
+    /// Largest level count over the species.
+    pub max_levels: u32,
+    /// Largest `3 × slabs` over the species.
+    pub quads_per_tree: u32,
+    /// Colour layers in all.
+    pub layers: u32,
+    /// Slab image side (the same for every species).
+    pub resolution: u32,
+}
+
+impl SceneTables {
+    /// Build the tables; the error says which species or instance is inconsistent.
+    pub fn new(species: &[SpeciesData], forest: &Forest) -> Result<Self, RenderError> {
+        if species.len() != forest.species.len() {
+            return Err(RenderError::Scene(format!(
+                "the forest names {} species but {} atlases were given",
+                forest.species.len(),
+                species.len()
+            )));
+        }
+        let mut t = SceneTables::default();
+        for (k, s) in species.iter().enumerate() {
+            let m = &s.atlas.manifest;
+            if t.resolution != 0 && m.params.resolution != t.resolution {
+                return Err(RenderError::Scene(format!(
+                    "species {k} ({}) was baked at {} px but species 0 at {} px: bake all \
+                     species of a forest at one resolution",
+                    forest.species[k], m.params.resolution, t.resolution
+                )));
+            }
+            t.resolution = m.params.resolution;
+            let node_base = t.nodes.len() as u32;
+            t.species.push(GpuSpecies {
+                sphere: m
+                    .bounding_sphere
+                    .center
+                    .extend(m.bounding_sphere.radius)
+                    .to_array(),
+                directions: m.params.directions,
+                slabs: m.params.slabs,
+                levels: m.levels,
+                dir_base: t.frames.len() as u32,
+                tri_base: t.tris.len() as u32,
+                tri_count: m.direction_triangles.len() as u32,
+                layer_base: t.layers,
+                node_base,
+            });
+            t.frames.extend(m.directions.iter().map(|f| GpuFrame {
+                dir: f.dir.extend(0.0).to_array(),
+                right: f.right.extend(0.0).to_array(),
+                up: f.up.extend(0.0).to_array(),
+            }));
+            t.tris
+                .extend(m.direction_triangles.iter().map(|x| [x[0], x[1], x[2], 0]));
+            t.roots.extend(
+                m.layer_roots
+                    .iter()
+                    .map(|r| r.map_or(u32::MAX, |r| r + node_base)),
+            );
+            t.nodes.extend_from_slice(&s.atlas.nodes);
+            t.layers += m.params.layers();
+            t.max_levels = t.max_levels.max(m.levels);
+            t.quads_per_tree = t.quads_per_tree.max(3 * m.params.slabs);
+        }
+        t.instances = forest
+            .instances
+            .iter()
+            .map(|i| GpuInstance {
+                position: i.position,
+                scale: i.scale,
+                cos_rot: i.rotation.cos(),
+                sin_rot: i.rotation.sin(),
+                species: i.species,
+                pad: 0,
+            })
+            .collect();
+        t.presort_dirs = forest
+            .presort
+            .directions
+            .iter()
+            .map(|d| d.extend(0.0).to_array())
+            .collect();
+        t.presort = forest.presort.orders.concat();
+        Ok(t)
+    }
+}
+
+/// Box-filter a premultiplied sRGB RGBA8 image to half size, in linear space.
+fn downsample(src: &[u8], side: usize, table: &[f32; 256]) -> Vec<u8> {
+    let half = side / 2;
+    let mut out = vec![0u8; half * half * 4];
+    for y in 0..half {
+        for x in 0..half {
+            let mut acc = [0f32; 4];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let i = ((2 * y + dy) * side + 2 * x + dx) * 4;
+                for c in 0..3 {
+                    acc[c] += table[src[i + c] as usize];
+                }
+                acc[3] += f32::from(src[i + 3]);
+            }
+            let o = (y * half + x) * 4;
+            for c in 0..3 {
+                out[o + c] = (srgb_encode(acc[c] / 4.0) * 255.0).round() as u8;
+            }
+            out[o + 3] = (acc[3] / 4.0).round() as u8;
+        }
+    }
+    out
+}
+
+/// Mip levels of a colour layer: down to 4×4 (the BC block), at least one.
+pub fn colour_mip_count(resolution: u32) -> u32 {
+    (resolution.trailing_zeros()).saturating_sub(1).max(1)
+}
+
+/// Every layer's mip chain (layer-major), encoded as BC7 or kept as RGBA8.
+fn colour_data(species: &[SpeciesData], resolution: u32, bc7: bool) -> Vec<u8> {
+    let table = srgb_decode_table();
+    let mips = colour_mip_count(resolution);
+    let settings = intel_tex_2::bc7::alpha_very_fast_settings();
+    let mut out = Vec::new();
+    for s in species {
+        for l in 0..s.layers.count {
+            let mut img = s.layers.layer(l).to_vec();
+            let mut side = resolution as usize;
+            for m in 0..mips {
+                if m > 0 {
+                    img = downsample(&img, side, &table);
+                    side /= 2;
+                }
+                if bc7 && side >= 4 {
+                    let surface = intel_tex_2::RgbaSurface {
+                        data: &img,
+                        width: side as u32,
+                        height: side as u32,
+                        stride: side as u32 * 4,
+                    };
+                    out.extend(intel_tex_2::bc7::compress_blocks(&settings, &surface));
+                } else {
+                    out.extend_from_slice(&img);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The uploaded scene.
+pub struct GpuScene {
+    /// CPU copies of the tables.
+    pub tables: SceneTables,
+    /// Colour layers of all species.
+    pub colour: wgpu::Texture,
+    /// Node texture (`Rg32Uint`, [`NODE_TEXTURE_WIDTH`] wide).
+    pub nodes: wgpu::Texture,
+    /// Presort texture (`R32Uint`, [`PRESORT_TEXTURE_WIDTH`] wide).
+    pub presort: wgpu::Texture,
+    /// Instance buffer.
+    pub instances: wgpu::Buffer,
+    /// Species table.
+    pub species: wgpu::Buffer,
+    /// Direction frames.
+    pub frames: wgpu::Buffer,
+    /// Direction triangles.
+    pub tris: wgpu::Buffer,
+    /// Layer roots.
+    pub roots: wgpu::Buffer,
+    /// Presort directions.
+    pub presort_dirs: wgpu::Buffer,
+    /// Bytes of all the above on the GPU.
+    pub bytes: u64,
+}
+
+fn storage<T: bytemuck::Pod + Default>(ctx: &GpuContext, label: &str, data: &[T]) -> wgpu::Buffer {
+    let one = [T::default()];
+    let data: &[T] = if data.is_empty() { &one } else { data };
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(data),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+}
+
+fn u32_texture(
+    ctx: &GpuContext,
+    label: &str,
+    format: wgpu::TextureFormat,
+    width: u32,
+    texel_bytes: usize,
+    bytes: &[u8],
+) -> Result<wgpu::Texture, RenderError> {
+    let texels = bytes.len() / texel_bytes;
+    let height = texels.div_ceil(width as usize).max(1) as u32;
+    let max = ctx.device.limits().max_texture_dimension_2d;
+    if height > max {
+        return Err(RenderError::Scene(format!(
+            "the {label} texture needs {height} rows, the device allows {max}"
+        )));
+    }
+    let mut padded = bytes.to_vec();
+    padded.resize(width as usize * height as usize * texel_bytes, 0);
+    Ok(ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &padded,
+    ))
+}
+
+impl GpuScene {
+    /// Upload species and a forest.
+    pub fn new(
+        ctx: &GpuContext,
+        species: &[SpeciesData],
+        forest: &Forest,
+    ) -> Result<Self, RenderError> {
+        let tables = SceneTables::new(species, forest)?;
+        let limits = ctx.device.limits();
+        if tables.layers > limits.max_texture_array_layers {
+            return Err(RenderError::Scene(format!(
+                "{} colour layers, the device allows {}",
+                tables.layers, limits.max_texture_array_layers
+            )));
+        }
+        let bc7 = ctx.has_bc() && tables.resolution >= 4;
+        let format = if bc7 {
+            wgpu::TextureFormat::Bc7RgbaUnormSrgb
+        } else {
+            wgpu::TextureFormat::Rgba8UnormSrgb
+        };
+        let res = tables.resolution.max(1);
+        let data = colour_data(species, res, bc7);
+        let layers = tables.layers.max(1);
+        let data = if tables.layers == 0 {
+            vec![
+                0u8;
+                if bc7 {
+                    16
+                } else {
+                    4 * res as usize * res as usize
+                }
+            ]
+        } else {
+            data
+        };
+        let colour = ctx.device.create_texture_with_data(
+            &ctx.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("colour layers"),
+                size: wgpu::Extent3d {
+                    width: res,
+                    height: res,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: if tables.layers == 0 {
+                    1
+                } else {
+                    colour_mip_count(res)
+                },
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &data,
+        );
+        let nodes = u32_texture(
+            ctx,
+            "nodes",
+            wgpu::TextureFormat::Rg32Uint,
+            NODE_TEXTURE_WIDTH,
+            8,
+            bytemuck::cast_slice(&tables.nodes),
+        )?;
+        let presort = u32_texture(
+            ctx,
+            "presort",
+            wgpu::TextureFormat::R32Uint,
+            PRESORT_TEXTURE_WIDTH,
+            4,
+            bytemuck::cast_slice(&tables.presort),
+        )?;
+        let bytes = data.len() as u64
+            + u64::from(nodes.height()) * u64::from(NODE_TEXTURE_WIDTH) * 8
+            + u64::from(presort.height()) * u64::from(PRESORT_TEXTURE_WIDTH) * 4
+            + (tables.instances.len() * 32
+                + tables.species.len() * 48
+                + tables.frames.len() * 48
+                + tables.tris.len() * 16
+                + tables.roots.len() * 4
+                + tables.presort_dirs.len() * 16) as u64;
+        Ok(Self {
+            instances: storage(ctx, "instances", &tables.instances),
+            species: storage(ctx, "species", &tables.species),
+            frames: storage(ctx, "frames", &tables.frames),
+            tris: storage(ctx, "direction triangles", &tables.tris),
+            roots: storage(ctx, "roots", &tables.roots),
+            presort_dirs: storage(ctx, "presort directions", &tables.presort_dirs),
+            tables,
+            colour,
+            nodes,
+            presort,
+            bytes,
+        })
+    }
+}

@@ -1,0 +1,108 @@
+//! An offscreen colour + depth target and its read-back, for headless rendering.
+
+use crate::context::GpuContext;
+use crate::passes::draw::DEPTH_FORMAT;
+
+/// Colour (`Rgba8UnormSrgb`) and depth textures of one size.
+pub struct Target {
+    /// Colour texture.
+    pub colour: wgpu::Texture,
+    /// Depth texture.
+    pub depth: wgpu::Texture,
+    /// View of the colour texture.
+    pub colour_view: wgpu::TextureView,
+    /// View of the depth texture.
+    pub depth_view: wgpu::TextureView,
+    /// Size in pixels.
+    pub size: (u32, u32),
+}
+
+/// Colour format of [`Target`].
+pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+impl Target {
+    /// Create a target of `width × height` pixels.
+    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Self {
+        let make = |label, format, usage| {
+            ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let colour = make(
+            "target colour",
+            TARGET_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let depth = make(
+            "target depth",
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        Self {
+            colour_view: colour.create_view(&Default::default()),
+            depth_view: depth.create_view(&Default::default()),
+            colour,
+            depth,
+            size: (width, height),
+        }
+    }
+
+    /// Read the colour back as an sRGB RGBA8 image (waits for the GPU).
+    pub fn read(&self, ctx: &GpuContext) -> image::RgbaImage {
+        let (w, h) = self.size;
+        let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("target readback"),
+            size: u64::from(row) * u64::from(h),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.colour,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buf,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        ctx.queue.submit([enc.finish()]);
+        buf.map_async(wgpu::MapMode::Read, .., |r| {
+            r.expect("map the target readback")
+        });
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("the device answers");
+        let data = buf.get_mapped_range(..).expect("mapped");
+        let mut img = image::RgbaImage::new(w, h);
+        for y in 0..h as usize {
+            let src = &data[y * row as usize..y * row as usize + w as usize * 4];
+            img.as_mut()[y * w as usize * 4..(y + 1) * w as usize * 4].copy_from_slice(src);
+        }
+        img
+    }
+}

@@ -1,0 +1,110 @@
+//! Shared fixtures of the GPU tests: small atlases baked once, a small forest, cameras.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use forest_format::generate::{GenerateParams, generate};
+use forest_format::{Atlas, BakeParams, forest::Forest};
+use forest_render::scene::SpeciesData;
+use forest_render::{Camera, GpuContext};
+use glam::Vec3;
+
+/// Small atlases (64 px, 5 directions, 2 slabs): bush and pine.
+pub fn atlases() -> &'static [Atlas] {
+    static A: OnceLock<Vec<Atlas>> = OnceLock::new();
+    A.get_or_init(|| {
+        let params = BakeParams {
+            directions: 5,
+            resolution: 64,
+            min_quad: 4,
+            spp: 2,
+            ..BakeParams::default()
+        };
+        ["bush", "pine"]
+            .iter()
+            .map(|s| {
+                let p = root().join(format!("assets/trees/{s}/{s}.obj"));
+                forest_bake::bake_file(&p, &params, &|_, _| {})
+                    .unwrap()
+                    .atlas
+            })
+            .collect()
+    })
+}
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+pub fn species() -> Vec<SpeciesData> {
+    atlases()
+        .iter()
+        .map(|a| SpeciesData {
+            layers: a.decode_layers(Path::new("test")).unwrap(),
+            atlas: a.clone(),
+        })
+        .collect()
+}
+
+pub fn forest(trees: u32) -> Forest {
+    generate(&GenerateParams {
+        trees,
+        species: vec!["bush".into(), "pine".into()],
+        area_per_tree: 12.0,
+        clump_size: 15.0,
+        seed: 5,
+        ..GenerateParams::default()
+    })
+    .unwrap()
+}
+
+pub fn ctx() -> GpuContext {
+    GpuContext::headless().expect("a GPU adapter (install mesa-vulkan-drivers)")
+}
+
+pub fn camera(eye: Vec3, target: Vec3, epsilon: f32) -> Camera {
+    Camera {
+        eye,
+        target,
+        fov_y_deg: 60.0,
+        near: 0.1,
+        far: 2000.0,
+        viewport: (160, 120),
+        epsilon,
+    }
+}
+
+/// The named test cameras over a forest of extent ~`side` metres around the origin.
+pub fn cameras(side: f32) -> Vec<(&'static str, Camera)> {
+    vec![
+        (
+            "inside",
+            camera(Vec3::new(2.0, 1.7, 3.0), Vec3::new(-10.0, 2.0, -20.0), 4.0),
+        ),
+        (
+            "birds_eye",
+            camera(Vec3::new(0.0, side, side * 0.6), Vec3::ZERO, 4.0),
+        ),
+        (
+            "horizon",
+            camera(
+                Vec3::new(-side * 0.7, 0.5, 0.0),
+                Vec3::new(0.0, 0.6, 0.0),
+                4.0,
+            ),
+        ),
+        (
+            "under_canopy",
+            camera(Vec3::new(0.5, 0.3, 0.5), Vec3::new(1.0, 8.0, 2.0), 4.0),
+        ),
+        (
+            "culled",
+            camera(
+                Vec3::new(0.0, 5.0, side * 5.0),
+                Vec3::new(0.0, 5.0, side * 10.0),
+                4.0,
+            ),
+        ),
+    ]
+}

@@ -1,0 +1,96 @@
+//! The GPU's quad stream equals the CPU reference, quad for quad and in order.
+
+mod common;
+
+use forest_render::reference;
+use forest_render::renderer::RendererOptions;
+use forest_render::target::Target;
+use forest_render::{GpuScene, QuadStream};
+
+fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
+    let ctx = common::ctx();
+    let forest = common::forest(trees);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let opts = RendererOptions {
+        viewport: (160, 120),
+        min_epsilon: 4.0,
+        max_quads,
+        ..Default::default()
+    };
+    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let target = Target::new(&ctx, 160, 120);
+    let side = forest.extent();
+    let mut summary = Vec::new();
+    for (name, cam) in common::cameras(side) {
+        stream.set_camera(&ctx, &cam).unwrap();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        let gpu = stream.read_quads(&ctx);
+        let stats = stream.read_stats(&ctx);
+        let cpu = reference::run(&stream.scene.tables, &cam.to_gpu(), stream.capacity.quads);
+        assert_eq!(
+            ctx.take_errors(),
+            Vec::<String>::new(),
+            "{name}: wgpu errors"
+        );
+        assert_eq!(stats.presort, cpu.presort, "{name}: presort direction");
+        assert_eq!(stats.visible_trees, cpu.visible, "{name}: visible trees");
+        assert_eq!(
+            stats.overflow_cull, cpu.overflow_cull,
+            "{name}: cull overflow"
+        );
+        assert_eq!(
+            stats.overflow_refine, cpu.overflow_refine,
+            "{name}: refine overflow"
+        );
+        if let Some(i) = gpu.iter().zip(&cpu.quads).position(|(a, b)| a != b) {
+            panic!(
+                "{name}: quad {i} of {}/{} differs: GPU {:?} CPU {:?}",
+                gpu.len(),
+                cpu.quads.len(),
+                gpu[i],
+                cpu.quads[i]
+            );
+        }
+        assert_eq!(gpu.len(), cpu.quads.len(), "{name}: stream length");
+        assert_eq!(stats.per_level, cpu.per_level, "{name}: quads per level");
+        assert!(gpu.len() <= stream.capacity.quads as usize);
+        summary.push((
+            name.to_string(),
+            gpu.len(),
+            stats.visible_trees,
+            stats.overflow_refine + stats.overflow_cull,
+        ));
+    }
+    summary
+}
+
+#[test]
+fn gpu_stream_equals_the_cpu_reference() {
+    let s = check(300, None);
+    eprintln!("{s:?}");
+    let get = |n: &str| s.iter().find(|x| x.0 == n).unwrap().clone();
+    assert!(get("inside").1 > 0 && get("birds_eye").1 > 0 && get("horizon").1 > 0);
+    assert_eq!(get("culled").1, 0, "nothing visible");
+    assert_eq!(get("culled").2, 0);
+    assert!(
+        get("birds_eye").2 > get("inside").2,
+        "a bird's eye sees more trees"
+    );
+    assert!(
+        s.iter().all(|x| x.3 == 0),
+        "no overflow at the formula's capacity"
+    );
+}
+
+#[test]
+fn overflow_keeps_to_the_capacity_and_matches_the_reference() {
+    let s = check(300, Some(700));
+    eprintln!("{s:?}");
+    assert!(
+        s.iter().any(|x| x.3 > 0),
+        "a small stream overflows somewhere"
+    );
+    assert!(s.iter().all(|x| x.1 <= 700));
+}

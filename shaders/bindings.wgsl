@@ -1,0 +1,57 @@
+// Bindings of the compute passes (cull, scan, refine, stats): one layout for all of them, see
+// crates/forest-render/src/passes/mod.rs. Appended after common.wgsl.
+
+struct SceneConsts {
+    instances: u32,     // N
+    presort_dirs: u32,  // K
+    capacity: u32,      // quad capacity Q of each stream buffer
+    species: u32,
+}
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(1) var<uniform> scene: SceneConsts;
+@group(0) @binding(2) var<storage, read> instances: array<Instance>;
+@group(0) @binding(3) var<storage, read> species: array<Species>;
+@group(0) @binding(4) var<storage, read> frames: array<Frame>;
+@group(0) @binding(5) var<storage, read> dir_tris: array<vec4<u32>>;
+// Root node of every layer, global index (species node base included); NONE when blank.
+@group(0) @binding(6) var<storage, read> roots: array<u32>;
+@group(0) @binding(7) var<storage, read> presort_dirs: array<vec4<f32>>;
+@group(0) @binding(8) var presort: texture_2d<u32>;
+@group(0) @binding(9) var nodes: texture_2d<u32>;
+@group(0) @binding(10) var<storage, read_write> state: StateAtomic;
+@group(0) @binding(12) var<storage, read_write> data: array<u32>;
+@group(0) @binding(13) var<storage, read_write> sums: array<u32>;
+@group(0) @binding(14) var<storage, read_write> want: array<u32>;
+@group(0) @binding(15) var<storage, read> quads_in: array<Quad>;
+@group(0) @binding(16) var<storage, read_write> quads_out: array<Quad>;
+
+// The indirect arguments are a separate group: a buffer may not be bound for writing in the
+// same dispatch that reads its arguments from it, so only the few one-thread entry points
+// that write them (frame_setup, cull_finish, refine_finish) use a layout with group 1.
+@group(1) @binding(0) var<storage, read_write> args: Args;
+
+// `State` with atomic members (same layout).
+struct StateAtomic {
+    presort: atomic<u32>,
+    n: atomic<u32>,
+    total: atomic<u32>,
+    pmin: atomic<u32>,
+    overflow_cull: atomic<u32>,
+    overflow_refine: atomic<u32>,
+    visible: atomic<u32>,
+    quads: atomic<u32>,
+    per_level: array<atomic<u32>, 16>,
+}
+
+fn set_args(n: u32) {
+    args.items = vec4<u32>((n + WG - 1u) / WG, 1u, 1u, 0u);
+    args.blocks0 = vec4<u32>((n + BLOCK - 1u) / BLOCK, 1u, 1u, 0u);
+    args.blocks1 = vec4<u32>((n + BLOCK * BLOCK - 1u) / (BLOCK * BLOCK), 1u, 1u, 0u);
+    args.one = vec4<u32>(1u, 1u, 1u, 0u);
+    args.draw = vec4<u32>(4u, n, 0u, 0u);
+}
+
+fn node_at(i: u32) -> vec2<u32> {
+    return textureLoad(nodes, vec2<u32>(i % NODE_TEX_WIDTH, i / NODE_TEX_WIDTH), 0).xy;
+}

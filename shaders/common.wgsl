@@ -1,0 +1,124 @@
+// Types and helpers shared by every pass. Each pass's WGSL is appended to this file.
+// Host mirrors: crates/forest-render/src/gpu_types.rs (layouts checked by a naga test).
+
+struct Camera {
+    view_proj: mat4x4<f32>,
+    // xyz: eye position (world, metres); w: epsilon, the refinement threshold in pixels.
+    eye: vec4<f32>,
+    // xyz: unit view direction (world); w: unused.
+    forward: vec4<f32>,
+    // x, y: viewport size in pixels; z, w: unused.
+    viewport: vec4<f32>,
+    // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
+    planes: array<vec4<f32>, 6>,
+}
+
+struct Instance {
+    position: vec3<f32>,
+    scale: f32,
+    cos_rot: f32,
+    sin_rot: f32,
+    species: u32,
+    pad: u32,
+}
+
+struct Species {
+    // xyz: bounding sphere centre (object space); w: radius.
+    sphere: vec4<f32>,
+    directions: u32,
+    slabs: u32,
+    levels: u32,
+    // First direction frame / direction triangle / layer (colour array and roots) / node.
+    dir_base: u32,
+    tri_base: u32,
+    tri_count: u32,
+    layer_base: u32,
+    node_base: u32,
+}
+
+// One direction frame: dir, right, up (xyz of each), object space.
+struct Frame {
+    dir: vec4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+}
+
+// A quad of the stream: 16 bytes.
+//   instance: instance index.
+//   node: global node index (species node base + local index).
+//   pos: level (bits 0..4) | x (4..16) | y (16..28) | slab (28..32).
+//   dir_weight: direction index within the species (bits 0..16) | blend alpha, unorm16 (16..32).
+struct Quad {
+    instance: u32,
+    node: u32,
+    pos: u32,
+    dir_weight: u32,
+}
+
+// Frame state written by the GPU, read back for statistics.
+struct State {
+    presort: u32,       // chosen presort direction
+    n: u32,             // items of the pass being run (instances, then quads)
+    total: u32,         // scan total
+    pmin: u32,          // refine: smallest prefix among refined quads (0xffffffff: none)
+    overflow_cull: u32, // level-0 quads dropped (farthest trees first)
+    overflow_refine: u32, // quads left unrefined for lack of room
+    visible: u32,       // trees passing the frustum test
+    quads: u32,         // quads in the final stream
+    per_level: array<u32, 16>,
+}
+
+// Dispatch arguments (x, y, z) for each kind of dispatch, and the draw arguments.
+struct Args {
+    items: vec4<u32>,   // ceil(n / 256) workgroups (w unused)
+    blocks0: vec4<u32>, // ceil(n / 512)
+    blocks1: vec4<u32>, // ceil(n / 512^2)
+    one: vec4<u32>,     // 1
+    draw: vec4<u32>,    // vertex count 4, instance count n, 0, 0
+}
+
+const WG: u32 = 256u;
+const BLOCK: u32 = 512u;
+const NONE: u32 = 0xffffffffu;
+const NODE_TEX_WIDTH: u32 = 4096u;
+const PRESORT_TEX_WIDTH: u32 = 4096u;
+
+fn quad_level(q: Quad) -> u32 { return q.pos & 15u; }
+fn quad_x(q: Quad) -> u32 { return (q.pos >> 4u) & 4095u; }
+fn quad_y(q: Quad) -> u32 { return (q.pos >> 16u) & 4095u; }
+fn quad_slab(q: Quad) -> u32 { return q.pos >> 28u; }
+fn quad_dir(q: Quad) -> u32 { return q.dir_weight & 65535u; }
+fn quad_weight(q: Quad) -> f32 { return f32(q.dir_weight >> 16u) / 65535.0; }
+fn pack_pos(level: u32, x: u32, y: u32, slab: u32) -> u32 {
+    return level | (x << 4u) | (y << 16u) | (slab << 28u);
+}
+
+// Instance transform: rotate about +Y, scale, translate (object -> world).
+fn to_world(inst: Instance, p: vec3<f32>) -> vec3<f32> {
+    let s = p * inst.scale;
+    return vec3<f32>(inst.cos_rot * s.x + inst.sin_rot * s.z, s.y,
+                     -inst.sin_rot * s.x + inst.cos_rot * s.z) + inst.position;
+}
+
+// World direction -> object direction (inverse rotation; scale does not change directions).
+fn to_object_dir(inst: Instance, d: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(inst.cos_rot * d.x - inst.sin_rot * d.z, d.y,
+                     inst.sin_rot * d.x + inst.cos_rot * d.z);
+}
+
+// Object-space point of a slab image: u, v in [0,1] (v down), t slab-relative depth.
+fn slab_point(sp: Species, f: Frame, slab: u32, u: f32, v: f32, t: f32) -> vec3<f32> {
+    let r = sp.sphere.w;
+    let d = (f32(slab) + t) / f32(sp.slabs);
+    return sp.sphere.xyz + f.right.xyz * ((2.0 * u - 1.0) * r) + f.up.xyz * ((1.0 - 2.0 * v) * r)
+        + f.dir.xyz * ((1.0 - 2.0 * d) * r);
+}
+
+// Octahedral projection of the upper hemisphere (see forest_format::directions::disk_point).
+fn disk_point(d: vec3<f32>) -> vec2<f32> {
+    let den = abs(d.x) + max(d.y, 0.0) + abs(d.z);
+    if (den > 0.0) {
+        return vec2<f32>(d.x / den, d.z / den);
+    }
+    return vec2<f32>(0.0, 0.0);
+}

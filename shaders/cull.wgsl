@@ -1,0 +1,182 @@
+// Pass 1, cull: over the instances in the presorted order nearest the view, frustum-test each
+// tree's bounding sphere; for each visible tree find the 1–3 sampling directions around the
+// view direction in the tree's own frame, and emit the level-0 quads of their slabs, back slab
+// first. Compaction keeps the order: cull_count writes per-tree counts, the scan turns them
+// into offsets, cull_emit writes each tree's quads at its offset.
+
+// Blend of the species' directions for an object-space view vector (unnormalised), exactly as
+// forest_format::directions::blend. Returns indices in .idx and weights in .w.
+struct Blend {
+    idx: vec3<u32>,
+    w: vec3<f32>,
+}
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+fn blend(sp: Species, view: vec3<f32>) -> Blend {
+    let p = disk_point(view);
+    var best_d = 3.4e38;
+    var best = Blend(vec3<u32>(0u), vec3<f32>(1.0, 0.0, 0.0));
+    var have_edge = false;
+    for (var k = 0u; k < sp.tri_count; k++) {
+        let t = dir_tris[sp.tri_base + k].xyz;
+        let a = disk_point(frames[sp.dir_base + t.x].dir.xyz);
+        let b = disk_point(frames[sp.dir_base + t.y].dir.xyz);
+        let c = disk_point(frames[sp.dir_base + t.z].dir.xyz);
+        let den = cross2(b - a, c - a);
+        if (abs(den) < 1e-12) { continue; }
+        let wb = cross2(p - a, c - a) / den;
+        let wc = cross2(b - a, p - a) / den;
+        let wa = 1.0 - wb - wc;
+        if (wa >= -1e-6 && wb >= -1e-6 && wc >= -1e-6) {
+            let w = vec3<f32>(max(wa, 0.0), max(wb, 0.0), max(wc, 0.0));
+            let s = w.x + w.y + w.z;
+            return Blend(t, w / s);
+        }
+        let pts = array<vec2<f32>, 3>(a, b, c);
+        for (var e = 0u; e < 3u; e++) {
+            let q0 = pts[e];
+            let q1 = pts[(e + 1u) % 3u];
+            let ev = q1 - q0;
+            let d = p - q0;
+            let s = clamp((d.x * ev.x + d.y * ev.y) / (ev.x * ev.x + ev.y * ev.y), 0.0, 1.0);
+            let r = q0 + ev * s - p;
+            let dist = r.x * r.x + r.y * r.y;
+            if (!have_edge || dist < best_d) {
+                have_edge = true;
+                best_d = dist;
+                let i0 = t[e];
+                let i1 = t[(e + 1u) % 3u];
+                best = Blend(vec3<u32>(i0, i1, i0), vec3<f32>(1.0 - s, s, 0.0));
+            }
+        }
+    }
+    if (have_edge) { return best; }
+    // No triangles: the nearest direction.
+    var nearest = 0u;
+    var best_c = -3.4e38;
+    for (var i = 0u; i < sp.directions; i++) {
+        let d = frames[sp.dir_base + i].dir.xyz;
+        let c = d.x * view.x + d.y * view.y + d.z * view.z;
+        if (c > best_c) { nearest = i; best_c = c; }
+    }
+    return Blend(vec3<u32>(nearest), vec3<f32>(1.0, 0.0, 0.0));
+}
+
+fn instance_in_order(i: u32) -> u32 {
+    let idx = atomicLoad(&state.presort) * scene.instances + i;
+    return textureLoad(presort, vec2<u32>(idx % PRESORT_TEX_WIDTH, idx / PRESORT_TEX_WIDTH), 0).x;
+}
+
+// Whether the instance's bounding sphere touches the frustum.
+fn visible(inst: Instance, sp: Species) -> bool {
+    let c = to_world(inst, sp.sphere.xyz);
+    let r = sp.sphere.w * inst.scale;
+    for (var k = 0u; k < 6u; k++) {
+        let pl = camera.planes[k];
+        if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) { return false; }
+    }
+    return true;
+}
+
+fn unorm16(x: f32) -> u32 {
+    return u32(floor(clamp(x, 0.0, 1.0) * 65535.0 + 0.5));
+}
+
+// Level-0 quads of one tree, in drawing order: slabs back to front; within a slab the present
+// aspects, each with alpha w_a / (sum of the weights of the aspects drawn so far in this slab),
+// so that "over" compositing yields the weighted average where the aspects are opaque.
+// Writes them from `out` on (skipping indices below `skip`) when `emit`; returns the count.
+fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
+    let inst = instances[inst_id];
+    let sp = species[inst.species];
+    let eye_obj = to_object_dir(inst, camera.eye.xyz - to_world(inst, sp.sphere.xyz));
+    let bl = blend(sp, eye_obj);
+    // Weights are quantised first, so that every decision below is on integers and a weight
+    // a rounding error away from zero cannot make the GPU and the CPU reference disagree.
+    let w16 = vec3<u32>(unorm16(bl.w.x), unorm16(bl.w.y), unorm16(bl.w.z));
+    var n = 0u;
+    for (var s = 0u; s < sp.slabs; s++) {
+        let slab = sp.slabs - 1u - s;
+        var acc = 0u;
+        for (var a = 0u; a < 3u; a++) {
+            let w = w16[a];
+            if (w == 0u) { continue; }
+            let layer = sp.layer_base + bl.idx[a] * sp.slabs + slab;
+            let root = roots[layer];
+            if (root == NONE) { continue; }
+            acc = acc + w;
+            if (emit && out + n >= skip) {
+                let alpha = unorm16(f32(w) / f32(acc));
+                quads_out[out + n - skip] = Quad(inst_id, root,
+                    pack_pos(0u, 0u, 0u, slab), bl.idx[a] | (alpha << 16u));
+            }
+            n = n + 1u;
+        }
+    }
+    return n;
+}
+
+@compute @workgroup_size(1)
+fn frame_setup() {
+    // Presort direction nearest the direction towards the viewer (first on ties).
+    let towards = -camera.forward.xyz;
+    var best = 0u;
+    var best_c = -3.4e38;
+    for (var k = 0u; k < scene.presort_dirs; k++) {
+        let d = presort_dirs[k].xyz;
+        let c = d.x * towards.x + d.y * towards.y + d.z * towards.z;
+        if (c > best_c) { best = k; best_c = c; }
+    }
+    atomicStore(&state.presort, best);
+    atomicStore(&state.n, scene.instances);
+    atomicStore(&state.total, 0u);
+    atomicStore(&state.pmin, NONE);
+    atomicStore(&state.overflow_cull, 0u);
+    atomicStore(&state.overflow_refine, 0u);
+    atomicStore(&state.visible, 0u);
+    atomicStore(&state.quads, 0u);
+    for (var l = 0u; l < 16u; l++) { atomicStore(&state.per_level[l], 0u); }
+    set_args(scene.instances);
+}
+
+@compute @workgroup_size(256)
+fn cull_count(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= scene.instances) { return; }
+    let inst_id = instance_in_order(i);
+    let inst = instances[inst_id];
+    var n = 0u;
+    if (visible(inst, species[inst.species])) {
+        atomicAdd(&state.visible, 1u);
+        n = tree_quads(inst_id, false, 0u, 0u);
+    }
+    data[i] = n;
+}
+
+// When the level-0 quads exceed the capacity, the farthest trees' quads are dropped (the
+// first `total - capacity` of the stream), so the near trees stay.
+@compute @workgroup_size(256)
+fn cull_emit(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= scene.instances) { return; }
+    let total = atomicLoad(&state.total);
+    var skip = 0u;
+    if (total > scene.capacity) { skip = total - scene.capacity; }
+    let inst_id = instance_in_order(i);
+    let inst = instances[inst_id];
+    if (visible(inst, species[inst.species])) {
+        _ = tree_quads(inst_id, true, data[i], skip);
+    }
+}
+
+@compute @workgroup_size(1)
+fn cull_finish() {
+    let total = atomicLoad(&state.total);
+    let n = min(total, scene.capacity);
+    atomicStore(&state.overflow_cull, total - n);
+    atomicStore(&state.n, n);
+    set_args(n);
+}

@@ -1,0 +1,79 @@
+// Pass 3, draw: every quad of the final stream becomes 4 vertices (a triangle strip, one
+// instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
+// the sampling frame of its direction and slab (object space), then the instance transform.
+// Textured from the colour array (premultiplied, sRGB-decoded by the format), alpha-blended
+// with the aspect weight: colour = src + dst·(1 − src.a).
+//
+// Depth: the quads are drawn strictly back to front (presorted trees, back slab first), so
+// ordering comes from the stream and blending needs no depth writes; writing depth would make
+// semi-transparent quads hide what is drawn after them behind their transparent parts. The
+// quads are still depth-tested against the opaque ground drawn first, so trees are hidden by
+// hills and the ground hides the parts of slabs below it.
+
+struct Ground {
+    // xyz: albedo-lit colour (linear); w: half size of the ground square in metres.
+    colour: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(1) var<storage, read> instances: array<Instance>;
+@group(0) @binding(2) var<storage, read> species: array<Species>;
+@group(0) @binding(3) var<storage, read> frames: array<Frame>;
+@group(0) @binding(4) var<storage, read> quads: array<Quad>;
+@group(0) @binding(5) var nodes: texture_2d<u32>;
+@group(0) @binding(6) var colour: texture_2d_array<f32>;
+@group(0) @binding(7) var colour_sampler: sampler;
+@group(0) @binding(8) var<uniform> ground: Ground;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) layer: u32,
+    @location(2) @interpolate(flat) alpha: f32,
+}
+
+@vertex
+fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
+    let q = quads[qi];
+    let inst = instances[q.instance];
+    let sp = species[inst.species];
+    let dir = quad_dir(q);
+    let f = frames[sp.dir_base + dir];
+    let node = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).xy;
+    let size = 1.0 / f32(1u << quad_level(q));
+    let u = (f32(quad_x(q)) + f32(vi & 1u)) * size;
+    let v = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
+    let t = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
+    var out: VsOut;
+    out.clip = camera.view_proj * vec4<f32>(w, 1.0);
+    out.uv = vec2<f32>(u, v);
+    out.layer = sp.layer_base + dir * sp.slabs + quad_slab(q);
+    out.alpha = quad_weight(q);
+    return out;
+}
+
+@fragment
+fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
+    let c = textureSample(colour, colour_sampler, in.uv, in.layer);
+    return c * in.alpha;
+}
+
+struct GroundOut {
+    @builtin(position) clip: vec4<f32>,
+}
+
+@vertex
+fn vs_ground(@builtin(vertex_index) vi: u32) -> GroundOut {
+    let s = ground.colour.w;
+    let x = select(-s, s, (vi & 1u) == 1u) + camera.eye.x;
+    let z = select(-s, s, (vi >> 1u) == 1u) + camera.eye.z;
+    var out: GroundOut;
+    out.clip = camera.view_proj * vec4<f32>(x, 0.0, z, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_ground() -> @location(0) vec4<f32> {
+    return vec4<f32>(ground.colour.xyz, 1.0);
+}
