@@ -5,6 +5,8 @@ use std::process::ExitCode;
 use clap::Parser;
 
 mod bake;
+mod render;
+mod scene;
 
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
@@ -14,9 +16,21 @@ enum Cli {
     Bake(bake::BakeArgs),
     /// Check an atlas and print its summary.
     Info(bake::InfoArgs),
+    /// Generate a forest of clumped trees with presorted orders.
+    Scene(scene::SceneArgs),
+    /// Render views of a forest to PNG, headless.
+    Render(render::RenderArgs),
 }
 
 fn main() -> ExitCode {
+    // Vulkan loaders print a warning without it; give them a private folder.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join(format!("forest-xdg-{}", std::process::id()));
+        if std::fs::create_dir_all(&dir).is_ok() {
+            // SAFETY: at the start of main, before any other thread exists.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version
@@ -31,6 +45,8 @@ fn main() -> ExitCode {
     let result = match cli {
         Cli::Bake(args) => bake::run(&args),
         Cli::Info(args) => bake::info(&args),
+        Cli::Scene(args) => scene::run(&args),
+        Cli::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -235,7 +235,7 @@ pub struct AtlasManifest {
 
 impl AtlasManifest {
     /// Bytes the runtime puts in GPU textures for this atlas: the colour layers as BC7 (16
-    /// bytes per 4×4 block) with a full mip chain, plus the node texture (8 bytes per texel,
+    /// bytes per 4×4 block) with mips down to 4×4, plus the node texture (8 bytes per texel,
     /// [`NODE_TEXTURE_WIDTH`] wide, rows rounded up).
     pub fn gpu_bytes(&self) -> u64 {
         let mut per_layer = 0u64;
@@ -243,7 +243,7 @@ impl AtlasManifest {
         loop {
             let blocks = side.div_ceil(4);
             per_layer += blocks * blocks * 16;
-            if side == 1 {
+            if side <= 4 {
                 break;
             }
             side /= 2;

@@ -80,10 +80,19 @@ impl GpuContext {
         std::mem::take(&mut *self.errors.lock().unwrap())
     }
 
-    /// Whether BC textures are available (else colour is uploaded as RGBA8).
-    pub fn has_bc(&self) -> bool {
-        self.device
+    /// Whether colour layers are uploaded as BC7 (else RGBA8): when the device has BC
+    /// textures and is not a CPU rasteriser (lavapipe decodes BC7 in software on every
+    /// sample, which made drawing ~10× slower there). `FOREST_COLOUR_FORMAT=bc7|rgba8`
+    /// overrides the choice (BC7 still needs the feature).
+    pub fn use_bc7(&self) -> bool {
+        let has = self
+            .device
             .features()
-            .contains(wgpu::Features::TEXTURE_COMPRESSION_BC)
+            .contains(wgpu::Features::TEXTURE_COMPRESSION_BC);
+        match std::env::var("FOREST_COLOUR_FORMAT").as_deref() {
+            Ok("bc7") => has,
+            Ok("rgba8") => false,
+            _ => has && self.adapter_info.device_type != wgpu::DeviceType::Cpu,
+        }
     }
 }

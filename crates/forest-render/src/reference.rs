@@ -77,8 +77,7 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     for s in 0..sp.slabs {
         let slab = sp.slabs - 1 - s;
         let mut acc = 0u32;
-        for a in 0..3 {
-            let w = w16[a];
+        for (a, &w) in w16.iter().enumerate() {
             if w == 0 {
                 continue;
             }

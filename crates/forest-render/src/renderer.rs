@@ -109,6 +109,7 @@ pub struct QuadStream {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     writes: Cell<(u64, u64)>,
     camera_set: Cell<bool>,
+    owned: Vec<(&'static str, wgpu::Buffer)>,
 }
 
 fn buffer(ctx: &GpuContext, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
@@ -136,7 +137,7 @@ impl QuadStream {
             overdraw: opts.overdraw,
             max_quads: opts.max_quads,
         });
-        let limit = ctx.device.limits().max_storage_buffer_binding_size as u64;
+        let limit = ctx.device.limits().max_storage_buffer_binding_size;
         let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
         if quad_bytes > limit {
             return Err(RenderError::Scene(format!(
@@ -310,6 +311,28 @@ impl QuadStream {
                 },
             ],
         });
+        let owned: Vec<(&'static str, wgpu::Buffer)> = [
+            ("camera", &camera),
+            ("scene constants", &consts),
+            ("ground", &ground),
+            ("state", &state),
+            ("args", &args),
+            ("spare", &spare),
+            ("scan data", &data),
+            ("want", &want),
+            ("block sums", &sums),
+            ("stream A", &quads[0]),
+            ("stream B", &quads[1]),
+            ("instances", &scene.instances),
+            ("species", &scene.species),
+            ("frames", &scene.frames),
+            ("direction triangles", &scene.tris),
+            ("roots", &scene.roots),
+            ("presort directions", &scene.presort_dirs),
+        ]
+        .into_iter()
+        .map(|(l, b)| (l, b.clone()))
+        .collect();
         let queries = device
             .features()
             .contains(wgpu::Features::TIMESTAMP_QUERY)
@@ -343,12 +366,23 @@ impl QuadStream {
             queries,
             writes: Cell::new((0, 0)),
             camera_set: Cell::new(false),
+            owned,
         })
     }
 
     /// Number of refinement iterations per frame (`max levels − 1`).
     pub fn iterations(&self) -> u32 {
         self.iterations
+    }
+
+    fn bindings(&self) -> crate::passes::StreamBindings<'_> {
+        crate::passes::StreamBindings {
+            cull: &self.bg_cull,
+            ping: &self.bg_ab,
+            pong: &self.bg_ba,
+            args_group: &self.args_group,
+            args_buf: &self.args,
+        }
     }
 
     /// Write the camera: the one upload of a frame.
@@ -392,28 +426,15 @@ impl QuadStream {
                 label: Some("cull"),
                 timestamp_writes: ts(0),
             });
-            self.cull.record(
-                &mut pass,
-                &self.bg_cull,
-                &self.args_group,
-                &self.args,
-                &self.scan,
-            );
+            self.cull.record(&mut pass, &self.bindings(), &self.scan);
         }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("refine"),
                 timestamp_writes: ts(2),
             });
-            self.refine.record(
-                &mut pass,
-                self.iterations,
-                &self.bg_ab,
-                &self.bg_ba,
-                &self.args_group,
-                &self.args,
-                &self.scan,
-            );
+            self.refine
+                .record(&mut pass, self.iterations, &self.bindings(), &self.scan);
         }
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -508,6 +529,15 @@ impl QuadStream {
         let buf = &self.quads[(self.iterations % 2) as usize];
         let bytes = self.read_buffer(ctx, buf, (n * std::mem::size_of::<Quad>()) as u64);
         bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<Quad>()])
+    }
+
+    /// Labels of the renderer's buffers that accept queue writes or copies (only the camera).
+    pub fn writable_buffers(&self) -> Vec<&'static str> {
+        self.owned
+            .iter()
+            .filter(|(_, b)| b.usage().contains(wgpu::BufferUsages::COPY_DST))
+            .map(|(l, _)| *l)
+            .collect()
     }
 
     /// The shared compute layout (for inspection in tests).

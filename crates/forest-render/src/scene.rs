@@ -161,18 +161,24 @@ fn downsample(src: &[u8], side: usize, table: &[f32; 256]) -> Vec<u8> {
 
 /// Mip levels of a colour layer: down to 4×4 (the BC block), at least one.
 pub fn colour_mip_count(resolution: u32) -> u32 {
-    (resolution.trailing_zeros()).saturating_sub(1).max(1)
+    resolution.trailing_zeros().saturating_sub(1).max(1)
 }
 
-/// Every layer's mip chain (layer-major), encoded as BC7 or kept as RGBA8.
+/// Every layer's mip chain (layer-major), encoded as BC7 or kept as RGBA8; layers in parallel.
 fn colour_data(species: &[SpeciesData], resolution: u32, bc7: bool) -> Vec<u8> {
+    use rayon::prelude::*;
     let table = srgb_decode_table();
     let mips = colour_mip_count(resolution);
     let settings = intel_tex_2::bc7::alpha_very_fast_settings();
-    let mut out = Vec::new();
-    for s in species {
-        for l in 0..s.layers.count {
-            let mut img = s.layers.layer(l).to_vec();
+    let layers: Vec<&[u8]> = species
+        .iter()
+        .flat_map(|s| (0..s.layers.count).map(|l| s.layers.layer(l)))
+        .collect();
+    let chains: Vec<Vec<u8>> = layers
+        .par_iter()
+        .map(|layer| {
+            let mut out = Vec::new();
+            let mut img = layer.to_vec();
             let mut side = resolution as usize;
             for m in 0..mips {
                 if m > 0 {
@@ -191,9 +197,10 @@ fn colour_data(species: &[SpeciesData], resolution: u32, bc7: bool) -> Vec<u8> {
                     out.extend_from_slice(&img);
                 }
             }
-        }
-    }
-    out
+            out
+        })
+        .collect();
+    chains.concat()
 }
 
 /// The uploaded scene.
@@ -287,7 +294,7 @@ impl GpuScene {
                 tables.layers, limits.max_texture_array_layers
             )));
         }
-        let bc7 = ctx.has_bc() && tables.resolution >= 4;
+        let bc7 = ctx.use_bc7() && tables.resolution >= 4;
         let format = if bc7 {
             wgpu::TextureFormat::Bc7RgbaUnormSrgb
         } else {

@@ -1,7 +1,7 @@
 //! Pass 1, cull (`shaders/cull.wgsl`): presorted instances → level-0 quads, order kept.
 
 use super::scan::ScanPass;
-use super::{ComputeShared, args};
+use super::{ComputeShared, StreamBindings, args};
 
 /// The cull pass's pipelines.
 pub struct CullPass {
@@ -23,16 +23,10 @@ impl CullPass {
     }
 
     /// Record: reset the frame state, count each tree's quads, scan, emit, clamp.
-    pub fn record(
-        &self,
-        pass: &mut wgpu::ComputePass,
-        bind_group: &wgpu::BindGroup,
-        args_group: &wgpu::BindGroup,
-        args_buf: &wgpu::Buffer,
-        scan: &ScanPass,
-    ) {
-        pass.set_bind_group(0, bind_group, &[]);
-        pass.set_bind_group(1, args_group, &[]);
+    pub fn record(&self, pass: &mut wgpu::ComputePass, b: &StreamBindings, scan: &ScanPass) {
+        let args_buf = b.args_buf;
+        pass.set_bind_group(0, b.cull, &[]);
+        pass.set_bind_group(1, b.args_group, &[]);
         pass.set_pipeline(&self.setup);
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(&self.count);

@@ -179,6 +179,20 @@ impl ComputeShared {
     }
 }
 
+/// The bind groups and argument buffer the compute passes record with.
+pub struct StreamBindings<'a> {
+    /// Cull: writes stream A.
+    pub cull: &'a wgpu::BindGroup,
+    /// Refine A → B.
+    pub ping: &'a wgpu::BindGroup,
+    /// Refine B → A.
+    pub pong: &'a wgpu::BindGroup,
+    /// Group 1 (the arguments) for the writers.
+    pub args_group: &'a wgpu::BindGroup,
+    /// The arguments buffer, read by indirect dispatches.
+    pub args_buf: &'a wgpu::Buffer,
+}
+
 /// Byte offsets of the dispatch arguments in the args buffer (see `GpuArgs`).
 pub mod args {
     /// `ceil(n/256)` workgroups.

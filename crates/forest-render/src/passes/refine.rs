@@ -2,7 +2,7 @@
 //! between the two stream buffers, then per-level statistics of the final stream.
 
 use super::scan::ScanPass;
-use super::{ComputeShared, args};
+use super::{ComputeShared, StreamBindings, args};
 
 /// The refine pass's pipelines.
 pub struct RefinePass {
@@ -31,15 +31,13 @@ impl RefinePass {
         &self,
         pass: &mut wgpu::ComputePass,
         iterations: u32,
-        ping: &wgpu::BindGroup,
-        pong: &wgpu::BindGroup,
-        args_group: &wgpu::BindGroup,
-        args_buf: &wgpu::Buffer,
+        b: &StreamBindings,
         scan: &ScanPass,
     ) {
-        pass.set_bind_group(1, args_group, &[]);
+        let (ping, pong, args_buf) = (b.ping, b.pong, b.args_buf);
+        pass.set_bind_group(1, b.args_group, &[]);
         for it in 0..iterations {
-            pass.set_bind_group(0, if it % 2 == 0 { ping } else { pong }, &[]);
+            pass.set_bind_group(0, if it.is_multiple_of(2) { ping } else { pong }, &[]);
             pass.set_pipeline(&self.count);
             pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
             scan.record(pass, args_buf);
@@ -51,7 +49,15 @@ impl RefinePass {
             pass.dispatch_workgroups(1, 1, 1);
         }
         // The final stream is A after an even number of steps (read it through `ping`).
-        pass.set_bind_group(0, if iterations % 2 == 0 { ping } else { pong }, &[]);
+        pass.set_bind_group(
+            0,
+            if iterations.is_multiple_of(2) {
+                ping
+            } else {
+                pong
+            },
+            &[],
+        );
         pass.set_pipeline(&self.stats);
         pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
     }

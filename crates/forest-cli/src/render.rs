@@ -1,0 +1,220 @@
+//! `forest render`: headless rendering of camera views of a forest to PNG.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use forest_format::forest::Forest;
+use forest_render::renderer::RendererOptions;
+use forest_render::scene::SpeciesData;
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+use glam::Vec3;
+
+/// Arguments of `forest render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Forest file (binary .forest or .json).
+    pub forest: PathBuf,
+    /// Output PNG; with several views, `-VIEW` is inserted before the extension.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Named views: inside (eye height inside the forest), birds-eye (above it). Repeatable.
+    #[arg(long = "view", value_parser = ["inside", "birds-eye"])]
+    pub views: Vec<String>,
+    /// Eye position x,y,z in metres (with --target, instead of --view).
+    #[arg(long, value_parser = parse_vec3, requires = "target")]
+    pub eye: Option<Vec3>,
+    /// Point looked at, x,y,z.
+    #[arg(long, value_parser = parse_vec3, requires = "eye")]
+    pub target: Option<Vec3>,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Refinement threshold ε in pixels.
+    #[arg(long, default_value_t = 16.0)]
+    pub epsilon: f32,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 60.0)]
+    pub fov: f32,
+    /// Print one JSON line of figures per view.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f32>()
+                .map_err(|_| format!("{x:?} is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(format!("{s:?}: expected x,y,z")),
+    }
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT"))?;
+    let p = |x: &str| {
+        x.parse::<u32>()
+            .ok()
+            .filter(|&v| (1..=16384).contains(&v))
+            .ok_or_else(|| format!("{x:?} is not a size from 1 to 16384"))
+    };
+    Ok((p(w)?, p(h)?))
+}
+
+/// Load a forest and its species' atlases (resolved against the forest's folder).
+pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
+    let forest = Forest::load(path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let species = forest
+        .species
+        .iter()
+        .map(|s| {
+            let p = dir.join(s);
+            SpeciesData::load(&p).with_context(|| format!("species {s} of {}", path.display()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok((forest, species))
+}
+
+/// The named views of a forest: eye height in a clump near the centre, and high above.
+pub fn named_view(name: &str, forest: &Forest) -> (Vec3, Vec3) {
+    let r = forest.extent().max(10.0);
+    // The tree nearest the centre: stand 6 m south of it, look north-west along the ground.
+    let centre = forest
+        .instances
+        .iter()
+        .map(|i| Vec3::from_array(i.position))
+        .min_by(|a, b| a.length().total_cmp(&b.length()))
+        .unwrap_or(Vec3::ZERO);
+    match name {
+        "inside" => (
+            centre + Vec3::new(3.0, 1.7, 6.0),
+            centre + Vec3::new(-40.0, 3.0, -60.0),
+        ),
+        _ => (
+            Vec3::new(0.0, r * 0.35, r * 0.55),
+            Vec3::new(0.0, 0.0, -r * 0.1),
+        ),
+    }
+}
+
+/// Run `forest render`.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let mut views: Vec<(String, Vec3, Vec3)> = Vec::new();
+    let (forest, species) = load_scene(&args.forest)?;
+    for v in &args.views {
+        let (e, t) = named_view(v, &forest);
+        views.push((v.clone(), e, t));
+    }
+    if let (Some(e), Some(t)) = (args.eye, args.target) {
+        views.push(("camera".into(), e, t));
+    }
+    if views.is_empty() {
+        bail!("give a --view (inside, birds-eye) or --eye and --target");
+    }
+    let cameras: Vec<(String, Camera)> = views
+        .into_iter()
+        .map(|(name, eye, target)| {
+            let far = (forest.extent() * 3.0 + 100.0).max(eye.length() * 2.0 + 100.0);
+            let cam = Camera {
+                eye,
+                target,
+                fov_y_deg: args.fov,
+                near: 0.1,
+                far,
+                viewport: args.size,
+                epsilon: args.epsilon,
+            };
+            cam.validate().map(|()| (name, cam))
+        })
+        .collect::<Result<_, _>>()?;
+    for (name, _) in &cameras {
+        let out = output_for(&args.output, name, cameras.len());
+        let parent = out.parent().filter(|p| !p.as_os_str().is_empty());
+        if let Some(p) = parent
+            && !p.is_dir()
+        {
+            bail!("output folder {} does not exist", p.display());
+        }
+    }
+    let ctx = GpuContext::headless()?;
+    let scene = GpuScene::new(&ctx, &species, &forest)?;
+    let opts = RendererOptions {
+        format: TARGET_FORMAT,
+        viewport: args.size,
+        min_epsilon: args.epsilon.min(8.0),
+        ..Default::default()
+    };
+    let stream = QuadStream::new(&ctx, scene, &opts)?;
+    let target = Target::new(&ctx, args.size.0, args.size.1);
+    for (name, cam) in &cameras {
+        stream.set_camera(&ctx, cam)?;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        let stats = stream.read_stats(&ctx);
+        let errors = ctx.take_errors();
+        if !errors.is_empty() {
+            bail!("the GPU reported: {}", errors.join("; "));
+        }
+        let img = target.read(&ctx);
+        let out = output_for(&args.output, name, cameras.len());
+        let tmp = forest_bake::tmp_name(&out);
+        img.save_with_format(&tmp, image::ImageFormat::Png)
+            .with_context(|| format!("writing {}", out.display()))?;
+        std::fs::rename(&tmp, &out).with_context(|| format!("writing {}", out.display()))?;
+        let t = stats.times.unwrap_or_default();
+        if args.json {
+            println!(
+                "{}",
+                serde_json::json!({
+                    "view": name, "output": out.display().to_string(),
+                    "adapter": ctx.adapter_info.name,
+                    "visible_trees": stats.visible_trees, "quads": stats.quads,
+                    "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
+                    "overflow_refine": stats.overflow_refine,
+                    "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+                })
+            );
+        } else {
+            println!(
+                "{name}: {} visible trees, {} quads {:?}, overflow {}/{}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms ({}) -> {}",
+                stats.visible_trees,
+                stats.quads,
+                stats.per_level,
+                stats.overflow_cull,
+                stats.overflow_refine,
+                t.cull_ms,
+                t.refine_ms,
+                t.draw_ms,
+                ctx.adapter_info.name,
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn output_for(base: &Path, view: &str, views: usize) -> PathBuf {
+    if views == 1 {
+        return base.to_path_buf();
+    }
+    let stem = base
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = base
+        .extension()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or("png".into());
+    base.with_file_name(format!("{stem}-{view}.{ext}"))
+}

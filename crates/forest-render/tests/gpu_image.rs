@@ -1,0 +1,156 @@
+//! Image tests against stored references (NVIDIA FLIP), and the per-frame upload contract.
+
+mod common;
+
+use std::path::PathBuf;
+
+use forest_render::renderer::RendererOptions;
+use forest_render::target::Target;
+use forest_render::{GpuScene, QuadStream};
+
+fn refs() -> PathBuf {
+    common::root().join("tests/images")
+}
+
+fn out_dir() -> PathBuf {
+    let d = common::root().join("target/test-output");
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Mean FLIP error of `test` against `reference` (both sRGB RGBA8), and the error map.
+fn flip(reference: &image::RgbaImage, test: &image::RgbaImage) -> (f32, image::RgbImage) {
+    let rgb = |i: &image::RgbaImage| image::DynamicImage::ImageRgba8(i.clone()).to_rgb8();
+    let (w, h) = reference.dimensions();
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, &rgb(reference));
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, &rgb(test));
+    let err = nv_flip::flip(r, t, 67.0);
+    let mean = nv_flip::FlipPool::from_image(&err).mean();
+    let map = err.apply_color_lut(&nv_flip::magma_lut());
+    (mean, image::RgbImage::from_raw(w, h, map.to_vec()).unwrap())
+}
+
+#[test]
+fn renders_match_the_stored_references() {
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let opts = RendererOptions {
+        viewport: (160, 120),
+        min_epsilon: 4.0,
+        ..Default::default()
+    };
+    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let target = Target::new(&ctx, 160, 120);
+    let mut failures = Vec::new();
+    for (name, cam) in common::cameras(forest.extent()) {
+        if name == "culled" || name == "under_canopy" {
+            continue;
+        }
+        stream.set_camera(&ctx, &cam).unwrap();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        let img = target.read(&ctx);
+        assert_eq!(ctx.take_errors(), Vec::<String>::new());
+        let path = refs().join(format!("{name}.png"));
+        let Ok(reference) = image::open(&path) else {
+            img.save(&path).unwrap();
+            failures.push(format!(
+                "{name}: no reference; wrote {} (inspect and commit it)",
+                path.display()
+            ));
+            continue;
+        };
+        let (mean, map) = flip(&reference.to_rgba8(), &img);
+        // Different drivers rasterise a little differently; a broken pass changes far more.
+        if mean > 0.05 {
+            img.save(out_dir().join(format!("{name}-actual.png")))
+                .unwrap();
+            map.save(out_dir().join(format!("{name}-flip.png")))
+                .unwrap();
+            failures.push(format!(
+                "{name}: mean FLIP {mean:.4} > 0.05 (see target/test-output/)"
+            ));
+        }
+        // The image is not just sky and ground: trees cover a good part of it.
+        let sky_or_ground = img
+            .pixels()
+            .filter(|p| p[2] > p[1] + 40 || (p[0] as i32 - 0x6f).abs() < 8)
+            .count();
+        assert!(
+            sky_or_ground < img.pixels().count() * 95 / 100,
+            "{name}: no trees drawn"
+        );
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn a_frame_writes_only_the_camera() {
+    let ctx = common::ctx();
+    let forest = common::forest(100);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let stream = QuadStream::new(
+        &ctx,
+        scene,
+        &RendererOptions {
+            viewport: (64, 48),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    // Nothing but the camera can be written after load: no other buffer accepts copies.
+    assert_eq!(stream.writable_buffers(), vec!["camera"]);
+    let target = Target::new(&ctx, 64, 48);
+    let cams = common::cameras(forest.extent());
+    let mut streams = Vec::new();
+    for (_, cam) in cams.iter().take(3) {
+        stream.set_camera(&ctx, cam).unwrap();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        streams.push(stream.read_quads(&ctx));
+    }
+    assert_eq!(
+        stream.uploads(),
+        (3, 3 * 208),
+        "one 208-byte camera write per frame"
+    );
+    assert_ne!(
+        streams[0], streams[1],
+        "the GPU rebuilt the stream from the camera alone"
+    );
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
+#[test]
+fn an_empty_forest_and_bad_cameras_are_handled() {
+    let ctx = common::ctx();
+    let mut forest = common::forest(10);
+    forest.instances.clear();
+    forest.presort = forest_format::forest::Presort::new(&[], 15);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let stream = QuadStream::new(
+        &ctx,
+        scene,
+        &RendererOptions {
+            viewport: (32, 32),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let target = Target::new(&ctx, 32, 32);
+    let (_, mut cam) = common::cameras(10.0).remove(0);
+    cam.viewport = (32, 32);
+    stream.set_camera(&ctx, &cam).unwrap();
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+    ctx.queue.submit([enc.finish()]);
+    assert_eq!(stream.read_stats(&ctx).quads, 0);
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    let mut bad = cam;
+    bad.target = bad.eye;
+    assert!(stream.set_camera(&ctx, &bad).is_err());
+    assert_eq!(stream.uploads().0, 1, "a refused camera is not written");
+}
