@@ -1,17 +1,28 @@
 #!/usr/bin/env bash
-# The main job: bake the bundled tree models into atlases and write their contact sheets.
-# Outputs go to out/ (atlases, contact sheets, one JSON line of figures per model).
+# The main job: bake the bundled tree models (cached), generate a 100k-tree forest, and render
+# a view inside the forest and a bird's-eye view to PNG, headless (lavapipe or a real GPU).
+# Outputs go to out/: atlases, contact sheets, the forest, the renders.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
 
 cargo build --release --locked -p forest-cli
-mkdir -p out/atlases out/contact
-: > out/bake.jsonl
-for species in oak ash aspen pine bush; do
-  ./target/release/forest bake "assets/trees/$species/$species.obj" \
-    -o "out/atlases/$species.atlas" --contact-sheet "out/contact/$species.png"
-  ./target/release/forest info "out/atlases/$species.atlas" --json >/dev/null
+forest=./target/release/forest
+mkdir -p out/atlases out/contact out/render
+species=()
+for s in oak ash aspen pine bush; do
+  atlas="out/atlases/$s.atlas"
+  # Cached: re-bake only when the model, its materials or textures are newer than the atlas.
+  if [ -f "$atlas/manifest.json" ] && [ -z "$(find "assets/trees/$s" -newer "$atlas/manifest.json" -type f)" ] \
+     && $forest info "$atlas" >/dev/null 2>&1; then
+    echo "cached: $atlas"
+  else
+    $forest bake "assets/trees/$s/$s.obj" -o "$atlas" --contact-sheet "out/contact/$s.png"
+  fi
+  species+=("$atlas")
 done
+$forest scene --trees 100000 --species "$(IFS=,; echo "${species[*]}")" --seed 1 -o out/forest-100k.forest
+$forest render out/forest-100k.forest -o out/render/forest.png --view inside --view birds-eye --size 800x600
 echo
-echo "Atlases in out/atlases/, contact sheets in out/contact/ (open them: people look at these)."
+echo "Renders: out/render/forest-inside.png, out/render/forest-birds-eye.png"
+echo "Atlases: out/atlases/, contact sheets: out/contact/"

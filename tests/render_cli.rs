@@ -1,1 +1,188 @@
+//! End-to-end: `forest bake` → `forest scene` → `forest render`, and their bad inputs.
 
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn forest(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_forest"))
+        .args(args)
+        .output()
+        .expect("the forest binary runs")
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn err(out: &Output) -> String {
+    assert!(
+        !out.status.success(),
+        "succeeded: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let e = String::from_utf8_lossy(&out.stderr).into_owned();
+    let lines: Vec<&str> = e
+        .lines()
+        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
+        .collect();
+    assert_eq!(lines.len(), 1, "one line: {e}");
+    e
+}
+
+fn model(s: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../../assets/trees/{s}/{s}.obj"))
+        .display()
+        .to_string()
+}
+
+#[test]
+fn bake_scene_render_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    for s in ["bush", "aspen"] {
+        ok(&forest(&[
+            "bake",
+            &model(s),
+            "-o",
+            &p(&format!("{s}.atlas")),
+            "--resolution",
+            "64",
+            "--directions",
+            "5",
+            "--spp",
+            "1",
+        ]));
+    }
+    let species = format!("{},{}", p("bush.atlas"), p("aspen.atlas"));
+    let text = ok(&forest(&[
+        "scene",
+        "--trees",
+        "200",
+        "--species",
+        &species,
+        "--area-per-tree",
+        "15",
+        "-o",
+        &p("f.forest"),
+    ]));
+    assert!(text.contains("200 trees of 2 species"), "{text}");
+    let out = ok(&forest(&[
+        "render",
+        &p("f.forest"),
+        "-o",
+        &p("shot.png"),
+        "--view",
+        "inside",
+        "--view",
+        "birds-eye",
+        "--size",
+        "96x72",
+        "--json",
+    ]));
+    let lines: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2);
+    for (v, name) in lines.iter().zip(["inside", "birds-eye"]) {
+        assert_eq!(v["view"], name);
+        assert!(v["visible_trees"].as_u64().unwrap() > 0, "{v}");
+        assert!(v["quads"].as_u64().unwrap() > 0, "{v}");
+        let img = image::open(d.join(format!("shot-{name}.png"))).unwrap();
+        assert_eq!((img.width(), img.height()), (96, 72));
+    }
+    // A JSON forest written by `forest scene` renders the same way.
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "20",
+        "--species",
+        &species,
+        "-o",
+        &p("small.json"),
+    ]));
+    ok(&forest(&[
+        "render",
+        &p("small.json"),
+        "-o",
+        &p("small.png"),
+        "--eye",
+        "0,2,30",
+        "--target",
+        "0,2,0",
+        "--size",
+        "64x48",
+    ]));
+    assert!(d.join("small.png").is_file());
+
+    // Bad inputs: one line, non-zero exit, nothing written.
+    let e = err(&forest(&[
+        "render",
+        &p("none.forest"),
+        "-o",
+        &p("x.png"),
+        "--view",
+        "inside",
+    ]));
+    assert!(e.contains("none.forest"), "{e}");
+    let e = err(&forest(&[
+        "render",
+        &p("f.forest"),
+        "-o",
+        &p("x.png"),
+        "--eye",
+        "1,2,3",
+        "--target",
+        "1,2,3",
+    ]));
+    assert!(e.contains("target equals eye"), "{e}");
+    let e = err(&forest(&[
+        "render",
+        &p("f.forest"),
+        "-o",
+        &p("no/dir/x.png"),
+        "--view",
+        "inside",
+    ]));
+    assert!(e.contains("does not exist"), "{e}");
+    let e = err(&forest(&[
+        "render",
+        &p("f.forest"),
+        "-o",
+        &p("x.png"),
+        "--view",
+        "inside",
+        "--size",
+        "0x10",
+    ]));
+    assert!(e.contains("size"), "{e}");
+    assert!(!d.join("x.png").exists());
+    std::fs::write(d.join("broken.forest"), b"FRST\x01\x00\x00\x00").unwrap();
+    let e = err(&forest(&[
+        "render",
+        &p("broken.forest"),
+        "-o",
+        &p("x.png"),
+        "--view",
+        "inside",
+    ]));
+    assert!(e.contains("truncated"), "{e}");
+    let e = err(&forest(&[
+        "scene",
+        "--trees",
+        "10",
+        "--species",
+        &p("missing.atlas"),
+        "-o",
+        &p("g.forest"),
+    ]));
+    assert!(e.contains("missing.atlas"), "{e}");
+    assert!(!d.join("g.forest").exists());
+}

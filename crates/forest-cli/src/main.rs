@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 
 mod bake;
+mod bench;
 mod render;
 mod scene;
 
@@ -20,6 +21,8 @@ enum Cli {
     Scene(scene::SceneArgs),
     /// Render views of a forest to PNG, headless.
     Render(render::RenderArgs),
+    /// Run a benchmark suite and write its CSV.
+    Bench(bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +50,7 @@ fn main() -> ExitCode {
         Cli::Info(args) => bake::info(&args),
         Cli::Scene(args) => scene::run(&args),
         Cli::Render(args) => render::run(&args),
+        Cli::Bench(args) => bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
