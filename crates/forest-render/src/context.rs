@@ -22,6 +22,18 @@ pub enum RenderError {
     Format(#[from] forest_format::FormatError),
 }
 
+/// How colour layers are stored on the GPU.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ColourFormat {
+    /// BC7 on GPUs, RGBA8 on CPU rasterisers (see [`GpuContext::use_bc7`]).
+    #[default]
+    Auto,
+    /// BC7 (1 byte per texel) where the device has BC textures, else RGBA8.
+    Bc7,
+    /// RGBA8 (4 bytes per texel).
+    Rgba8,
+}
+
 /// Device, queue and the validation errors wgpu reported so far.
 pub struct GpuContext {
     /// The adapter's description (name, backend, type).
@@ -74,25 +86,49 @@ impl GpuContext {
         })
     }
 
+    /// Wrap a device and queue the application already has (its error handler is left alone,
+    /// so [`Self::take_errors`] reports nothing; the device should have the adapter's limits
+    /// for large scenes, and `TIMESTAMP_QUERY` for pass times).
+    pub fn from_device(
+        adapter_info: wgpu::AdapterInfo,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
+        Self {
+            adapter_info,
+            device,
+            queue,
+            errors: Arc::new(Mutex::new(Vec::new())),
+        }
+    }
+
     /// Validation and out-of-memory errors reported since the last call (drained).
     pub fn take_errors(&self) -> Vec<String> {
         let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
         std::mem::take(&mut *self.errors.lock().unwrap())
     }
 
-    /// Whether colour layers are uploaded as BC7 (else RGBA8): when the device has BC
-    /// textures and is not a CPU rasteriser (lavapipe decodes BC7 in software on every
-    /// sample, which made drawing ~10× slower there). `FOREST_COLOUR_FORMAT=bc7|rgba8`
-    /// overrides the choice (BC7 still needs the feature).
-    pub fn use_bc7(&self) -> bool {
-        let has = self
-            .device
+    /// Whether the device can sample BC textures.
+    pub fn has_bc(&self) -> bool {
+        self.device
             .features()
-            .contains(wgpu::Features::TEXTURE_COMPRESSION_BC);
-        match std::env::var("FOREST_COLOUR_FORMAT").as_deref() {
-            Ok("bc7") => has,
-            Ok("rgba8") => false,
-            _ => has && self.adapter_info.device_type != wgpu::DeviceType::Cpu,
+            .contains(wgpu::Features::TEXTURE_COMPRESSION_BC)
+    }
+
+    /// Whether colour layers are uploaded as BC7 for `choice`.
+    ///
+    /// [`ColourFormat::Auto`]: BC7 when the device has BC textures and is not a CPU rasteriser
+    /// (lavapipe decodes BC7 in software on every sample, which made drawing ~10× slower
+    /// there), unless `FOREST_COLOUR_FORMAT=bc7|rgba8` says otherwise.
+    pub fn use_bc7(&self, choice: ColourFormat) -> bool {
+        match choice {
+            ColourFormat::Bc7 => self.has_bc(),
+            ColourFormat::Rgba8 => false,
+            ColourFormat::Auto => match std::env::var("FOREST_COLOUR_FORMAT").as_deref() {
+                Ok("bc7") => self.has_bc(),
+                Ok("rgba8") => false,
+                _ => self.has_bc() && self.adapter_info.device_type != wgpu::DeviceType::Cpu,
+            },
         }
     }
 }

@@ -18,6 +18,6 @@ pub mod scene;
 pub mod target;
 
 pub use camera::Camera;
-pub use context::{GpuContext, RenderError};
+pub use context::{ColourFormat, GpuContext, RenderError};
 pub use renderer::{FrameStats, QuadStream, RendererOptions};
 pub use scene::{GpuScene, SpeciesData};

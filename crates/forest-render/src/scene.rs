@@ -6,7 +6,7 @@ use forest_format::shading::{srgb_decode_table, srgb_encode};
 use forest_format::{Atlas, QuadNode};
 use wgpu::util::DeviceExt;
 
-use crate::context::{GpuContext, RenderError};
+use crate::context::{ColourFormat, GpuContext, RenderError};
 use crate::gpu_types::{GpuFrame, GpuInstance, GpuSpecies};
 
 /// Width of the presort texture (one instance index per texel, orders one after another).
@@ -227,6 +227,8 @@ pub struct GpuScene {
     pub presort_dirs: wgpu::Buffer,
     /// Bytes of all the above on the GPU.
     pub bytes: u64,
+    /// Whether colour is BC7 (else RGBA8).
+    pub bc7: bool,
 }
 
 fn storage<T: bytemuck::Pod + Default>(ctx: &GpuContext, label: &str, data: &[T]) -> wgpu::Buffer {
@@ -280,11 +282,21 @@ fn u32_texture(
 }
 
 impl GpuScene {
-    /// Upload species and a forest.
+    /// Upload species and a forest, colour in the automatic format.
     pub fn new(
         ctx: &GpuContext,
         species: &[SpeciesData],
         forest: &Forest,
+    ) -> Result<Self, RenderError> {
+        Self::with_format(ctx, species, forest, ColourFormat::Auto)
+    }
+
+    /// Upload species and a forest with the given colour format.
+    pub fn with_format(
+        ctx: &GpuContext,
+        species: &[SpeciesData],
+        forest: &Forest,
+        colour_format: ColourFormat,
     ) -> Result<Self, RenderError> {
         let tables = SceneTables::new(species, forest)?;
         let limits = ctx.device.limits();
@@ -294,7 +306,7 @@ impl GpuScene {
                 tables.layers, limits.max_texture_array_layers
             )));
         }
-        let bc7 = ctx.use_bc7() && tables.resolution >= 4;
+        let bc7 = ctx.use_bc7(colour_format) && tables.resolution >= 4;
         let format = if bc7 {
             wgpu::TextureFormat::Bc7RgbaUnormSrgb
         } else {
@@ -375,6 +387,7 @@ impl GpuScene {
             nodes,
             presort,
             bytes,
+            bc7,
         })
     }
 }

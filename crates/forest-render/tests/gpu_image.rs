@@ -154,3 +154,45 @@ fn an_empty_forest_and_bad_cameras_are_handled() {
     assert!(stream.set_camera(&ctx, &bad).is_err());
     assert_eq!(stream.uploads().0, 1, "a refused camera is not written");
 }
+
+#[test]
+fn bc7_colour_renders_like_rgba8() {
+    let ctx = common::ctx();
+    if !ctx.has_bc() {
+        eprintln!("skipped: the adapter has no BC textures");
+        return;
+    }
+    let forest = common::forest(300);
+    let (name, cam) = common::cameras(forest.extent()).remove(2);
+    let mut images = Vec::new();
+    for format in [
+        forest_render::ColourFormat::Rgba8,
+        forest_render::ColourFormat::Bc7,
+    ] {
+        let scene = GpuScene::with_format(&ctx, &common::species(), &forest, format).unwrap();
+        assert_eq!(scene.bc7, format == forest_render::ColourFormat::Bc7);
+        let opts = RendererOptions {
+            viewport: (160, 120),
+            min_epsilon: 4.0,
+            ..Default::default()
+        };
+        let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+        let target = Target::new(&ctx, 160, 120);
+        stream.set_camera(&ctx, &cam).unwrap();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        images.push(target.read(&ctx));
+        assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    }
+    let (mean, map) = flip(&images[0], &images[1]);
+    if mean > 0.05 {
+        images[1]
+            .save(out_dir().join(format!("{name}-bc7.png")))
+            .unwrap();
+        map.save(out_dir().join(format!("{name}-bc7-flip.png")))
+            .unwrap();
+    }
+    assert!(mean <= 0.05, "BC7 vs RGBA8: mean FLIP {mean:.4}");
+    assert!(mean > 0.0, "BC7 is lossy: the images cannot be identical");
+}
