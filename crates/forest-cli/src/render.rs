@@ -157,10 +157,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let stream = QuadStream::new(&ctx, scene, &opts)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
     for (name, cam) in &cameras {
-        stream.set_camera(&ctx, cam)?;
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
-        ctx.queue.submit([enc.finish()]);
+        stream.render_frame(&ctx, cam, &target)?;
         let stats = stream.read_stats(&ctx);
         let errors = ctx.take_errors();
         if !errors.is_empty() {

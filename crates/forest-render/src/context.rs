@@ -108,6 +108,21 @@ impl GpuContext {
         std::mem::take(&mut *self.errors.lock().unwrap())
     }
 
+    /// Submit `enc` (which copies into the `MAP_READ` buffer `staging`), wait, and return the
+    /// buffer's bytes. Read-backs are for tests, statistics and screenshots, never per frame.
+    pub fn submit_and_read(&self, enc: wgpu::CommandEncoder, staging: &wgpu::Buffer) -> Vec<u8> {
+        self.queue.submit([enc.finish()]);
+        staging.map_async(wgpu::MapMode::Read, .., |r| {
+            r.expect("map a read-back buffer")
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("the device answers");
+        let bytes = staging.get_mapped_range(..).expect("mapped").to_vec();
+        staging.unmap();
+        bytes
+    }
+
     /// Whether the device can sample BC textures.
     pub fn has_bc(&self) -> bool {
         self.device

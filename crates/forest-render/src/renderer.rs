@@ -385,6 +385,20 @@ impl QuadStream {
         }
     }
 
+    /// Write the camera, record a frame into `target` and submit it.
+    pub fn render_frame(
+        &self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        target: &crate::target::Target,
+    ) -> Result<(), CameraError> {
+        self.set_camera(ctx, camera)?;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        self.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
     /// Write the camera: the one upload of a frame.
     pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
         camera.validate()?;
@@ -483,16 +497,7 @@ impl QuadStream {
         );
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
-        ctx.queue.submit([enc.finish()]);
-        staging.map_async(wgpu::MapMode::Read, .., |r| {
-            r.expect("map the readback buffer")
-        });
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .expect("the device answers");
-        let bytes = staging.get_mapped_range(..).expect("mapped").to_vec();
-        staging.unmap();
-        bytes
+        ctx.submit_and_read(enc, &staging)
     }
 
     /// Counters (and pass times) of the last submitted frame; waits for the GPU.

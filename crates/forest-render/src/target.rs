@@ -90,14 +90,7 @@ impl Target {
                 depth_or_array_layers: 1,
             },
         );
-        ctx.queue.submit([enc.finish()]);
-        buf.map_async(wgpu::MapMode::Read, .., |r| {
-            r.expect("map the target readback")
-        });
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .expect("the device answers");
-        let data = buf.get_mapped_range(..).expect("mapped");
+        let data = ctx.submit_and_read(enc, &buf);
         let mut img = image::RgbaImage::new(w, h);
         for y in 0..h as usize {
             let src = &data[y * row as usize..y * row as usize + w as usize * 4];

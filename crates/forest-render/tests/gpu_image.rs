@@ -47,10 +47,7 @@ fn renders_match_the_stored_references() {
         if name == "culled" || name == "under_canopy" {
             continue;
         }
-        stream.set_camera(&ctx, &cam).unwrap();
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
-        ctx.queue.submit([enc.finish()]);
+        stream.render_frame(&ctx, &cam, &target).unwrap();
         let img = target.read(&ctx);
         assert_eq!(ctx.take_errors(), Vec::<String>::new());
         let path = refs().join(format!("{name}.png"));
@@ -106,10 +103,7 @@ fn a_frame_writes_only_the_camera() {
     let cams = common::cameras(forest.extent());
     let mut streams = Vec::new();
     for (_, cam) in cams.iter().take(3) {
-        stream.set_camera(&ctx, cam).unwrap();
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
-        ctx.queue.submit([enc.finish()]);
+        stream.render_frame(&ctx, cam, &target).unwrap();
         streams.push(stream.read_quads(&ctx));
     }
     assert_eq!(
@@ -143,10 +137,7 @@ fn an_empty_forest_and_bad_cameras_are_handled() {
     let target = Target::new(&ctx, 32, 32);
     let (_, mut cam) = common::cameras(10.0).remove(0);
     cam.viewport = (32, 32);
-    stream.set_camera(&ctx, &cam).unwrap();
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    stream.encode(&mut enc, &target.colour_view, &target.depth_view);
-    ctx.queue.submit([enc.finish()]);
+    stream.render_frame(&ctx, &cam, &target).unwrap();
     assert_eq!(stream.read_stats(&ctx).quads, 0);
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     let mut bad = cam;
@@ -178,10 +169,7 @@ fn bc7_colour_renders_like_rgba8() {
         };
         let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
         let target = Target::new(&ctx, 160, 120);
-        stream.set_camera(&ctx, &cam).unwrap();
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
-        ctx.queue.submit([enc.finish()]);
+        stream.render_frame(&ctx, &cam, &target).unwrap();
         images.push(target.read(&ctx));
         assert_eq!(ctx.take_errors(), Vec::<String>::new());
     }

@@ -22,10 +22,7 @@ fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
     let side = forest.extent();
     let mut summary = Vec::new();
     for (name, cam) in common::cameras(side) {
-        stream.set_camera(&ctx, &cam).unwrap();
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
-        ctx.queue.submit([enc.finish()]);
+        stream.render_frame(&ctx, &cam, &target).unwrap();
         let gpu = stream.read_quads(&ctx);
         let stats = stream.read_stats(&ctx);
         let cpu = reference::run(&stream.scene.tables, &cam.to_gpu(), stream.capacity.quads);
