@@ -186,3 +186,51 @@ fn bake_scene_render_end_to_end() {
     assert!(e.contains("missing.atlas"), "{e}");
     assert!(!d.join("g.forest").exists());
 }
+
+#[test]
+fn compare_reports_metrics_and_refuses_mismatched_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    let a = image::RgbaImage::from_fn(32, 32, |x, y| {
+        image::Rgba([
+            (x * 8) as u8,
+            (y * 8) as u8,
+            90,
+            if x < 16 { 255 } else { 0 },
+        ])
+    });
+    let mut b = a.clone();
+    for y in 0..32 {
+        b.put_pixel(20, y, image::Rgba([255, 255, 255, 255]));
+    }
+    a.save(p("a.png")).unwrap();
+    b.save(p("b.png")).unwrap();
+    let out = ok(&forest(&[
+        "compare",
+        &p("a.png"),
+        &p("b.png"),
+        "--json",
+        "--flip-map",
+        &p("map.png"),
+    ]));
+    let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    // Coverage: 16 columns vs 17 (column 20 added): IoU 16/17.
+    assert!(
+        (v["coverage_iou"].as_f64().unwrap() - 16.0 / 17.0).abs() < 1e-9,
+        "{v}"
+    );
+    assert!(v["flip_mean"].as_f64().unwrap() > 0.0 && v["psnr"].as_f64().unwrap() < 100.0);
+    assert!(d_exists(&p("map.png")));
+    let same = ok(&forest(&["compare", &p("a.png"), &p("a.png"), "--json"]));
+    let s: serde_json::Value = serde_json::from_str(same.trim()).unwrap();
+    assert_eq!(s["flip_mean"], 0.0);
+    image::RgbaImage::new(8, 8).save(p("small.png")).unwrap();
+    let e = err(&forest(&["compare", &p("a.png"), &p("small.png")]));
+    assert!(e.contains("sizes differ"), "{e}");
+    let e = err(&forest(&["compare", &p("a.png"), &p("none.png")]));
+    assert!(e.contains("none.png"), "{e}");
+}
+
+fn d_exists(p: &str) -> bool {
+    Path::new(p).is_file()
+}

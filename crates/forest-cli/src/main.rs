@@ -6,6 +6,7 @@ use clap::Parser;
 
 mod bake;
 mod bench;
+mod compare;
 mod render;
 mod scene;
 
@@ -23,6 +24,8 @@ enum Cli {
     Render(render::RenderArgs),
     /// Run a benchmark suite and write its CSV.
     Bench(bench::BenchArgs),
+    /// Accuracy of an image against a reference: mean FLIP, SSIM, PSNR, coverage IoU.
+    Compare(compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Cli::Scene(args) => scene::run(&args),
         Cli::Render(args) => render::run(&args),
         Cli::Bench(args) => bench::run(&args),
+        Cli::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

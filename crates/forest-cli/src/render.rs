@@ -40,6 +40,9 @@ pub struct RenderArgs {
     /// Print one JSON line of figures per view.
     #[arg(long)]
     pub json: bool,
+    /// Draw over a transparent background without ground (alpha = tree coverage, for metrics).
+    #[arg(long)]
+    pub transparent: bool,
 }
 
 pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -152,6 +155,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         format: TARGET_FORMAT,
         viewport: args.size,
         min_epsilon: args.epsilon.min(8.0),
+        background: if args.transparent {
+            forest_render::renderer::Background::Transparent
+        } else {
+            forest_render::renderer::Background::Sky
+        },
         ..Default::default()
     };
     let stream = QuadStream::new(&ctx, scene, &opts)?;

@@ -17,6 +17,16 @@ use crate::passes::refine::RefinePass;
 use crate::passes::scan::ScanPass;
 use crate::scene::GpuScene;
 
+/// What the trees are drawn over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Background {
+    /// Sky colour and a ground plane (the demo).
+    #[default]
+    Sky,
+    /// Transparent black, no ground: the alpha channel is the trees' coverage (for metrics).
+    Transparent,
+}
+
 /// Options of a renderer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RendererOptions {
@@ -32,6 +42,8 @@ pub struct RendererOptions {
     pub max_quads: Option<u32>,
     /// Lighting for the ground (the atlases carry their own baked lighting).
     pub lighting: Lighting,
+    /// Sky and ground, or transparent.
+    pub background: Background,
 }
 
 impl Default for RendererOptions {
@@ -43,6 +55,7 @@ impl Default for RendererOptions {
             overdraw: 16.0,
             max_quads: None,
             lighting: Lighting::with_sun(30.0, 55.0),
+            background: Background::Sky,
         }
     }
 }
@@ -109,6 +122,7 @@ pub struct QuadStream {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     writes: Cell<(u64, u64)>,
     camera_set: Cell<bool>,
+    background: Background,
     owned: Vec<(&'static str, wgpu::Buffer)>,
 }
 
@@ -366,6 +380,7 @@ impl QuadStream {
             queries,
             writes: Cell::new((0, 0)),
             camera_set: Cell::new(false),
+            background: opts.background,
             owned,
         })
     }
@@ -458,7 +473,10 @@ impl QuadStream {
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(SKY),
+                        load: wgpu::LoadOp::Clear(match self.background {
+                            Background::Sky => SKY,
+                            Background::Transparent => wgpu::Color::TRANSPARENT,
+                        }),
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -480,7 +498,12 @@ impl QuadStream {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            self.draw.record(&mut pass, &self.bg_draw, &self.args);
+            self.draw.record(
+                &mut pass,
+                &self.bg_draw,
+                &self.args,
+                self.background == Background::Sky,
+            );
         }
         if let Some((set, resolve, _)) = &self.queries {
             encoder.resolve_query_set(set, 0..6, resolve, 0);

@@ -18,16 +18,8 @@ fn out_dir() -> PathBuf {
     d
 }
 
-/// Mean FLIP error of `test` against `reference` (both sRGB RGBA8), and the error map.
 fn flip(reference: &image::RgbaImage, test: &image::RgbaImage) -> (f32, image::RgbImage) {
-    let rgb = |i: &image::RgbaImage| image::DynamicImage::ImageRgba8(i.clone()).to_rgb8();
-    let (w, h) = reference.dimensions();
-    let r = nv_flip::FlipImageRgb8::with_data(w, h, &rgb(reference));
-    let t = nv_flip::FlipImageRgb8::with_data(w, h, &rgb(test));
-    let err = nv_flip::flip(r, t, 67.0);
-    let mean = nv_flip::FlipPool::from_image(&err).mean();
-    let map = err.apply_color_lut(&nv_flip::magma_lut());
-    (mean, image::RgbImage::from_raw(w, h, map.to_vec()).unwrap())
+    forest_metrics::flip(reference, test).unwrap()
 }
 
 #[test]

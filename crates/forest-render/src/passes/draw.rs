@@ -133,16 +133,19 @@ impl DrawPass {
         }
     }
 
-    /// Record the ground and the indirect quad draw.
+    /// Record the ground (when `ground`) and the indirect quad draw.
     pub fn record(
         &self,
         pass: &mut wgpu::RenderPass,
         bind_group: &wgpu::BindGroup,
         args_buf: &wgpu::Buffer,
+        ground: bool,
     ) {
         pass.set_bind_group(0, bind_group, &[]);
-        pass.set_pipeline(&self.ground);
-        pass.draw(0..4, 0..1);
+        if ground {
+            pass.set_pipeline(&self.ground);
+            pass.draw(0..4, 0..1);
+        }
         pass.set_pipeline(&self.quads);
         pass.draw_indirect(args_buf, args::DRAW);
     }

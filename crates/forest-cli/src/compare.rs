@@ -1,0 +1,51 @@
+//! `forest compare`: accuracy metrics of an image against a reference.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+/// Arguments of `forest compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Reference image.
+    pub reference: PathBuf,
+    /// Image to judge.
+    pub test: PathBuf,
+    /// Also write the FLIP error map (PNG).
+    #[arg(long, value_name = "PNG")]
+    pub flip_map: Option<PathBuf>,
+    /// Print one JSON line.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Run `forest compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let open = |p: &PathBuf| {
+        image::open(p)
+            .with_context(|| format!("reading {}", p.display()))
+            .map(|i| i.to_rgba8())
+    };
+    let (a, b) = (open(&args.reference)?, open(&args.test)?);
+    let m = forest_metrics::compare(&a, &b)?;
+    if let Some(p) = &args.flip_map {
+        let (_, map) = forest_metrics::flip(&a, &b)?;
+        let tmp = forest_bake::tmp_name(p);
+        map.save_with_format(&tmp, image::ImageFormat::Png)
+            .with_context(|| format!("writing {}", p.display()))?;
+        std::fs::rename(&tmp, p).with_context(|| format!("writing {}", p.display()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&m)?);
+    } else {
+        let iou = m
+            .coverage_iou
+            .map_or("n/a (opaque images)".to_string(), |v| format!("{v:.4}"));
+        println!(
+            "FLIP {:.4}  SSIM {:.4}  PSNR {:.2} dB  coverage IoU {iou}",
+            m.flip_mean, m.ssim, m.psnr
+        );
+    }
+    Ok(())
+}
