@@ -259,3 +259,66 @@ pub fn finish_tmp(result: Result<(), String>, tmp: &Path, path: &Path) -> Result
     }
     Ok(result?)
 }
+
+/// One vertex of the full-geometry reference (48 bytes, as `GeoVertex` in
+/// `shaders/geometry.wgsl`): object-space position, sun visibility, normal, material, uv.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct RefVertex {
+    /// Object-space position (metres).
+    pub pos: [f32; 3],
+    /// Fraction of sun visibility traced at this corner, in `[0, 1]`.
+    pub sun_visibility: f32,
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Material index.
+    pub material: u32,
+    /// Texture coordinates (OBJ convention).
+    pub uv: [f32; 2],
+    /// Padding.
+    pub pad: [f32; 2],
+}
+
+/// Per-vertex sun visibility for the full-geometry reference: for each triangle corner, the
+/// mean of alpha-tested shadow rays from `SUN_SAMPLES` points of the triangle near that
+/// corner (barycentric weight 0.7 on the corner), so that the interpolated visibility follows
+/// the same shadows the bake traces per pixel. Non-indexed: three vertices per triangle.
+pub fn reference_vertices(
+    mesh: &Mesh,
+    lighting: &forest_format::shading::Lighting,
+) -> Vec<RefVertex> {
+    const SUN_SAMPLES: u32 = 4;
+    let scene = trace::Scene::new(mesh);
+    let eps = bounding_sphere(mesh).radius * 1e-5;
+    let sun = lighting.sun_dir;
+    scene
+        .tris
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(ti, t)| {
+            let geo = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalize_or_zero();
+            let side = if geo.dot(sun) >= 0.0 { geo } else { -geo };
+            let scene = &scene;
+            (0..3).map(move |k| {
+                let mut lit = 0u32;
+                for s in 0..SUN_SAMPLES {
+                    // Points around the corner: weights (0.7, 0.15, 0.15) jittered a little.
+                    let j = 0.1 * (s as f32 / SUN_SAMPLES as f32 - 0.4);
+                    let w = [0.7 - j, 0.15 + j, 0.15];
+                    let p = t.p[k] * w[0] + t.p[(k + 1) % 3] * w[1] + t.p[(k + 2) % 3] * w[2];
+                    if !scene.occluded(p + side * eps, sun, eps, f32::INFINITY, ti as u32) {
+                        lit += 1;
+                    }
+                }
+                RefVertex {
+                    pos: t.p[k].to_array(),
+                    sun_visibility: lit as f32 / SUN_SAMPLES as f32,
+                    normal: t.n[k].to_array(),
+                    material: t.material,
+                    uv: t.uv[k].to_array(),
+                    pad: [0.0; 2],
+                }
+            })
+        })
+        .collect()
+}

@@ -64,7 +64,8 @@ impl GpuContext {
     pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Self, RenderError> {
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-            | wgpu::Features::TEXTURE_COMPRESSION_BC;
+            | wgpu::Features::TEXTURE_COMPRESSION_BC
+            | wgpu::Features::INDIRECT_FIRST_INSTANCE;
         let features = adapter.features() & wanted;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("forest"),

@@ -10,6 +10,7 @@
 pub mod camera;
 pub mod capacity;
 pub mod context;
+pub mod geometry;
 pub mod gpu_types;
 pub mod passes;
 pub mod reference;
