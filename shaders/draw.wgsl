@@ -10,11 +10,6 @@
 // quads are still depth-tested against the opaque ground drawn first, so trees are hidden by
 // hills and the ground hides the parts of slabs below it.
 
-struct Ground {
-    // xyz: albedo-lit colour (linear); w: half size of the ground square in metres.
-    colour: vec4<f32>,
-}
-
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
 @group(0) @binding(2) var<storage, read> species: array<Species>;
@@ -23,7 +18,6 @@ struct Ground {
 @group(0) @binding(5) var nodes: texture_2d<u32>;
 @group(0) @binding(6) var colour: texture_2d_array<f32>;
 @group(0) @binding(7) var colour_sampler: sampler;
-@group(0) @binding(8) var<uniform> ground: Ground;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -59,21 +53,3 @@ fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
     return c * in.alpha;
 }
 
-struct GroundOut {
-    @builtin(position) clip: vec4<f32>,
-}
-
-@vertex
-fn vs_ground(@builtin(vertex_index) vi: u32) -> GroundOut {
-    let s = ground.colour.w;
-    let x = select(-s, s, (vi & 1u) == 1u) + camera.eye.x;
-    let z = select(-s, s, (vi >> 1u) == 1u) + camera.eye.z;
-    var out: GroundOut;
-    out.clip = camera.view_proj * vec4<f32>(x, 0.0, z, 1.0);
-    return out;
-}
-
-@fragment
-fn fs_ground() -> @location(0) vec4<f32> {
-    return vec4<f32>(ground.colour.xyz, 1.0);
-}

@@ -43,6 +43,16 @@ pub struct RenderArgs {
     /// Draw over a transparent background without ground (alpha = tree coverage, for metrics).
     #[arg(long)]
     pub transparent: bool,
+    /// Rendering method: the quad stream, or full geometry (the reference and brute-force
+    /// baseline; needs --models).
+    #[arg(long, default_value = "quads", value_parser = ["quads", "geometry"])]
+    pub method: String,
+    /// OBJ models of the forest's species, in its species order (for --method geometry).
+    #[arg(long, value_delimiter = ',')]
+    pub models: Vec<PathBuf>,
+    /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
+    #[arg(long, default_value_t = 1)]
+    pub supersample: u32,
 }
 
 pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -149,34 +159,46 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             bail!("output folder {} does not exist", p.display());
         }
     }
+    if !(1..=8).contains(&args.supersample) {
+        bail!("supersample = {}: must be 1 to 8", args.supersample);
+    }
+    if args.method == "geometry" && args.models.len() != forest.species.len() {
+        bail!(
+            "--method geometry needs --models with one OBJ per species ({} given, the forest has {})",
+            args.models.len(),
+            forest.species.len()
+        );
+    }
     let ctx = GpuContext::headless()?;
+    if args.method == "geometry" {
+        return render_geometry(args, &ctx, &forest, &species, &cameras);
+    }
+    let (sw, sh) = (
+        args.size.0 * args.supersample,
+        args.size.1 * args.supersample,
+    );
     let scene = GpuScene::new(&ctx, &species, &forest)?;
     let opts = RendererOptions {
         format: TARGET_FORMAT,
-        viewport: args.size,
         min_epsilon: args.epsilon.min(8.0),
-        background: if args.transparent {
-            forest_render::renderer::Background::Transparent
-        } else {
-            forest_render::renderer::Background::Sky
-        },
+        viewport: (sw, sh),
+        background: background(args),
         ..Default::default()
     };
     let stream = QuadStream::new(&ctx, scene, &opts)?;
-    let target = Target::new(&ctx, args.size.0, args.size.1);
+    let target = Target::new(&ctx, sw, sh);
     for (name, cam) in &cameras {
+        let mut cam = *cam;
+        cam.viewport = (sw, sh);
+        let cam = &cam;
         stream.render_frame(&ctx, cam, &target)?;
         let stats = stream.read_stats(&ctx);
         let errors = ctx.take_errors();
         if !errors.is_empty() {
             bail!("the GPU reported: {}", errors.join("; "));
         }
-        let img = target.read(&ctx);
         let out = output_for(&args.output, name, cameras.len());
-        let tmp = forest_bake::tmp_name(&out);
-        img.save_with_format(&tmp, image::ImageFormat::Png)
-            .with_context(|| format!("writing {}", out.display()))?;
-        std::fs::rename(&tmp, &out).with_context(|| format!("writing {}", out.display()))?;
+        save(&target, &ctx, args.supersample, &out)?;
         let t = stats.times.unwrap_or_default();
         if args.json {
             println!(
@@ -205,6 +227,72 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 out.display()
             );
         }
+    }
+    Ok(())
+}
+
+fn background(args: &RenderArgs) -> forest_render::renderer::Background {
+    if args.transparent {
+        forest_render::renderer::Background::Transparent
+    } else {
+        forest_render::renderer::Background::Sky
+    }
+}
+
+/// Read the target back, box-filter it down by `supersample`, and write a PNG atomically.
+fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Result<()> {
+    let mut img = target.read(ctx);
+    if supersample > 1 {
+        img = forest_render::geometry::downsample(&img, supersample);
+    }
+    let tmp = forest_bake::tmp_name(out);
+    img.save_with_format(&tmp, image::ImageFormat::Png)
+        .with_context(|| format!("writing {}", out.display()))?;
+    std::fs::rename(&tmp, out).with_context(|| format!("writing {}", out.display()))?;
+    Ok(())
+}
+
+/// `--method geometry`: the full-geometry reference / brute-force baseline.
+fn render_geometry(
+    args: &RenderArgs,
+    ctx: &GpuContext,
+    forest: &Forest,
+    species: &[SpeciesData],
+    cameras: &[(String, Camera)],
+) -> Result<()> {
+    use forest_render::geometry::{GeometryRenderer, GeometrySpecies};
+    let geo_species = args
+        .models
+        .iter()
+        .zip(species)
+        .map(|(m, s)| {
+            Ok(GeometrySpecies {
+                mesh: forest_bake::Mesh::load(m)?,
+                lighting: s.atlas.manifest.lighting,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let geo = GeometryRenderer::new(ctx, &geo_species, forest, TARGET_FORMAT, background(args))?;
+    let (sw, sh) = (
+        args.size.0 * args.supersample,
+        args.size.1 * args.supersample,
+    );
+    let target = Target::new(ctx, sw, sh);
+    for (name, cam) in cameras {
+        let mut cam = *cam;
+        cam.viewport = (sw, sh);
+        geo.render_frame(ctx, &cam, &target)?;
+        let errors = ctx.take_errors();
+        if !errors.is_empty() {
+            bail!("the GPU reported: {}", errors.join("; "));
+        }
+        let out = output_for(&args.output, name, cameras.len());
+        save(&target, ctx, args.supersample, &out)?;
+        println!(
+            "{name}: full geometry ({}x supersampled) -> {}",
+            args.supersample,
+            out.display()
+        );
     }
     Ok(())
 }

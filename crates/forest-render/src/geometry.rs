@@ -64,6 +64,8 @@ pub struct GeometryRenderer {
     cull: wgpu::ComputePipeline,
     args_pipeline: wgpu::ComputePipeline,
     draw: wgpu::RenderPipeline,
+    ground_pipeline: wgpu::RenderPipeline,
+    ground_bg: wgpu::BindGroup,
     compute_bg: wgpu::BindGroup,
     draw_bg: wgpu::BindGroup,
     args: wgpu::Buffer,
@@ -318,9 +320,7 @@ impl GeometryRenderer {
         });
         let draw_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry draw"),
-            source: wgpu::ShaderSource::Wgsl(
-                src(include_str!("../../../shaders/geometry_draw.wgsl")).into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(crate::passes::GEOMETRY_DRAW_WGSL.concat().into()),
         });
         // One explicit layout shared by the three compute entry points (one bind group).
         let entries: Vec<wgpu::BindGroupLayoutEntry> = crate::passes::layout_entries(
@@ -389,39 +389,67 @@ impl GeometryRenderer {
                 },
             ],
         });
-        let draw = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("geometry"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &draw_module,
-                entry_point: Some("vs_geo"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &draw_module,
-                entry_point: Some("fs_geo"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
+        let render_pipeline = |vs: &str, fs: &str, topology| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(vs),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &draw_module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &draw_module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let draw = render_pipeline("vs_geo", "fs_geo", wgpu::PrimitiveTopology::TriangleList);
+        let ground_pipeline = render_pipeline(
+            "vs_ground",
+            "fs_ground",
+            wgpu::PrimitiveTopology::TriangleStrip,
+        );
+        let ground_buf = init(
+            "geometry ground",
+            bytemuck::bytes_of(&crate::renderer::ground_uniform(&l, &instances)),
+            U::UNIFORM,
+        );
+        let ground_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("geometry ground"),
+            layout: &ground_pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: ground_buf.as_entire_binding(),
+                },
+            ],
         });
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry draw"),
@@ -467,6 +495,8 @@ impl GeometryRenderer {
             cull,
             args_pipeline,
             draw,
+            ground_pipeline,
+            ground_bg,
             compute_bg,
             draw_bg,
             args,
@@ -525,6 +555,11 @@ impl GeometryRenderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
+            if self.background == Background::Sky {
+                pass.set_pipeline(&self.ground_pipeline);
+                pass.set_bind_group(0, &self.ground_bg, &[]);
+                pass.draw(0..4, 0..1);
+            }
             pass.set_pipeline(&self.draw);
             pass.set_bind_group(0, &self.draw_bg, &[]);
             for s in 0..self.species {

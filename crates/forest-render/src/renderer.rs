@@ -98,6 +98,22 @@ pub const SKY: wgpu::Color = wgpu::Color {
     a: 1.0,
 };
 
+/// The ground's uniform: the ground albedo lit by the shared shading model (facing up, in sun),
+/// and a square reaching 5 km beyond the farthest tree.
+pub fn ground_uniform(
+    lighting: &Lighting,
+    instances: &[crate::gpu_types::GpuInstance],
+) -> GpuGround {
+    let extent = instances
+        .iter()
+        .map(|i| glam::Vec3::from_array(i.position).length())
+        .fold(0.0f32, f32::max);
+    let lit = lighting.shade(glam::Vec3::new(0.16, 0.14, 0.09), glam::Vec3::Y, 1.0, 0.0);
+    GpuGround {
+        colour: [lit.x, lit.y, lit.z, extent + 5000.0],
+    }
+}
+
 /// The renderer of one scene.
 pub struct QuadStream {
     /// The uploaded scene.
@@ -184,19 +200,9 @@ impl QuadStream {
             }),
             usage: U::UNIFORM,
         });
-        let extent = t
-            .instances
-            .iter()
-            .map(|i| glam::Vec3::from_array(i.position).length())
-            .fold(0.0f32, f32::max);
-        let l = &opts.lighting;
-        let ground_albedo = glam::Vec3::new(0.16, 0.14, 0.09);
-        let lit = l.shade(ground_albedo, glam::Vec3::Y, 1.0, 0.0);
         let ground = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ground"),
-            contents: bytemuck::bytes_of(&GpuGround {
-                colour: [lit.x, lit.y, lit.z, extent + 5000.0],
-            }),
+            contents: bytemuck::bytes_of(&ground_uniform(&opts.lighting, &t.instances)),
             usage: U::UNIFORM,
         });
         let state = buffer(

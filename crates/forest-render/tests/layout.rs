@@ -164,7 +164,8 @@ fn draw_structs_match_the_host() {
 
 #[test]
 fn shaders_validate() {
-    for src in [compute_source(), draw_source()] {
+    let geometry = forest_render::passes::GEOMETRY_DRAW_WGSL.concat();
+    for src in [compute_source(), draw_source(), geometry] {
         let module = naga::front::wgsl::parse_str(&src).unwrap();
         naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),

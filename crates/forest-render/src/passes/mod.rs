@@ -19,9 +19,17 @@ pub const COMPUTE_WGSL: [&str; 5] = [
 ];
 
 /// WGSL of the draw pass.
-pub const DRAW_WGSL: [&str; 2] = [
+pub const DRAW_WGSL: [&str; 3] = [
     include_str!("../../../../shaders/common.wgsl"),
     include_str!("../../../../shaders/draw.wgsl"),
+    include_str!("../../../../shaders/ground.wgsl"),
+];
+
+/// WGSL of the full-geometry draw.
+pub const GEOMETRY_DRAW_WGSL: [&str; 3] = [
+    include_str!("../../../../shaders/common.wgsl"),
+    include_str!("../../../../shaders/geometry_draw.wgsl"),
+    include_str!("../../../../shaders/ground.wgsl"),
 ];
 
 /// The compute module's source.
