@@ -43,9 +43,9 @@ pub struct RenderArgs {
     /// Draw over a transparent background without ground (alpha = tree coverage, for metrics).
     #[arg(long)]
     pub transparent: bool,
-    /// Rendering method: the quad stream, or full geometry (the reference and brute-force
-    /// baseline; needs --models).
-    #[arg(long, default_value = "quads", value_parser = ["quads", "geometry"])]
+    /// Rendering method: the quad stream; static impostors (the stream without refinement);
+    /// or full geometry (the reference and brute-force baseline; needs --models).
+    #[arg(long, default_value = "quads", value_parser = ["quads", "impostor", "geometry"])]
     pub method: String,
     /// OBJ models of the forest's species, in its species order (for --method geometry).
     #[arg(long, value_delimiter = ',')]
@@ -183,6 +183,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         min_epsilon: args.epsilon.min(8.0),
         viewport: (sw, sh),
         background: background(args),
+        refine: args.method != "impostor",
         ..Default::default()
     };
     let stream = QuadStream::new(&ctx, scene, &opts)?;

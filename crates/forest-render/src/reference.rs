@@ -163,6 +163,11 @@ fn scan(v: &[u32]) -> (Vec<u32>, u32) {
 
 /// Run passes 1 and 2 for a camera with stream capacity `capacity`.
 pub fn run(t: &SceneTables, cam: &GpuCamera, capacity: u32) -> Reference {
+    run_with(t, cam, capacity, t.max_levels.saturating_sub(1))
+}
+
+/// Run pass 1 and `iterations` refinement steps (0: the static impostor).
+pub fn run_with(t: &SceneTables, cam: &GpuCamera, capacity: u32, iterations: u32) -> Reference {
     let towards = -xyz(cam.forward);
     let mut presort = 0usize;
     let mut best = f32::NEG_INFINITY;
@@ -197,7 +202,7 @@ pub fn run(t: &SceneTables, cam: &GpuCamera, capacity: u32) -> Reference {
     r.overflow_cull = skip;
     let mut quads: Vec<Quad> = level0[skip as usize..].to_vec();
     // Pass 2.
-    for _ in 0..t.max_levels.saturating_sub(1) {
+    for _ in 0..iterations {
         let want: Vec<u32> = quads.iter().map(|q| wants(t, cam, q)).collect();
         let extra: Vec<u32> = want.iter().map(|&w| w.saturating_sub(1)).collect();
         let (p, total) = scan(&extra);

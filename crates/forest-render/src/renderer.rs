@@ -44,6 +44,9 @@ pub struct RendererOptions {
     pub lighting: Lighting,
     /// Sky and ground, or transparent.
     pub background: Background,
+    /// Refine the stream (the method). `false` draws the level-0 quads only: the static
+    /// impostor baseline (each tree as its 1–3 blended slab images, never subdivided).
+    pub refine: bool,
 }
 
 impl Default for RendererOptions {
@@ -56,6 +59,7 @@ impl Default for RendererOptions {
             max_quads: None,
             lighting: Lighting::with_sun(30.0, 55.0),
             background: Background::Sky,
+            refine: true,
         }
     }
 }
@@ -276,7 +280,11 @@ impl QuadStream {
         let bg_cull = compute_bg("cull", &quads[1], &quads[0]);
         let bg_ab = compute_bg("refine A->B", &quads[0], &quads[1]);
         let bg_ba = compute_bg("refine B->A", &quads[1], &quads[0]);
-        let iterations = t.max_levels.saturating_sub(1);
+        let iterations = if opts.refine {
+            t.max_levels.saturating_sub(1)
+        } else {
+            0
+        };
         let final_quads = &quads[(iterations % 2) as usize];
         let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

@@ -91,3 +91,35 @@ fn overflow_keeps_to_the_capacity_and_matches_the_reference() {
     );
     assert!(s.iter().all(|x| x.1 <= 700));
 }
+
+#[test]
+fn static_impostors_are_the_level0_stream() {
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let opts = RendererOptions {
+        viewport: (160, 120),
+        refine: false,
+        ..Default::default()
+    };
+    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    assert_eq!(stream.iterations(), 0);
+    let target = Target::new(&ctx, 160, 120);
+    for (name, cam) in common::cameras(forest.extent()) {
+        stream.render_frame(&ctx, &cam, &target).unwrap();
+        let gpu = stream.read_quads(&ctx);
+        let cpu = reference::run_with(
+            &stream.scene.tables,
+            &cam.to_gpu(),
+            stream.capacity.quads,
+            0,
+        );
+        assert_eq!(gpu, cpu.quads, "{name}");
+        assert!(
+            gpu.iter().all(|q| q.level() == 0),
+            "{name}: only level-0 quads"
+        );
+        let _ = target.read(&ctx);
+        assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    }
+}
