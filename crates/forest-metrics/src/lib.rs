@@ -5,9 +5,10 @@
 //! - **SSIM** on luma (image-compare's 8×8-window mean SSIM; 1 = identical);
 //! - **PSNR** over the RGB channels of the 8-bit images, in dB, capped at [`PSNR_CAP`] for
 //!   identical images;
-//! - **coverage IoU**: intersection over union of the pixels with non-zero alpha (tree
-//!   coverage, when rendered over a transparent background); `None` when both images are
-//!   fully opaque, since coverage is then unknown.
+//! - **coverage IoU**: intersection over union of the pixels at least half covered
+//!   (alpha ≥ 128; tree coverage when rendered over a transparent background), so faint
+//!   filtering fringes do not count; `None` when both images are fully opaque, since coverage
+//!   is then unknown.
 
 use image::RgbaImage;
 
@@ -90,7 +91,8 @@ pub fn ssim(reference: &RgbaImage, test: &RgbaImage) -> Result<f64, MetricsError
     Ok(s.score)
 }
 
-/// Intersection over union of non-zero alpha; `None` when both are fully opaque.
+/// Intersection over union of half-covered pixels (alpha ≥ 128); `None` when both are fully
+/// opaque.
 pub fn coverage_iou(reference: &RgbaImage, test: &RgbaImage) -> Result<Option<f64>, MetricsError> {
     check(reference, test)?;
     let opaque = |i: &RgbaImage| i.pixels().all(|p| p[3] == 255);
@@ -99,7 +101,7 @@ pub fn coverage_iou(reference: &RgbaImage, test: &RgbaImage) -> Result<Option<f6
     }
     let (mut inter, mut union) = (0u64, 0u64);
     for (a, b) in reference.pixels().zip(test.pixels()) {
-        let (ca, cb) = (a[3] > 0, b[3] > 0);
+        let (ca, cb) = (a[3] >= 128, b[3] >= 128);
         inter += u64::from(ca && cb);
         union += u64::from(ca || cb);
     }

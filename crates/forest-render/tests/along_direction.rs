@@ -1,0 +1,93 @@
+//! Viewed exactly along a sampling direction from far away (nearly orthographic), with a tiny
+//! ε, the quad stream reproduces the bake's own slab images (front slab over back slab).
+
+mod common;
+
+use forest_format::forest::{Forest, Instance};
+use forest_format::shading::{srgb_decode_table, srgb_encode};
+use forest_render::renderer::{Background, RendererOptions};
+use forest_render::target::Target;
+use forest_render::{Camera, GpuScene, QuadStream};
+
+#[test]
+fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
+    let ctx = common::ctx();
+    let species = common::species();
+    let atlas = &species[0].atlas; // bush, 64 px, 5 directions, 2 slabs
+    let forest = Forest::new(
+        vec!["bush".into(), "pine".into()],
+        vec![Instance {
+            position: [0.0; 3],
+            rotation: 0.0,
+            scale: 1.0,
+            species: 0,
+        }],
+        15,
+    );
+    let res = atlas.manifest.params.resolution;
+    let scene =
+        GpuScene::with_format(&ctx, &species, &forest, forest_render::ColourFormat::Rgba8).unwrap();
+    let opts = RendererOptions {
+        viewport: (res, res),
+        min_epsilon: 0.5,
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let target = Target::new(&ctx, res, res);
+    let sphere = atlas.manifest.bounding_sphere;
+    let table = srgb_decode_table();
+    let layers = &species[0].layers;
+    let mut checked = 0;
+    for (d, frame) in atlas.manifest.directions.iter().enumerate() {
+        if frame.dir.y > 0.99 {
+            continue; // the zenith: a look-at camera has no up vector there
+        }
+        let dist = sphere.radius * 1000.0;
+        let cam = Camera {
+            eye: sphere.center + frame.dir * dist,
+            target: sphere.center,
+            fov_y_deg: (2.0 * (sphere.radius / dist).atan()).to_degrees(),
+            near: dist - 2.0 * sphere.radius,
+            far: dist + 2.0 * sphere.radius,
+            viewport: (res, res),
+            epsilon: 0.5,
+        };
+        stream.render_frame(&ctx, &cam, &target).unwrap();
+        let img = target.read(&ctx);
+        assert_eq!(ctx.take_errors(), Vec::<String>::new());
+        // Expected: front slab over back slab, in linear premultiplied space.
+        let slabs = atlas.manifest.params.slabs;
+        let front = layers.layer(d as u32 * slabs);
+        let back = layers.layer(d as u32 * slabs + 1);
+        let expected = image::RgbaImage::from_fn(res, res, |x, y| {
+            let i = ((y * res + x) * 4) as usize;
+            let fa = f32::from(front[i + 3]) / 255.0;
+            let mut px = [0u8; 4];
+            for c in 0..3 {
+                let v = table[front[i + c] as usize] + table[back[i + c] as usize] * (1.0 - fa);
+                px[c] = (srgb_encode(v) * 255.0).round() as u8;
+            }
+            let a = fa + f32::from(back[i + 3]) / 255.0 * (1.0 - fa);
+            px[3] = (a * 255.0).round() as u8;
+            image::Rgba(px)
+        });
+        let m = forest_metrics::compare(&expected, &img).unwrap();
+        let out = common::root().join("target/test-output");
+        std::fs::create_dir_all(&out).unwrap();
+        if m.flip_mean > 0.05 || m.coverage_iou.unwrap_or(0.0) < 0.9 {
+            expected
+                .save(out.join(format!("along-{d}-expected.png")))
+                .unwrap();
+            img.save(out.join(format!("along-{d}-actual.png"))).unwrap();
+        }
+        assert!(
+            m.flip_mean <= 0.05,
+            "direction {d}: FLIP {:.4} ({m:?})",
+            m.flip_mean
+        );
+        assert!(m.coverage_iou.unwrap() >= 0.9, "direction {d}: {m:?}");
+        checked += 1;
+    }
+    assert_eq!(checked, 4, "every direction but the zenith");
+}
