@@ -2,16 +2,7 @@
 // instanced, frustum-culled on the GPU, alpha-tested, shaded with the project's one shading
 // model (forest_format::shading) in the tree's object space — the bake's lighting rotates with
 // the tree, so the reference must too — with per-vertex sun visibility traced by the bake's
-// ray tracer. Appended after common.wgsl.
-
-struct GeoVertex {
-    pos: vec3<f32>,
-    sun_visibility: f32,
-    normal: vec3<f32>,
-    material: u32,
-    uv: vec2<f32>,
-    pad: vec2<f32>,
-}
+// ray tracer. Appended after common.wgsl and geometry_types.wgsl.
 
 struct GeoSpecies {
     sphere: vec4<f32>,
@@ -19,22 +10,6 @@ struct GeoSpecies {
     vertex_count: u32,
     seg_base: u32,
     pad: u32,
-}
-
-struct GeoMaterial {
-    // rgb: Kd (linear); a: translucency.
-    kd: vec4<f32>,
-    // Texture layer (NONE: none), alpha tested (0/1).
-    layer: u32,
-    alpha_tested: u32,
-    pad: vec2<u32>,
-}
-
-struct Light {
-    sun_dir: vec4<f32>,
-    sun: vec4<f32>,
-    sky: vec4<f32>,
-    ground: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;

@@ -1,28 +1,5 @@
-// Drawing of the full geometry (see geometry.wgsl). Appended after common.wgsl and the structs
-// of geometry.wgsl are repeated here because the compute bindings differ.
-
-struct GeoVertex {
-    pos: vec3<f32>,
-    sun_visibility: f32,
-    normal: vec3<f32>,
-    material: u32,
-    uv: vec2<f32>,
-    pad: vec2<f32>,
-}
-
-struct GeoMaterial {
-    kd: vec4<f32>,
-    layer: u32,
-    alpha_tested: u32,
-    pad: vec2<u32>,
-}
-
-struct Light {
-    sun_dir: vec4<f32>,
-    sun: vec4<f32>,
-    sky: vec4<f32>,
-    ground: vec4<f32>,
-}
+// Drawing of the full geometry (see geometry.wgsl). Appended after common.wgsl and
+// geometry_types.wgsl; ground.wgsl follows.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;

@@ -12,9 +12,9 @@ use wgpu::util::DeviceExt;
 
 use crate::camera::{Camera, CameraError};
 use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::{GpuCamera, GpuInstance};
+use crate::gpu_types::GpuCamera;
 use crate::passes::draw::DEPTH_FORMAT;
-use crate::renderer::{Background, SKY};
+use crate::renderer::Background;
 use crate::target::Target;
 
 /// Side of every material texture layer on the GPU.
@@ -188,18 +188,7 @@ impl GeometryRenderer {
             sky: l.sky.extend(0.0).to_array(),
             ground: l.ground.extend(0.0).to_array(),
         };
-        let instances: Vec<GpuInstance> = forest
-            .instances
-            .iter()
-            .map(|i| GpuInstance {
-                position: i.position,
-                scale: i.scale,
-                cos_rot: i.rotation.cos(),
-                sin_rot: i.rotation.sin(),
-                species: i.species,
-                pad: 0,
-            })
-            .collect();
+        let instances = crate::scene::gpu_instances(forest);
         use wgpu::BufferUsages as U;
         let init = |label: &str, bytes: &[u8], usage: U| {
             let pad = [0u8; 16];
@@ -311,12 +300,9 @@ impl GeometryRenderer {
             ..Default::default()
         });
 
-        let src = |part: &str| [include_str!("../../../shaders/common.wgsl"), part].concat();
         let compute = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry cull"),
-            source: wgpu::ShaderSource::Wgsl(
-                src(include_str!("../../../shaders/geometry.wgsl")).into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(crate::passes::GEOMETRY_CULL_WGSL.concat().into()),
         });
         let draw_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry draw"),
@@ -529,32 +515,14 @@ impl GeometryRenderer {
             pass.dispatch_workgroups(self.species.div_ceil(64).max(1), 1, 1);
         }
         {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("geometry"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target.colour_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(match self.background {
-                            Background::Sky => SKY,
-                            Background::Transparent => wgpu::Color::TRANSPARENT,
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &target.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = crate::target::begin_pass(
+                &mut enc,
+                "geometry",
+                &target.colour_view,
+                &target.depth_view,
+                self.background.clear_colour(),
+                None,
+            );
             if self.background == Background::Sky {
                 pass.set_pipeline(&self.ground_pipeline);
                 pass.set_bind_group(0, &self.ground_bg, &[]);

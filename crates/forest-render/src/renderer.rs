@@ -27,6 +27,16 @@ pub enum Background {
     Transparent,
 }
 
+impl Background {
+    /// The colour a frame is cleared to.
+    pub fn clear_colour(self) -> wgpu::Color {
+        match self {
+            Background::Sky => SKY,
+            Background::Transparent => wgpu::Color::TRANSPARENT,
+        }
+    }
+}
+
 /// Options of a renderer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RendererOptions {
@@ -480,38 +490,20 @@ impl QuadStream {
                 .record(&mut pass, self.iterations, &self.bindings(), &self.scan);
         }
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("draw"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: colour,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(match self.background {
-                            Background::Sky => SKY,
-                            Background::Transparent => wgpu::Color::TRANSPARENT,
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: self.queries.as_ref().map(|(set, _, _)| {
-                    wgpu::RenderPassTimestampWrites {
+            let mut pass = crate::target::begin_pass(
+                encoder,
+                "draw",
+                colour,
+                depth,
+                self.background.clear_colour(),
+                self.queries
+                    .as_ref()
+                    .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
                         query_set: set,
                         beginning_of_pass_write_index: Some(4),
                         end_of_pass_write_index: Some(5),
-                    }
-                }),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+                    }),
+            );
             self.draw.record(
                 &mut pass,
                 &self.bg_draw,

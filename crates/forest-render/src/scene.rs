@@ -112,18 +112,7 @@ impl SceneTables {
             t.max_levels = t.max_levels.max(m.levels);
             t.quads_per_tree = t.quads_per_tree.max(3 * m.params.slabs);
         }
-        t.instances = forest
-            .instances
-            .iter()
-            .map(|i| GpuInstance {
-                position: i.position,
-                scale: i.scale,
-                cos_rot: i.rotation.cos(),
-                sin_rot: i.rotation.sin(),
-                species: i.species,
-                pad: 0,
-            })
-            .collect();
+        t.instances = gpu_instances(forest);
         t.presort_dirs = forest
             .presort
             .directions
@@ -133,6 +122,22 @@ impl SceneTables {
         t.presort = forest.presort.orders.concat();
         Ok(t)
     }
+}
+
+/// The forest's instances in their GPU form (rotation as cos/sin).
+pub fn gpu_instances(forest: &Forest) -> Vec<GpuInstance> {
+    forest
+        .instances
+        .iter()
+        .map(|i| GpuInstance {
+            position: i.position,
+            scale: i.scale,
+            cos_rot: i.rotation.cos(),
+            sin_rot: i.rotation.sin(),
+            species: i.species,
+            pad: 0,
+        })
+        .collect()
 }
 
 /// Box-filter a premultiplied sRGB RGBA8 image to half size, in linear space.

@@ -163,9 +163,30 @@ fn draw_structs_match_the_host() {
 }
 
 #[test]
+fn geometry_vertex_matches_the_host() {
+    use forest_bake::RefVertex;
+    check(
+        &forest_render::passes::GEOMETRY_DRAW_WGSL.concat(),
+        &[(
+            "GeoVertex",
+            size_of::<RefVertex>(),
+            vec![
+                ("pos", offset_of!(RefVertex, pos)),
+                ("sun_visibility", offset_of!(RefVertex, sun_visibility)),
+                ("normal", offset_of!(RefVertex, normal)),
+                ("material", offset_of!(RefVertex, material)),
+                ("uv", offset_of!(RefVertex, uv)),
+                ("pad", offset_of!(RefVertex, pad)),
+            ],
+        )],
+    );
+}
+
+#[test]
 fn shaders_validate() {
     let geometry = forest_render::passes::GEOMETRY_DRAW_WGSL.concat();
-    for src in [compute_source(), draw_source(), geometry] {
+    let geometry_cull = forest_render::passes::GEOMETRY_CULL_WGSL.concat();
+    for src in [compute_source(), draw_source(), geometry, geometry_cull] {
         let module = naga::front::wgsl::parse_str(&src).unwrap();
         naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),

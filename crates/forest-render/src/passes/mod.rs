@@ -26,10 +26,18 @@ pub const DRAW_WGSL: [&str; 3] = [
 ];
 
 /// WGSL of the full-geometry draw.
-pub const GEOMETRY_DRAW_WGSL: [&str; 3] = [
+pub const GEOMETRY_DRAW_WGSL: [&str; 4] = [
     include_str!("../../../../shaders/common.wgsl"),
+    include_str!("../../../../shaders/geometry_types.wgsl"),
     include_str!("../../../../shaders/geometry_draw.wgsl"),
     include_str!("../../../../shaders/ground.wgsl"),
+];
+
+/// WGSL of the full-geometry culling.
+pub const GEOMETRY_CULL_WGSL: [&str; 3] = [
+    include_str!("../../../../shaders/common.wgsl"),
+    include_str!("../../../../shaders/geometry_types.wgsl"),
+    include_str!("../../../../shaders/geometry.wgsl"),
 ];
 
 /// The compute module's source.
