@@ -344,36 +344,15 @@ impl GeometryRenderer {
         let compute_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry cull"),
             layout: &compute_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: inst_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: species_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: visible.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: counts.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: args.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: consts.as_entire_binding(),
-                },
-            ],
+            entries: &crate::passes::numbered(vec![
+                camera.as_entire_binding(),
+                inst_buf.as_entire_binding(),
+                species_buf.as_entire_binding(),
+                visible.as_entire_binding(),
+                counts.as_entire_binding(),
+                args.as_entire_binding(),
+                consts.as_entire_binding(),
+            ]),
         });
         let render_pipeline = |vs: &str, fs: &str, topology| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -440,40 +419,16 @@ impl GeometryRenderer {
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry draw"),
             layout: &draw.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: inst_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: vertex_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: visible.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: material_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: light_buf.as_entire_binding(),
-                },
-            ],
+            entries: &crate::passes::numbered(vec![
+                camera.as_entire_binding(),
+                inst_buf.as_entire_binding(),
+                vertex_buf.as_entire_binding(),
+                visible.as_entire_binding(),
+                material_buf.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::Sampler(&sampler),
+                light_buf.as_entire_binding(),
+            ]),
         });
         Ok(Self {
             camera,

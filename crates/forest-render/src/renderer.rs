@@ -273,14 +273,7 @@ impl QuadStream {
                 q_in.as_entire_binding(),
                 q_out.as_entire_binding(),
             ];
-            let entries: Vec<wgpu::BindGroupEntry> = res
-                .into_iter()
-                .enumerate()
-                .map(|(i, resource)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource,
-                })
-                .collect();
+            let entries = crate::passes::numbered(res.into());
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),
                 layout: &shared.bind_layout,
@@ -310,44 +303,17 @@ impl QuadStream {
         let bg_draw = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("draw"),
             layout: &draw.bind_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: scene.instances.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: scene.species.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: scene.frames.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: final_quads.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&nodes_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::TextureView(&colour_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: ground.as_entire_binding(),
-                },
-            ],
+            entries: &crate::passes::numbered(vec![
+                camera.as_entire_binding(),
+                scene.instances.as_entire_binding(),
+                scene.species.as_entire_binding(),
+                scene.frames.as_entire_binding(),
+                final_quads.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&nodes_view),
+                wgpu::BindingResource::TextureView(&colour_view),
+                wgpu::BindingResource::Sampler(&sampler),
+                ground.as_entire_binding(),
+            ]),
         });
         let owned: Vec<(&'static str, wgpu::Buffer)> = [
             ("camera", &camera),

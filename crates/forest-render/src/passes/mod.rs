@@ -85,6 +85,18 @@ pub const COMPUTE_SLOTS: [Slot; 17] = [
     Slot::ReadWrite,   // 16 quads out
 ];
 
+/// Bind-group entries numbered 0, 1, 2, … in the order given.
+pub fn numbered(resources: Vec<wgpu::BindingResource<'_>>) -> Vec<wgpu::BindGroupEntry<'_>> {
+    resources
+        .into_iter()
+        .enumerate()
+        .map(|(i, resource)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource,
+        })
+        .collect()
+}
+
 /// Layout entries for slots.
 pub fn layout_entries(
     slots: &[Slot],
