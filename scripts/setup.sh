@@ -18,10 +18,13 @@ if ! command -v cargo >/dev/null; then
   if [ -x "$HOME/.cargo/bin/cargo" ]; then
     export PATH="$HOME/.cargo/bin:$PATH"
   else
-    echo "setup: installing Rust (rustup, from Debian's packages)"
-    as_root apt-get update -qq
-    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq rustup >/dev/null
-    rustup default stable
+    echo "setup: installing Rust (rustup, from the distribution's packages)"
+    if ! { as_root apt-get update -qq \
+        && as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq rustup >/dev/null \
+        && rustup default stable; }; then
+      echo "setup: could not install Rust; install Rust 1.87 or newer with rustup (https://rustup.rs) and run again" >&2
+      exit 1
+    fi
   fi
 fi
 
