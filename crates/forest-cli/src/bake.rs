@@ -163,11 +163,12 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     bar.finish_and_clear();
 
     let disk = out.atlas.save(&args.output)?;
-    let layers = out
-        .atlas
-        .decode_layers(&args.output)
-        .context("decoding the atlas just written")?;
     if let Some(p) = &args.contact_sheet {
+        // The sheet shows what was stored (after the lossy colour codec), not the raw trace.
+        let layers = out
+            .atlas
+            .decode_layers(&args.output)
+            .context("decoding the atlas just written")?;
         forest_bake::contact_sheet::write(p, &layers, params.mosaic_columns())?;
     }
     if let Some(p) = &args.depth_exr {

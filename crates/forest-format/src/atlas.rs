@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::FormatError;
 use crate::node::{MAX_NODES, QuadNode, level_count};
-use crate::shading::{Lighting, srgb_decode, srgb_encode};
+use crate::shading::{Lighting, srgb_encode};
 use crate::slab::{DirectionFrame, Sphere};
 use crate::{directions, nodes_codec};
 
@@ -640,13 +640,13 @@ impl Atlas {
                 ));
             }
         }
-        // Largest encoded colour allowed for each alpha: srgb_encode(alpha).
+        // Largest encoded colour allowed for each alpha: srgb_encode(alpha), the encoded form
+        // of `srgb_decode(c) ≤ a`.
         let limit: [u8; 256] = std::array::from_fn(|a| {
             (srgb_encode(a as f32 / 255.0) * 255.0)
                 .floor()
                 .clamp(0.0, 255.0) as u8
         });
-        let _ = srgb_decode; // the clamp is the encoded form of `srgb_decode(c) ≤ a`
         let r = p.resolution as usize;
         let mut rgba = vec![0u8; p.layers() as usize * r * r * 4];
         for l in 0..p.layers() {

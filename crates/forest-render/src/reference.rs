@@ -2,7 +2,7 @@
 //! the same arithmetic in the same order, so the GPU's quad stream must equal it exactly.
 
 use forest_format::directions::blend;
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad};
 use crate::scene::SceneTables;
@@ -250,9 +250,4 @@ pub fn run_with(t: &SceneTables, cam: &GpuCamera, capacity: u32, iterations: u32
     }
     r.quads = quads;
     r
-}
-
-/// The disk point used by the blend (re-exported for tests).
-pub fn disk(v: Vec3) -> Vec2 {
-    forest_format::directions::disk_point(v)
 }

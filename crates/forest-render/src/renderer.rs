@@ -134,7 +134,6 @@ pub struct QuadStream {
     pub scene: GpuScene,
     /// Buffer sizes.
     pub capacity: Capacity,
-    shared: ComputeShared,
     cull: CullPass,
     scan: ScanPass,
     refine: RefinePass,
@@ -352,7 +351,6 @@ impl QuadStream {
         Ok(Self {
             scene,
             capacity,
-            shared,
             cull,
             scan,
             refine,
@@ -538,10 +536,5 @@ impl QuadStream {
             .filter(|(_, b)| b.usage().contains(wgpu::BufferUsages::COPY_DST))
             .map(|(l, _)| *l)
             .collect()
-    }
-
-    /// The shared compute layout (for inspection in tests).
-    pub fn compute_layout(&self) -> &wgpu::BindGroupLayout {
-        &self.shared.bind_layout
     }
 }

@@ -374,12 +374,12 @@ impl GpuScene {
         let bytes = data.len() as u64
             + u64::from(nodes.height()) * u64::from(NODE_TEXTURE_WIDTH) * 8
             + u64::from(presort.height()) * u64::from(PRESORT_TEXTURE_WIDTH) * 4
-            + (tables.instances.len() * 32
-                + tables.species.len() * 48
-                + tables.frames.len() * 48
-                + tables.tris.len() * 16
-                + tables.roots.len() * 4
-                + tables.presort_dirs.len() * 16) as u64;
+            + (std::mem::size_of_val(tables.instances.as_slice())
+                + std::mem::size_of_val(tables.species.as_slice())
+                + std::mem::size_of_val(tables.frames.as_slice())
+                + std::mem::size_of_val(tables.tris.as_slice())
+                + std::mem::size_of_val(tables.roots.as_slice())
+                + std::mem::size_of_val(tables.presort_dirs.as_slice())) as u64;
         Ok(Self {
             instances: storage(ctx, "instances", &tables.instances),
             species: storage(ctx, "species", &tables.species),
