@@ -1,32 +1,27 @@
-// Full geometry, the ground truth and brute-force baseline: every visible tree's triangles,
-// instanced, frustum-culled on the GPU, alpha-tested, shaded with the project's one shading
-// model (forest_format::shading) in the tree's object space — the bake's lighting rotates with
-// the tree, so the reference must too — with per-vertex sun visibility traced by the bake's
-// ray tracer. Appended after common.wgsl and geometry_types.wgsl.
-
-struct GeoSpecies {
-    sphere: vec4<f32>,
-    first_vertex: u32,
-    vertex_count: u32,
-    seg_base: u32,
-    pad: u32,
-}
+// Culling of the geometry-based methods: every instance is frustum-tested and given a draw
+// segment (distance band × species, see method_band); a count, one serial pass of offsets and
+// indirect arguments, and a scatter build the visible list segment by segment, nearest band
+// first. Appended after common.wgsl and geometry_types.wgsl.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
 @group(0) @binding(2) var<storage, read> geo_species: array<GeoSpecies>;
-@group(0) @binding(3) var<storage, read_write> visible_list: array<u32>;
+@group(0) @binding(3) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
-@group(0) @binding(5) var<storage, read_write> draw_args: array<vec4<u32>>;
-@group(0) @binding(6) var<uniform> geo_consts: vec4<u32>; // x: instances, y: species
+@group(0) @binding(5) var<storage, read_write> cursor: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> visible_list: array<u32>;
+@group(0) @binding(7) var<storage, read_write> draw_args: array<vec4<u32>>;
+@group(0) @binding(8) var<uniform> geo_consts: vec4<u32>; // x: instances, y: species
+@group(0) @binding(9) var<uniform> method: Method;
+@group(0) @binding(10) var<storage, read> leaf_end: array<u32>;
 
 @compute @workgroup_size(64)
 fn geo_reset(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x < geo_consts.y) { atomicStore(&counts[gid.x], 0u); }
+    if (gid.x < BANDS * geo_consts.y) { atomicStore(&counts[gid.x], 0u); }
 }
 
 @compute @workgroup_size(256)
-fn geo_cull(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= geo_consts.x) { return; }
     let inst = instances[i];
@@ -35,18 +30,54 @@ fn geo_cull(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = sp.sphere.w * inst.scale;
     for (var k = 0u; k < 6u; k++) {
         let pl = camera.planes[k];
-        if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) { return; }
+        if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) {
+            keys[i] = NONE;
+            return;
+        }
     }
-    let slot = atomicAdd(&counts[inst.species], 1u);
-    visible_list[sp.seg_base + slot] = i;
+    let d = distance(camera.eye.xyz, c) / inst.scale;
+    let key = method_band(method, d) * geo_consts.y + inst.species;
+    keys[i] = key;
+    atomicAdd(&counts[key], 1u);
 }
 
-// Draw arguments per species: vertex count, visible instances, first vertex, first instance
-// (the species' segment of the visible list).
-@compute @workgroup_size(64)
-fn geo_args(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let s = gid.x;
-    if (s >= geo_consts.y) { return; }
-    let sp = geo_species[s];
-    draw_args[s] = vec4<u32>(sp.vertex_count, atomicLoad(&counts[s]), sp.first_vertex, sp.seg_base);
+// One invocation: segment offsets in draw order and the indirect arguments of every segment
+// (vertex count, instances, first vertex, first instance). Billboard segments draw 6 vertices.
+@compute @workgroup_size(1)
+fn geo_args() {
+    var offset = 0u;
+    let species = geo_consts.y;
+    for (var seg = 0u; seg < BANDS * species; seg++) {
+        let band = seg / species;
+        let sp = geo_species[seg % species];
+        var count = sp.lod_count.x;
+        var first = sp.lod_first.x;
+        if (method.mode == 1u) {
+            let k = band_elements(band, sp.leaves, method.fade);
+            count = sp.branch_vertices;
+            if (k > 0u) { count = leaf_end[sp.leaf_base + k - 1u]; }
+        } else if (method.mode == 2u) {
+            let lod = band / 4u;
+            if (lod == 3u) {
+                count = 6u;
+                first = 0u;
+            } else {
+                count = sp.lod_count[lod];
+                first = sp.lod_first[lod];
+            }
+        }
+        let n = atomicLoad(&counts[seg]);
+        draw_args[seg] = vec4<u32>(count, n, first, offset);
+        atomicStore(&cursor[seg], offset);
+        offset += n;
+    }
+}
+
+@compute @workgroup_size(256)
+fn geo_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= geo_consts.x) { return; }
+    let key = keys[i];
+    if (key == NONE) { return; }
+    visible_list[atomicAdd(&cursor[key], 1u)] = i;
 }

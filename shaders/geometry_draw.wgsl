@@ -1,5 +1,12 @@
-// Drawing of the full geometry (see geometry.wgsl). Appended after common.wgsl and
+// Drawing of the geometry-based methods (see geometry.wgsl). Appended after common.wgsl and
 // geometry_types.wgsl; ground.wgsl follows.
+//
+// Meshes are shaded with the project's one shading model (forest_format::shading) in the
+// tree's object space — the bake's lighting rotates with the tree, so every method must too —
+// with per-vertex sun visibility traced by the bake's ray tracer. Under stochastic
+// simplification a leaf vertex is moved towards its leaf's centre by the fade × area factor
+// and the leaf's colour pulled towards the species' mean by √λ; at λ = 1 nothing is touched,
+// so the image is exactly the full geometry's.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -9,6 +16,10 @@
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 @group(0) @binding(6) var tex_sampler: sampler;
 @group(0) @binding(7) var<uniform> light: Light;
+@group(0) @binding(9) var<storage, read> geo_species: array<GeoSpecies>;
+@group(0) @binding(10) var<uniform> method: Method;
+@group(0) @binding(11) var<storage, read> leaf_centre: array<vec4<f32>>;
+@group(0) @binding(12) var billboards: texture_2d_array<f32>;
 
 struct GeoOut {
     @builtin(position) clip: vec4<f32>,
@@ -17,13 +28,30 @@ struct GeoOut {
     @location(2) to_eye: vec3<f32>,
     @location(3) sun_visibility: f32,
     @location(4) @interpolate(flat) material: u32,
+    // rgb: mean leaf colour; a: contrast weight α = √λ (1: untouched).
+    @location(5) @interpolate(flat) contrast: vec4<f32>,
 }
 
 @vertex
 fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> GeoOut {
     let inst = instances[visible_list[ii]];
     let v = vertices[vi];
-    let w = to_world(inst, v.pos);
+    var p = v.pos;
+    var contrast = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    if (method.mode == 1u && v.element != NONE) {
+        let sp = geo_species[inst.species];
+        let d = distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz)) / inst.scale;
+        let lambda = lod_lambda(method, d);
+        if (lambda < 1.0) {
+            let u = (f32(v.element) + 0.5) / f32(sp.leaves);
+            var k = lod_fade(u, lambda, method.fade);
+            if (method.area != 0u) { k = k * sqrt(lod_area_scale(sp.r, lambda)); }
+            let c = leaf_centre[sp.leaf_base + v.element].xyz;
+            p = c + (p - c) * k;
+            if (method.contrast != 0u) { contrast = vec4<f32>(sp.mean_leaf.rgb, sqrt(lambda)); }
+        }
+    }
+    let w = to_world(inst, p);
     var out: GeoOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.uv = v.uv;
@@ -31,6 +59,7 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     out.to_eye = to_object_dir(inst, camera.eye.xyz - w);
     out.sun_visibility = v.sun_visibility;
     out.material = v.material;
+    out.contrast = contrast;
     return out;
 }
 
@@ -50,5 +79,48 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
     let direct = max(ndl, 0.0) + m.kd.a * max(-ndl, 0.0);
     let hemi = 0.5 + 0.5 * n.y;
     let ambient = light.sky.rgb * hemi + light.ground.rgb * (1.0 - hemi);
-    return vec4<f32>(albedo * (ambient + light.sun.rgb * (in.sun_visibility * direct)), 1.0);
+    var c = albedo * (ambient + light.sun.rgb * (in.sun_visibility * direct));
+    if (in.contrast.a < 1.0) { c = in.contrast.rgb + in.contrast.a * (c - in.contrast.rgb); }
+    return vec4<f32>(c, 1.0);
+}
+
+struct BillboardOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) layer: u32,
+}
+
+// A camera-facing quad over the tree's bounding sphere showing the billboard image whose
+// elevation (0°, 30°, 60°, 90°) is nearest the view's (seed 004).
+@vertex
+fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32)
+    -> BillboardOut {
+    let inst = instances[visible_list[ii]];
+    let sp = geo_species[inst.species];
+    let c = to_world(inst, sp.sphere.xyz);
+    let r = sp.sphere.w * inst.scale;
+    let f = normalize(c - camera.eye.xyz);
+    var right = cross(f, vec3<f32>(0.0, 1.0, 0.0));
+    if (dot(right, right) < 1e-8) { right = vec3<f32>(1.0, 0.0, 0.0); }
+    right = normalize(right);
+    let up = cross(right, f);
+    // Two triangles: corners (-1,-1) (1,-1) (1,1) / (-1,-1) (1,1) (-1,1).
+    let xs = array<f32, 6>(-1.0, 1.0, 1.0, -1.0, 1.0, -1.0);
+    let ys = array<f32, 6>(-1.0, -1.0, 1.0, -1.0, 1.0, 1.0);
+    let x = xs[vi % 6u];
+    let y = ys[vi % 6u];
+    let elevation = degrees(asin(clamp(-f.y, -1.0, 1.0)));
+    let e = u32(clamp(round(elevation / 30.0), 0.0, 3.0));
+    var out: BillboardOut;
+    out.clip = camera.view_proj * vec4<f32>(c + (right * x + up * y) * r, 1.0);
+    out.uv = vec2<f32>(0.5 + 0.5 * x, 0.5 - 0.5 * y);
+    out.layer = sp.lod_first.w + e;
+    return out;
+}
+
+@fragment
+fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
+    let t = textureSample(billboards, tex_sampler, in.uv, in.layer);
+    if (t.a < 0.5) { discard; }
+    return vec4<f32>(t.rgb, 1.0);
 }

@@ -1,5 +1,8 @@
-// Types of the full-geometry renderer, shared by geometry.wgsl (cull) and geometry_draw.wgsl.
-// Host mirrors: forest_bake::RefVertex and the structs in crates/forest-render/src/geometry.rs.
+// Types and level-of-detail functions of the geometry-based methods (full geometry,
+// stochastic simplification, discrete LODs + billboards), shared by geometry.wgsl (cull) and
+// geometry_draw.wgsl. Host mirrors: forest_bake::RefVertex, forest_render::gpu_types::Geo*,
+// and the pure functions of forest_bake::lod (lambda, area_scale, fade, lambda_band,
+// band_lambda, band_elements), which the tests check against this code's results.
 
 struct GeoVertex {
     pos: vec3<f32>,
@@ -7,7 +10,9 @@ struct GeoVertex {
     normal: vec3<f32>,
     material: u32,
     uv: vec2<f32>,
-    pad: vec2<f32>,
+    // Leaf rank in the species' shuffled order; NONE for branches and LOD 1/2 vertices.
+    element: u32,
+    pad: u32,
 }
 
 struct GeoMaterial {
@@ -26,3 +31,91 @@ struct Light {
     ground: vec4<f32>,
 }
 
+struct GeoSpecies {
+    // Bounding sphere (object space): centre, radius.
+    sphere: vec4<f32>,
+    // First vertex of LOD 0, 1, 2; w: first billboard layer.
+    lod_first: vec4<u32>,
+    // Vertex counts of LOD 0, 1, 2; w: unused.
+    lod_count: vec4<u32>,
+    // Branch vertices at the start of LOD 0, leaves N, offset into leaf_end / leaf_centre.
+    branch_vertices: u32,
+    leaves: u32,
+    leaf_base: u32,
+    // r of the area-preservation factor.
+    r: f32,
+    // rgb: mean shaded leaf colour (linear) for contrast preservation.
+    mean_leaf: vec4<f32>,
+}
+
+// The method and its parameters (forest_render::geometry::MeshMethod).
+struct Method {
+    // 0: full geometry, 1: stochastic simplification, 2: discrete LODs + billboards.
+    mode: u32,
+    depth_sort: u32,
+    area: u32,
+    contrast: u32,
+    // Stochastic: d0 (m), ln ½ / ln h, fading width.
+    d0: f32,
+    exponent: f32,
+    fade: f32,
+    pad: f32,
+    // LODs: distances (m) where LOD 1, LOD 2 and billboards start.
+    lod: vec4<f32>,
+}
+
+const BANDS: u32 = 16u;
+
+fn lod_lambda(m: Method, d: f32) -> f32 {
+    if (d <= m.d0) { return 1.0; }
+    let b = (m.d0 / d) * (m.d0 / d);
+    return clamp(pow(b, m.exponent), 1e-9, 1.0);
+}
+
+fn lod_area_scale(r_in: f32, lambda: f32) -> f32 {
+    if (lambda >= 1.0) { return 1.0; }
+    let r = clamp(r_in, 1e-9, 1.0);
+    let l = max(lambda, 1e-9);
+    let s = (1.0 - pow(1.0 - r, 1.0 / l)) / r;
+    return clamp(s, 1.0, 1.0 / l);
+}
+
+fn lod_fade(u: f32, lambda: f32, width: f32) -> f32 {
+    let r = min(1.0 - lambda, width * lambda);
+    if (r <= 0.0) { return select(0.0, 1.0, u < lambda); }
+    return clamp((lambda + r - u) / (2.0 * r), 0.0, 1.0);
+}
+
+fn lambda_band(lambda: f32) -> u32 {
+    let b = floor(-2.0 * log2(max(lambda, 1e-9)));
+    return min(u32(max(b, 0.0)), BANDS - 1u);
+}
+
+fn band_lambda(k: u32) -> f32 {
+    return exp2(-f32(k) / 2.0);
+}
+
+fn band_elements(k: u32, n: u32, width: f32) -> u32 {
+    let f = min(band_lambda(k) * (1.0 + width), 1.0);
+    return min(u32(ceil(f * f32(n))), n);
+}
+
+// Distance band of depth sorting: ⌊2·log2 d⌋ for d in [1, 256) m.
+fn distance_band(d: f32) -> u32 {
+    return min(u32(max(floor(2.0 * log2(max(d, 1.0))), 0.0)), BANDS - 1u);
+}
+
+// The draw band of a tree at object-space distance d (forest_render::geometry::cpu_band).
+fn method_band(m: Method, d: f32) -> u32 {
+    if (m.mode == 1u) { return lambda_band(lod_lambda(m, d)); }
+    if (m.mode == 2u) {
+        var lod = 0u;
+        var start = 1.0;
+        for (var k = 0u; k < 3u; k++) {
+            if (d >= m.lod[k]) { lod = k + 1u; start = m.lod[k]; }
+        }
+        let sub = min(u32(max(floor(2.0 * log2(max(d / start, 1.0))), 0.0)), 3u);
+        return lod * 4u + sub;
+    }
+    return select(0u, distance_band(d), m.depth_sort != 0u);
+}

@@ -10,6 +10,7 @@
 pub mod contact_sheet;
 pub mod error;
 pub mod ldi;
+pub mod lod;
 pub mod mesh;
 pub mod quadtree;
 pub mod texture;
@@ -275,8 +276,10 @@ pub struct RefVertex {
     pub material: u32,
     /// Texture coordinates (OBJ convention).
     pub uv: [f32; 2],
+    /// Leaf rank for stochastic simplification ([`lod::NONE`] when not a leaf, or unused).
+    pub element: u32,
     /// Padding.
-    pub pad: [f32; 2],
+    pub pad: u32,
 }
 
 /// Per-vertex sun visibility for the full-geometry reference: for each triangle corner, the
@@ -316,7 +319,8 @@ pub fn reference_vertices(
                     normal: t.n[k].to_array(),
                     material: t.material,
                     uv: t.uv[k].to_array(),
-                    pad: [0.0; 2],
+                    element: lod::NONE,
+                    pad: 0,
                 }
             })
         })

@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::forest::Forest;
+use forest_render::geometry::{
+    GeometryRenderer, GeometrySpecies, Lods, MeshMethod, PreparedGeometry, Stochastic,
+};
 use forest_render::renderer::RendererOptions;
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -44,15 +47,77 @@ pub struct RenderArgs {
     #[arg(long)]
     pub transparent: bool,
     /// Rendering method: the quad stream; static impostors (the stream without refinement);
-    /// or full geometry (the reference and brute-force baseline; needs --models).
-    #[arg(long, default_value = "quads", value_parser = ["quads", "impostor", "geometry"])]
+    /// full geometry (the reference and brute-force baseline); stochastic simplification;
+    /// discrete LODs + billboards. The last three need --models.
+    #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
-    /// OBJ models of the forest's species, in its species order (for --method geometry).
+    /// OBJ models of the forest's species, in its species order (geometry-based methods).
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<PathBuf>,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1)]
     pub supersample: u32,
+}
+
+/// The `--method` values.
+pub const METHODS: [&str; 5] = ["quads", "impostor", "geometry", "stochastic", "lods"];
+
+/// Parameters of the geometry-based methods.
+#[derive(clap::Args, Debug, Clone)]
+pub struct MeshArgs {
+    /// Full geometry: draw trees in submission order instead of nearest distance band first.
+    #[arg(long)]
+    pub unsorted: bool,
+    /// Stochastic: distance (m, per unit tree scale) within which every leaf is drawn.
+    #[arg(long, default_value_t = Stochastic::default().d0)]
+    pub d0: f32,
+    /// Stochastic: the d0²/d² at which half the leaves are drawn, in (0, 1).
+    #[arg(long, default_value_t = Stochastic::default().h)]
+    pub h: f32,
+    /// Stochastic: fading band width as a fraction of λ.
+    #[arg(long, default_value_t = Stochastic::default().fade)]
+    pub fade: f32,
+    /// Stochastic: no area preservation.
+    #[arg(long)]
+    pub no_area: bool,
+    /// Stochastic: no contrast preservation.
+    #[arg(long)]
+    pub no_contrast: bool,
+    /// LODs: distances (m, per unit tree scale) where LOD 1, LOD 2 and billboards start.
+    #[arg(long, value_delimiter = ',', default_values_t = Lods::default().distances)]
+    pub lod_distances: Vec<f32>,
+}
+
+impl MeshArgs {
+    /// The geometry method `name` names (None for the quad-stream methods).
+    pub fn method(&self, name: &str) -> Result<Option<MeshMethod>> {
+        let m = match name {
+            "geometry" => MeshMethod::Full {
+                depth_sort: !self.unsorted,
+            },
+            "stochastic" => MeshMethod::Stochastic(Stochastic {
+                d0: self.d0,
+                h: self.h,
+                fade: self.fade,
+                area: !self.no_area,
+                contrast: !self.no_contrast,
+            }),
+            "lods" => {
+                let d: [f32; 3] = self.lod_distances.as_slice().try_into().map_err(|_| {
+                    anyhow::anyhow!(
+                        "--lod-distances needs three distances, got {}",
+                        self.lod_distances.len()
+                    )
+                })?;
+                MeshMethod::Lods(Lods { distances: d })
+            }
+            _ => return Ok(None),
+        };
+        m.validate()?;
+        Ok(Some(m))
+    }
 }
 
 pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -162,16 +227,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !(1..=8).contains(&args.supersample) {
         bail!("supersample = {}: must be 1 to 8", args.supersample);
     }
-    if args.method == "geometry" && args.models.len() != forest.species.len() {
+    let mesh_method = args.mesh.method(&args.method)?;
+    if mesh_method.is_some() && args.models.len() != forest.species.len() {
         bail!(
-            "--method geometry needs --models with one OBJ per species ({} given, the forest has {})",
+            "--method {} needs --models with one OBJ per species ({} given, the forest has {})",
+            args.method,
             args.models.len(),
             forest.species.len()
         );
     }
     let ctx = GpuContext::headless()?;
-    if args.method == "geometry" {
-        return render_geometry(args, &ctx, &forest, &species, &cameras);
+    if let Some(m) = mesh_method {
+        return render_geometry(args, m, &ctx, &forest, &species, &cameras);
     }
     let (sw, sh) = (
         args.size.0 * args.supersample,
@@ -194,12 +261,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let cam = &cam;
         stream.render_frame(&ctx, cam, &target)?;
         let stats = stream.read_stats(&ctx);
-        let errors = ctx.take_errors();
-        if !errors.is_empty() {
-            bail!("the GPU reported: {}", errors.join("; "));
-        }
-        let out = output_for(&args.output, name, cameras.len());
-        save(&target, &ctx, args.supersample, &out)?;
+        let out = finish_view(&ctx, &target, args, name, cameras.len())?;
         let t = stats.times.unwrap_or_default();
         if args.json {
             println!(
@@ -240,6 +302,23 @@ fn background(args: &RenderArgs) -> forest_render::renderer::Background {
     }
 }
 
+/// Fail on any GPU error, then save the view's image; returns its path.
+fn finish_view(
+    ctx: &GpuContext,
+    target: &Target,
+    args: &RenderArgs,
+    name: &str,
+    views: usize,
+) -> Result<PathBuf> {
+    let errors = ctx.take_errors();
+    if !errors.is_empty() {
+        bail!("the GPU reported: {}", errors.join("; "));
+    }
+    let out = output_for(&args.output, name, views);
+    save(target, ctx, args.supersample, &out)?;
+    Ok(out)
+}
+
 /// Read the target back, box-filter it down by `supersample`, and write a PNG atomically.
 fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Result<()> {
     let mut img = target.read(ctx);
@@ -253,17 +332,10 @@ fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Resu
     Ok(())
 }
 
-/// `--method geometry`: the full-geometry reference / brute-force baseline.
-fn render_geometry(
-    args: &RenderArgs,
-    ctx: &GpuContext,
-    forest: &Forest,
-    species: &[SpeciesData],
-    cameras: &[(String, Camera)],
-) -> Result<()> {
-    use forest_render::geometry::{GeometryRenderer, GeometrySpecies};
-    let geo_species = args
-        .models
+/// Load the species' OBJ models and prepare them for the geometry-based methods, lit as their
+/// atlases were baked.
+pub fn prepare_models(models: &[PathBuf], species: &[SpeciesData]) -> Result<PreparedGeometry> {
+    let geo_species = models
         .iter()
         .zip(species)
         .map(|(m, s)| {
@@ -273,7 +345,22 @@ fn render_geometry(
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let geo = GeometryRenderer::new(ctx, &geo_species, forest, TARGET_FORMAT, background(args))?;
+    Ok(PreparedGeometry::new(&geo_species))
+}
+
+/// The geometry-based methods: full geometry (reference / brute force), stochastic
+/// simplification, discrete LODs + billboards.
+fn render_geometry(
+    args: &RenderArgs,
+    method: MeshMethod,
+    ctx: &GpuContext,
+    forest: &Forest,
+    species: &[SpeciesData],
+    cameras: &[(String, Camera)],
+) -> Result<()> {
+    let prepared = prepare_models(&args.models, species)?;
+    let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
+    geo.set_method(ctx, method)?;
     let (sw, sh) = (
         args.size.0 * args.supersample,
         args.size.1 * args.supersample,
@@ -283,17 +370,34 @@ fn render_geometry(
         let mut cam = *cam;
         cam.viewport = (sw, sh);
         geo.render_frame(ctx, &cam, &target)?;
-        let errors = ctx.take_errors();
-        if !errors.is_empty() {
-            bail!("the GPU reported: {}", errors.join("; "));
+        let stats = geo.read_stats(ctx);
+        let out = finish_view(ctx, &target, args, name, cameras.len())?;
+        let t = stats.times.unwrap_or_default();
+        if args.json {
+            println!(
+                "{}",
+                serde_json::json!({
+                    "view": name, "output": out.display().to_string(),
+                    "adapter": ctx.adapter_info.name, "method": args.method,
+                    "visible_trees": stats.visible_trees, "triangles": stats.triangles,
+                    "billboards": stats.billboards, "per_band": stats.per_band,
+                    "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
+                })
+            );
+        } else {
+            println!(
+                "{name}: {} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms ({}) -> {}",
+                args.method,
+                args.supersample,
+                stats.visible_trees,
+                stats.triangles,
+                stats.billboards,
+                t.cull_ms,
+                t.draw_ms,
+                ctx.adapter_info.name,
+                out.display()
+            );
         }
-        let out = output_for(&args.output, name, cameras.len());
-        save(&target, ctx, args.supersample, &out)?;
-        println!(
-            "{name}: full geometry ({}x supersampled) -> {}",
-            args.supersample,
-            out.display()
-        );
     }
     Ok(())
 }

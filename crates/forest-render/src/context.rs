@@ -124,6 +124,20 @@ impl GpuContext {
         bytes
     }
 
+    /// Copy the first `size` bytes of `src` (a `COPY_SRC` buffer) back to the CPU; waits.
+    pub fn read_buffer(&self, src: &wgpu::Buffer, size: u64) -> Vec<u8> {
+        let size = size.max(4).next_multiple_of(4).min(src.size());
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        self.submit_and_read(enc, &staging)
+    }
+
     /// Whether the device can sample BC textures.
     pub fn has_bc(&self) -> bool {
         self.device

@@ -1,10 +1,20 @@
-//! Full geometry: the ground-truth reference (supersampled) and the brute-force baseline.
+//! The geometry-based methods in one renderer: full geometry (the ground-truth reference when
+//! supersampled, the brute-force baseline at 1×, optionally depth-sorted by tree as in seed
+//! 003), stochastic simplification (seeds 000/001) and discrete LODs + billboards (seed 004).
 //!
-//! Every visible tree's triangles, instanced per species, frustum-culled on the GPU (one
-//! compute pass appends visible instances into per-species segments, one writes the indirect
-//! draw arguments), alpha-tested, shaded with `forest_format::shading` in object space using
-//! per-vertex sun visibility traced by the bake (`forest_bake::reference_vertices`).
+//! ```text
+//! per species, once: reference_vertices (per-vertex sun visibility, the bake's tracer)
+//!   ─► lod::build_lods (LOD 0 = every triangle, leaves shuffled; LODs 1, 2) + billboards
+//! per frame: geo_reset ─► geo_classify (frustum, distance band) ─► geo_args (offsets,
+//!   indirect arguments per band × species) ─► geo_scatter ─► draw bands nearest first
+//! ```
+//! The method is a uniform: [`GeometryRenderer::set_method`] switches at run time without
+//! rebuilding anything. Every tree is shaded with `forest_format::shading` in its object
+//! space, as the bake shades the atlases.
 
+use std::cell::Cell;
+
+use forest_bake::lod::{BANDS, LodParams};
 use forest_bake::{Mesh, RefVertex};
 use forest_format::forest::Forest;
 use forest_format::shading::Lighting;
@@ -12,68 +22,240 @@ use wgpu::util::DeviceExt;
 
 use crate::camera::{Camera, CameraError};
 use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::GpuCamera;
+use crate::gpu_types::{GpuCamera, GpuGeoMaterial, GpuGeoSpecies, GpuLight, GpuMethod};
 use crate::passes::draw::DEPTH_FORMAT;
-use crate::renderer::Background;
+use crate::renderer::{Background, PassTimes};
 use crate::target::Target;
 
 /// Side of every material texture layer on the GPU.
 pub const MATERIAL_TEXTURE_SIZE: u32 = 512;
 const NONE: u32 = u32::MAX;
 
-/// A species for the full-geometry renderer.
+/// A species for the geometry-based methods.
 pub struct GeometrySpecies {
     /// The model.
     pub mesh: Mesh,
-    /// The lighting its atlas was baked with (so both renderers shade alike).
+    /// The lighting its atlas was baked with (so every method shades alike).
     pub lighting: Lighting,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct GeoSpecies {
-    sphere: [f32; 4],
-    first_vertex: u32,
-    vertex_count: u32,
-    seg_base: u32,
-    pad: u32,
+/// Stochastic simplification parameters (Cook et al. 2007; seeds 000/001).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stochastic {
+    /// Trees nearer than this (metres, divided by the instance scale) get every leaf.
+    pub d0: f32,
+    /// The `b = d0²/d²` at which half the leaves are drawn, in `(0, 1)`; ½ gives `λ = b`.
+    pub h: f32,
+    /// Fading band width as a fraction of λ, in `[0, 1]`.
+    pub fade: f32,
+    /// Enlarge kept leaves to preserve the visible area.
+    pub area: bool,
+    /// Pull leaf colours towards the species' mean by `√λ`.
+    pub contrast: bool,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct GeoMaterial {
-    kd: [f32; 4],
-    layer: u32,
-    alpha_tested: u32,
-    pad: [u32; 2],
+impl Default for Stochastic {
+    fn default() -> Self {
+        Self {
+            d0: 15.0,
+            h: 0.5,
+            fade: 0.1,
+            area: true,
+            contrast: true,
+        }
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct Light {
-    sun_dir: [f32; 4],
-    sun: [f32; 4],
-    sky: [f32; 4],
-    ground: [f32; 4],
+/// Discrete LOD parameters (seed 004).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lods {
+    /// Distances (metres, divided by the instance scale) where LOD 1, LOD 2 and billboards
+    /// start; strictly increasing and positive.
+    pub distances: [f32; 3],
 }
 
-/// The full-geometry renderer of one forest.
+impl Default for Lods {
+    fn default() -> Self {
+        Self {
+            distances: [15.0, 40.0, 100.0],
+        }
+    }
+}
+
+/// What the geometry renderer draws for each tree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MeshMethod {
+    /// Every tree's full model; with `depth_sort` the nearest distance bands are drawn first.
+    Full {
+        /// Draw near trees first (seed 003's tree depth sorting).
+        depth_sort: bool,
+    },
+    /// Stochastic simplification of the leaves; branches drawn whole.
+    Stochastic(Stochastic),
+    /// Three mesh LODs and camera-facing multi-elevation billboards.
+    Lods(Lods),
+}
+
+impl Default for MeshMethod {
+    fn default() -> Self {
+        MeshMethod::Full { depth_sort: true }
+    }
+}
+
+impl MeshMethod {
+    /// Check the parameters; the error names the bad one.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let bad = |s: String| Err(RenderError::Scene(s));
+        match self {
+            MeshMethod::Full { .. } => Ok(()),
+            MeshMethod::Stochastic(s) => {
+                if !(s.d0.is_finite() && s.d0 > 0.0) {
+                    return bad(format!(
+                        "stochastic d0 {} must be a positive distance",
+                        s.d0
+                    ));
+                }
+                if !(s.h > 0.0 && s.h < 1.0) {
+                    return bad(format!("stochastic h {} must be in (0, 1)", s.h));
+                }
+                if !(0.0..=1.0).contains(&s.fade) {
+                    return bad(format!(
+                        "stochastic fade width {} must be in [0, 1]",
+                        s.fade
+                    ));
+                }
+                Ok(())
+            }
+            MeshMethod::Lods(l) => {
+                let d = l.distances;
+                if !(d.iter().all(|x| x.is_finite() && *x > 0.0) && d[0] < d[1] && d[1] < d[2]) {
+                    return bad(format!(
+                        "LOD distances {d:?} must be positive and strictly increasing"
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// The GPU form.
+    pub fn to_gpu(&self) -> GpuMethod {
+        match *self {
+            MeshMethod::Full { depth_sort } => GpuMethod {
+                mode: 0,
+                depth_sort: u32::from(depth_sort),
+                ..Default::default()
+            },
+            MeshMethod::Stochastic(s) => GpuMethod {
+                mode: 1,
+                area: u32::from(s.area),
+                contrast: u32::from(s.contrast),
+                d0: s.d0,
+                exponent: 0.5f32.ln() / s.h.ln(),
+                fade: s.fade,
+                ..Default::default()
+            },
+            MeshMethod::Lods(l) => GpuMethod {
+                mode: 2,
+                lod: [l.distances[0], l.distances[1], l.distances[2], 0.0],
+                ..Default::default()
+            },
+        }
+    }
+
+    /// First band drawn as billboards (`BANDS`: none).
+    pub fn first_billboard_band(&self) -> u32 {
+        match self {
+            MeshMethod::Lods(_) => 12,
+            _ => BANDS,
+        }
+    }
+
+    /// The draw band of a tree at object-space distance `d` (CPU mirror of `method_band` in
+    /// `shaders/geometry_types.wgsl`).
+    pub fn band(&self, d: f32) -> u32 {
+        let distance_band =
+            |d: f32| ((2.0 * d.max(1.0).log2()).floor().max(0.0) as u32).min(BANDS - 1);
+        match *self {
+            MeshMethod::Full { depth_sort } => {
+                if depth_sort {
+                    distance_band(d)
+                } else {
+                    0
+                }
+            }
+            MeshMethod::Stochastic(s) => {
+                forest_bake::lod::lambda_band(forest_bake::lod::lambda(d, s.d0, s.h))
+            }
+            MeshMethod::Lods(l) => {
+                let (mut lod, mut start) = (0, 1.0);
+                for (k, &x) in l.distances.iter().enumerate() {
+                    if d >= x {
+                        lod = k as u32 + 1;
+                        start = x;
+                    }
+                }
+                let sub = ((2.0 * (d / start).max(1.0).log2()).floor().max(0.0) as u32).min(3);
+                lod * 4 + sub
+            }
+        }
+    }
+}
+
+/// Counters of the last frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GeometryStats {
+    /// Trees that passed the frustum test.
+    pub visible_trees: u32,
+    /// Visible trees per draw band.
+    pub per_band: Vec<u32>,
+    /// Triangles submitted (billboards count two).
+    pub triangles: u64,
+    /// Trees drawn as billboards.
+    pub billboards: u32,
+    /// GPU pass times (refine is 0), where the adapter has timestamp queries.
+    pub times: Option<PassTimes>,
+}
+
+/// What one species was prepared into, for reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpeciesFigures {
+    /// Triangles of LOD 0, 1, 2.
+    pub lod_triangles: [u64; 3],
+    /// Leaves (stochastic elements).
+    pub leaves: u32,
+    /// `r` of the area-preservation factor.
+    pub r: f32,
+}
+
+/// Billboard image side (texels) and samples per texel.
+pub const BILLBOARD_RESOLUTION: u32 = 256;
+const BILLBOARD_SPP: u32 = 4;
+
+/// The geometry-based renderer of one forest.
 pub struct GeometryRenderer {
     camera: wgpu::Buffer,
+    method_buf: wgpu::Buffer,
+    method: Cell<MeshMethod>,
     reset: wgpu::ComputePipeline,
-    cull: wgpu::ComputePipeline,
+    classify: wgpu::ComputePipeline,
     args_pipeline: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
     draw: wgpu::RenderPipeline,
+    billboard: wgpu::RenderPipeline,
     ground_pipeline: wgpu::RenderPipeline,
     ground_bg: wgpu::BindGroup,
     compute_bg: wgpu::BindGroup,
     draw_bg: wgpu::BindGroup,
     args: wgpu::Buffer,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     species: u32,
     instances: u32,
     background: Background,
-    /// Triangles of one copy of every species.
-    pub triangles: Vec<u64>,
+    /// Per-species figures, in the forest's species order.
+    pub figures: Vec<SpeciesFigures>,
+    /// Bytes of GPU memory the renderer allocated (buffers and textures).
+    pub gpu_bytes: u64,
 }
 
 /// Combine a material's colour and alpha sources into one RGBA image of the layer size.
@@ -110,45 +292,147 @@ fn material_layer(
     out
 }
 
-impl GeometryRenderer {
-    /// Upload the species' geometry and the forest's instances.
-    pub fn new(
-        ctx: &GpuContext,
-        species: &[GeometrySpecies],
-        forest: &Forest,
-        format: wgpu::TextureFormat,
-        background: Background,
-    ) -> Result<Self, RenderError> {
-        if species.len() != forest.species.len() {
-            return Err(RenderError::Scene(format!(
-                "the forest names {} species but {} models were given",
-                forest.species.len(),
-                species.len()
-            )));
+/// Mip chain of an RGBA8 image down to 1×1 (triangle filter), level 0 first, concatenated.
+fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
+    let mut data = Vec::new();
+    let mut m = img.clone();
+    let mips = img.width().max(img.height()).ilog2() + 1;
+    for level in 0..mips {
+        if level > 0 {
+            let (w, h) = (
+                (img.width() >> level).max(1),
+                (img.height() >> level).max(1),
+            );
+            m = image::imageops::resize(&m, w, h, image::imageops::FilterType::Triangle);
         }
-        if !ctx
-            .device
-            .features()
-            .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
-        {
-            return Err(RenderError::Scene(
-                "the full-geometry renderer needs indirect draws with a first instance \
-                 (INDIRECT_FIRST_INSTANCE), which this adapter lacks"
-                    .into(),
-            ));
-        }
-        let device = &ctx.device;
+        data.extend_from_slice(m.as_raw());
+    }
+    (data, mips)
+}
+
+/// An sRGB RGBA8 2D-array texture with mips from square layers of side `size`.
+fn layered_texture(
+    ctx: &GpuContext,
+    label: &str,
+    size: u32,
+    layers: &[image::RgbaImage],
+) -> (wgpu::TextureView, u64) {
+    let white = [image::RgbaImage::from_pixel(
+        size,
+        size,
+        image::Rgba([255; 4]),
+    )];
+    let layers = if layers.is_empty() {
+        &white[..]
+    } else {
+        layers
+    };
+    let mut data = Vec::new();
+    let mut mips = 1;
+    for img in layers {
+        let (d, m) = mip_chain(img);
+        data.extend(d);
+        mips = m;
+    }
+    let texture = ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size,
+                height: size,
+                depth_or_array_layers: layers.len() as u32,
+            },
+            mip_level_count: mips,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &data,
+    );
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    (view, data.len() as u64)
+}
+
+/// Layout entries of the draw group (bindings as in `shaders/geometry_draw.wgsl`).
+fn draw_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    use wgpu::ShaderStages as S;
+    let buffer = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let uniform = wgpu::BufferBindingType::Uniform;
+    let texture = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: S::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        },
+        count: None,
+    };
+    vec![
+        buffer(0, S::VERTEX_FRAGMENT, uniform),
+        buffer(1, S::VERTEX, read),
+        buffer(2, S::VERTEX, read),
+        buffer(3, S::VERTEX, read),
+        buffer(4, S::FRAGMENT, read),
+        texture(5),
+        wgpu::BindGroupLayoutEntry {
+            binding: 6,
+            visibility: S::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        },
+        buffer(7, S::FRAGMENT, uniform),
+        buffer(9, S::VERTEX, read),
+        buffer(10, S::VERTEX, uniform),
+        buffer(11, S::VERTEX, read),
+        texture(12),
+    ]
+}
+
+/// The CPU preparation of the species (reference vertices with traced sun visibility, LOD set,
+/// billboard images), reusable for any forest of these species.
+pub struct PreparedGeometry {
+    vertices: Vec<RefVertex>,
+    geo_species: Vec<GpuGeoSpecies>,
+    materials: Vec<GpuGeoMaterial>,
+    layers: Vec<image::RgbaImage>,
+    billboard_layers: Vec<image::RgbaImage>,
+    leaf_end: Vec<u32>,
+    leaf_centre: Vec<[f32; 4]>,
+    /// Per-species figures.
+    pub figures: Vec<SpeciesFigures>,
+    lighting: Lighting,
+}
+
+impl PreparedGeometry {
+    /// Prepare every species (seconds per species: the sun-visibility and billboard rays).
+    pub fn new(species: &[GeometrySpecies]) -> Self {
         let mut vertices: Vec<RefVertex> = Vec::new();
         let mut geo_species = Vec::new();
         let mut materials = Vec::new();
         let mut layers: Vec<image::RgbaImage> = Vec::new();
-        let mut triangles = Vec::new();
-        let mut per_species = vec![0u32; species.len()];
-        for i in &forest.instances {
-            per_species[i.species as usize] += 1;
-        }
-        let mut seg = 0u32;
-        for (k, s) in species.iter().enumerate() {
+        let mut billboard_layers: Vec<image::RgbaImage> = Vec::new();
+        let mut leaf_end: Vec<u32> = Vec::new();
+        let mut leaf_centre: Vec<[f32; 4]> = Vec::new();
+        let mut figures = Vec::new();
+        for s in species {
             let material_base = materials.len() as u32;
             for m in &s.mesh.materials {
                 let layer = if m.colour.is_some() || m.alpha.is_some() {
@@ -157,53 +441,169 @@ impl GeometryRenderer {
                 } else {
                     NONE
                 };
-                materials.push(GeoMaterial {
+                materials.push(GpuGeoMaterial {
                     kd: m.kd.extend(m.translucency).to_array(),
                     layer,
                     alpha_tested: u32::from(m.alpha.is_some()),
                     pad: [0; 2],
                 });
             }
-            let mut v = forest_bake::reference_vertices(&s.mesh, &s.lighting);
-            v.iter_mut().for_each(|x| x.material += material_base);
+            let reference = forest_bake::reference_vertices(&s.mesh, &s.lighting);
+            let leaf: Vec<bool> = reference
+                .chunks_exact(3)
+                .map(|t| s.mesh.materials[t[0].material as usize].alpha.is_some())
+                .collect();
+            let set = forest_bake::lod::build_lods(&reference, &leaf, &LodParams::default());
+            let mean = forest_bake::lod::mean_leaf_colour(&s.mesh, &set.lod0, &s.lighting);
             let sphere = forest_bake::bounding_sphere(&s.mesh);
-            geo_species.push(GeoSpecies {
+            let first = vertices.len() as u32;
+            let counts = [
+                set.lod0.len() as u32,
+                set.lods[0].len() as u32,
+                set.lods[1].len() as u32,
+            ];
+            geo_species.push(GpuGeoSpecies {
                 sphere: sphere.center.extend(sphere.radius).to_array(),
-                first_vertex: vertices.len() as u32,
-                vertex_count: v.len() as u32,
-                seg_base: seg,
-                pad: 0,
+                lod_first: [
+                    first,
+                    first + counts[0],
+                    first + counts[0] + counts[1],
+                    billboard_layers.len() as u32,
+                ],
+                lod_count: [counts[0], counts[1], counts[2], 6],
+                branch_vertices: set.branch_vertices,
+                leaves: set.leaf_end.len() as u32,
+                leaf_base: leaf_end.len() as u32,
+                r: set.r,
+                mean_leaf: mean.extend(0.0).to_array(),
             });
-            triangles.push(v.len() as u64 / 3);
-            seg += per_species[k];
-            vertices.extend(v);
+            figures.push(SpeciesFigures {
+                lod_triangles: counts.map(|c| u64::from(c) / 3),
+                leaves: set.leaf_end.len() as u32,
+                r: set.r,
+            });
+            leaf_end.extend(&set.leaf_end);
+            leaf_centre.extend(set.leaf_centre.iter().map(|c| c.extend(0.0).to_array()));
+            billboard_layers.extend(forest_bake::lod::billboard_images(
+                &s.mesh,
+                &s.lighting,
+                BILLBOARD_RESOLUTION,
+                BILLBOARD_SPP,
+            ));
+            for v in set.lod0.iter().chain(&set.lods[0]).chain(&set.lods[1]) {
+                vertices.push(RefVertex {
+                    material: v.material + material_base,
+                    ..*v
+                });
+            }
         }
-        let l = species
+        let lighting = species
             .first()
             .map(|s| s.lighting)
             .unwrap_or(Lighting::with_sun(30.0, 55.0));
-        let light = Light {
+        Self {
+            vertices,
+            geo_species,
+            materials,
+            layers,
+            billboard_layers,
+            leaf_end,
+            leaf_centre,
+            figures,
+            lighting,
+        }
+    }
+
+    /// Bytes of the model data uploaded for all species: vertices, tables, material and
+    /// billboard textures with mips (what the geometry methods store per species, not per tree).
+    pub fn model_bytes(&self) -> u64 {
+        let tex = |layers: &[image::RgbaImage]| -> u64 {
+            layers.iter().map(|l| l.as_raw().len() as u64 * 4 / 3).sum()
+        };
+        (std::mem::size_of_val(&self.vertices[..])
+            + std::mem::size_of_val(&self.geo_species[..])
+            + std::mem::size_of_val(&self.materials[..])
+            + std::mem::size_of_val(&self.leaf_end[..])
+            + std::mem::size_of_val(&self.leaf_centre[..])) as u64
+            + tex(&self.layers)
+            + tex(&self.billboard_layers)
+    }
+}
+
+impl GeometryRenderer {
+    /// Upload prepared species with the forest's instances (their species order must match).
+    /// The method starts as [`MeshMethod::default`].
+    pub fn new(
+        ctx: &GpuContext,
+        prepared: &PreparedGeometry,
+        forest: &Forest,
+        format: wgpu::TextureFormat,
+        background: Background,
+    ) -> Result<Self, RenderError> {
+        let PreparedGeometry {
+            vertices,
+            geo_species,
+            materials,
+            layers,
+            billboard_layers,
+            leaf_end,
+            leaf_centre,
+            figures,
+            lighting: l,
+        } = prepared;
+        let l = *l;
+        if geo_species.len() != forest.species.len() {
+            return Err(RenderError::Scene(format!(
+                "the forest names {} species but {} models were given",
+                forest.species.len(),
+                geo_species.len()
+            )));
+        }
+        if !ctx
+            .device
+            .features()
+            .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
+        {
+            return Err(RenderError::Scene(
+                "the geometry renderer needs indirect draws with a first instance \
+                 (INDIRECT_FIRST_INSTANCE), which this adapter lacks"
+                    .into(),
+            ));
+        }
+        let device = &ctx.device;
+        let light = GpuLight {
             sun_dir: l.sun_dir.extend(0.0).to_array(),
             sun: l.sun.extend(0.0).to_array(),
             sky: l.sky.extend(0.0).to_array(),
             ground: l.ground.extend(0.0).to_array(),
         };
         let instances = crate::scene::gpu_instances(forest);
+        let segments = (BANDS as usize * geo_species.len()).max(1);
+        let gpu_bytes = Cell::new(0u64);
         use wgpu::BufferUsages as U;
         let init = |label: &str, bytes: &[u8], usage: U| {
-            let pad = [0u8; 16];
+            // Empty tables still bind one element of any of their types.
+            let pad = [0u8; 256];
+            let contents = if bytes.is_empty() { &pad[..] } else { bytes };
+            gpu_bytes.set(gpu_bytes.get() + contents.len() as u64);
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
-                contents: if bytes.is_empty() { &pad } else { bytes },
+                contents,
                 usage,
             })
         };
-        let camera = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("geometry camera"),
-            size: std::mem::size_of::<GpuCamera>() as u64,
-            usage: U::UNIFORM | U::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let zeros = |label: &str, bytes: usize, usage: U| init(label, &vec![0u8; bytes], usage);
+        let camera = zeros(
+            "geometry camera",
+            std::mem::size_of::<GpuCamera>(),
+            U::UNIFORM | U::COPY_DST,
+        );
+        let method = MeshMethod::default();
+        let method_buf = init(
+            "geometry method",
+            bytemuck::bytes_of(&method.to_gpu()),
+            U::UNIFORM | U::COPY_DST,
+        );
         let inst_buf = init(
             "geometry instances",
             bytemuck::cast_slice(&instances),
@@ -211,85 +611,46 @@ impl GeometryRenderer {
         );
         let species_buf = init(
             "geometry species",
-            bytemuck::cast_slice(&geo_species),
+            bytemuck::cast_slice(geo_species),
             U::STORAGE,
         );
         let vertex_buf = init(
             "geometry vertices",
-            bytemuck::cast_slice(&vertices),
+            bytemuck::cast_slice(vertices),
             U::STORAGE,
         );
         let material_buf = init(
             "geometry materials",
-            bytemuck::cast_slice(&materials),
+            bytemuck::cast_slice(materials),
+            U::STORAGE,
+        );
+        let leaf_end_buf = init("leaf ends", bytemuck::cast_slice(leaf_end), U::STORAGE);
+        let leaf_centre_buf = init(
+            "leaf centres",
+            bytemuck::cast_slice(leaf_centre),
             U::STORAGE,
         );
         let light_buf = init("geometry light", bytemuck::bytes_of(&light), U::UNIFORM);
         let consts = init(
             "geometry constants",
-            bytemuck::cast_slice(&[instances.len() as u32, species.len() as u32, 0, 0]),
+            bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
             U::UNIFORM,
         );
-        let visible = init(
-            "visible instances",
-            &vec![0u8; instances.len().max(1) * 4],
-            U::STORAGE,
-        );
-        let counts = init(
-            "visible counts",
-            &vec![0u8; species.len().max(1) * 4],
-            U::STORAGE,
-        );
-        let args = init(
+        let keys = zeros("segment keys", instances.len().max(1) * 4, U::STORAGE);
+        let counts = zeros("segment counts", segments * 4, U::STORAGE | U::COPY_SRC);
+        let cursor = zeros("segment cursors", segments * 4, U::STORAGE);
+        let visible = zeros("visible instances", instances.len().max(1) * 4, U::STORAGE);
+        let args = zeros(
             "geometry draw args",
-            &vec![0u8; species.len().max(1) * 16],
-            U::STORAGE | U::INDIRECT,
+            segments * 16,
+            U::STORAGE | U::INDIRECT | U::COPY_SRC,
         );
 
-        // Material textures: one array layer per textured material, with mips.
-        let mips = MATERIAL_TEXTURE_SIZE.trailing_zeros() + 1;
-        let layer_count = layers.len().max(1) as u32;
-        let mut data = Vec::new();
-        if layers.is_empty() {
-            layers.push(image::RgbaImage::from_pixel(
-                MATERIAL_TEXTURE_SIZE,
-                MATERIAL_TEXTURE_SIZE,
-                image::Rgba([255; 4]),
-            ));
-        }
-        for img in &layers {
-            let mut m = img.clone();
-            for level in 0..mips {
-                if level > 0 {
-                    let s = (MATERIAL_TEXTURE_SIZE >> level).max(1);
-                    m = image::imageops::resize(&m, s, s, image::imageops::FilterType::Triangle);
-                }
-                data.extend_from_slice(m.as_raw());
-            }
-        }
-        let texture = device.create_texture_with_data(
-            &ctx.queue,
-            &wgpu::TextureDescriptor {
-                label: Some("material textures"),
-                size: wgpu::Extent3d {
-                    width: MATERIAL_TEXTURE_SIZE,
-                    height: MATERIAL_TEXTURE_SIZE,
-                    depth_or_array_layers: layer_count,
-                },
-                mip_level_count: mips,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            &data,
-        );
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let (material_view, material_bytes) =
+            layered_texture(ctx, "material textures", MATERIAL_TEXTURE_SIZE, layers);
+        let (billboard_view, billboard_bytes) =
+            layered_texture(ctx, "billboards", BILLBOARD_RESOLUTION, billboard_layers);
+        gpu_bytes.set(gpu_bytes.get() + material_bytes + billboard_bytes);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("material"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -308,16 +669,21 @@ impl GeometryRenderer {
             label: Some("geometry draw"),
             source: wgpu::ShaderSource::Wgsl(crate::passes::GEOMETRY_DRAW_WGSL.concat().into()),
         });
-        // One explicit layout shared by the three compute entry points (one bind group).
-        let entries: Vec<wgpu::BindGroupLayoutEntry> = crate::passes::layout_entries(
+        // One explicit layout shared by the four compute entry points (one bind group).
+        use crate::passes::Slot;
+        let entries = crate::passes::layout_entries(
             &[
-                crate::passes::Slot::Uniform,
-                crate::passes::Slot::Read,
-                crate::passes::Slot::Read,
-                crate::passes::Slot::ReadWrite,
-                crate::passes::Slot::ReadWrite,
-                crate::passes::Slot::ReadWrite,
-                crate::passes::Slot::Uniform,
+                Slot::Uniform,   // 0 camera
+                Slot::Read,      // 1 instances
+                Slot::Read,      // 2 species
+                Slot::ReadWrite, // 3 keys
+                Slot::ReadWrite, // 4 counts
+                Slot::ReadWrite, // 5 cursors
+                Slot::ReadWrite, // 6 visible
+                Slot::ReadWrite, // 7 args
+                Slot::Uniform,   // 8 constants
+                Slot::Uniform,   // 9 method
+                Slot::Read,      // 10 leaf ends
             ],
             wgpu::ShaderStages::COMPUTE,
         );
@@ -340,7 +706,6 @@ impl GeometryRenderer {
                 cache: None,
             })
         };
-        let (reset, cull, args_pipeline) = (cpl("geo_reset"), cpl("geo_cull"), cpl("geo_args"));
         let compute_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry cull"),
             layout: &compute_layout,
@@ -348,55 +713,72 @@ impl GeometryRenderer {
                 camera.as_entire_binding(),
                 inst_buf.as_entire_binding(),
                 species_buf.as_entire_binding(),
-                visible.as_entire_binding(),
+                keys.as_entire_binding(),
                 counts.as_entire_binding(),
+                cursor.as_entire_binding(),
+                visible.as_entire_binding(),
                 args.as_entire_binding(),
                 consts.as_entire_binding(),
+                method_buf.as_entire_binding(),
+                leaf_end_buf.as_entire_binding(),
             ]),
         });
-        let render_pipeline = |vs: &str, fs: &str, topology| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(vs),
-                layout: None,
-                vertex: wgpu::VertexState {
-                    module: &draw_module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &draw_module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let draw = render_pipeline("vs_geo", "fs_geo", wgpu::PrimitiveTopology::TriangleList);
-        let ground_pipeline = render_pipeline(
-            "vs_ground",
-            "fs_ground",
-            wgpu::PrimitiveTopology::TriangleStrip,
+        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("geometry draw"),
+            entries: &draw_layout_entries(),
+        });
+        let draw_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("geometry draw"),
+            bind_group_layouts: &[Some(&draw_layout)],
+            immediate_size: 0,
+        });
+        let render_pipeline =
+            |vs: &str, fs: &str, topology, layout: Option<&wgpu::PipelineLayout>| {
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(vs),
+                    layout,
+                    vertex: wgpu::VertexState {
+                        module: &draw_module,
+                        entry_point: Some(vs),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology,
+                        cull_mode: None,
+                        ..Default::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &draw_module,
+                        entry_point: Some(fs),
+                        compilation_options: Default::default(),
+                        targets: &[Some(wgpu::ColorTargetState {
+                            format,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            };
+        use wgpu::PrimitiveTopology as T;
+        let draw = render_pipeline("vs_geo", "fs_geo", T::TriangleList, Some(&draw_pl));
+        let billboard = render_pipeline(
+            "vs_billboard",
+            "fs_billboard",
+            T::TriangleList,
+            Some(&draw_pl),
         );
+        let ground_pipeline = render_pipeline("vs_ground", "fs_ground", T::TriangleStrip, None);
         let ground_buf = init(
             "geometry ground",
             bytemuck::bytes_of(&crate::renderer::ground_uniform(&l, &instances)),
@@ -416,81 +798,210 @@ impl GeometryRenderer {
                 },
             ],
         });
+        let resources = vec![
+            (0, camera.as_entire_binding()),
+            (1, inst_buf.as_entire_binding()),
+            (2, vertex_buf.as_entire_binding()),
+            (3, visible.as_entire_binding()),
+            (4, material_buf.as_entire_binding()),
+            (5, wgpu::BindingResource::TextureView(&material_view)),
+            (6, wgpu::BindingResource::Sampler(&sampler)),
+            (7, light_buf.as_entire_binding()),
+            (9, species_buf.as_entire_binding()),
+            (10, method_buf.as_entire_binding()),
+            (11, leaf_centre_buf.as_entire_binding()),
+            (12, wgpu::BindingResource::TextureView(&billboard_view)),
+        ];
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry draw"),
-            layout: &draw.get_bind_group_layout(0),
-            entries: &crate::passes::numbered(vec![
-                camera.as_entire_binding(),
-                inst_buf.as_entire_binding(),
-                vertex_buf.as_entire_binding(),
-                visible.as_entire_binding(),
-                material_buf.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
-                wgpu::BindingResource::Sampler(&sampler),
-                light_buf.as_entire_binding(),
-            ]),
+            layout: &draw_layout,
+            entries: &resources
+                .into_iter()
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+                .collect::<Vec<_>>(),
         });
+        let queries = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| {
+                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("geometry pass times"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 4,
+                });
+                let resolve = zeros("geometry timestamps", 32, U::QUERY_RESOLVE | U::COPY_SRC);
+                (set, resolve, f64::from(ctx.queue.get_timestamp_period()))
+            });
         Ok(Self {
             camera,
-            reset,
-            cull,
-            args_pipeline,
+            method_buf,
+            method: Cell::new(method),
+            reset: cpl("geo_reset"),
+            classify: cpl("geo_classify"),
+            args_pipeline: cpl("geo_args"),
+            scatter: cpl("geo_scatter"),
             draw,
+            billboard,
             ground_pipeline,
             ground_bg,
             compute_bg,
             draw_bg,
             args,
-            species: species.len() as u32,
+            queries,
+            species: geo_species.len() as u32,
             instances: instances.len() as u32,
             background,
-            triangles,
+            figures: figures.clone(),
+            gpu_bytes: gpu_bytes.get(),
         })
     }
 
-    /// Write the camera, cull, draw into `target`, and submit.
-    pub fn render_frame(
+    /// Switch the method (a uniform write; nothing is rebuilt).
+    pub fn set_method(&self, ctx: &GpuContext, method: MeshMethod) -> Result<(), RenderError> {
+        method.validate()?;
+        ctx.queue
+            .write_buffer(&self.method_buf, 0, bytemuck::bytes_of(&method.to_gpu()));
+        self.method.set(method);
+        Ok(())
+    }
+
+    /// The current method.
+    pub fn method(&self) -> MeshMethod {
+        self.method.get()
+    }
+
+    /// Write the camera and record the frame: classify, arguments, scatter, then draw the
+    /// bands nearest first into `colour` and `depth`.
+    pub fn encode(
         &self,
         ctx: &GpuContext,
         camera: &Camera,
-        target: &Target,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
     ) -> Result<(), CameraError> {
         camera.validate()?;
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera.to_gpu()));
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let ts = |b: u32| {
+            self.queries
+                .as_ref()
+                .map(|(set, _, _)| (set, Some(b), Some(b + 1)))
+        };
         {
-            let mut pass = enc.begin_compute_pass(&Default::default());
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("geometry cull"),
+                timestamp_writes: ts(0).map(|(query_set, b, e)| wgpu::ComputePassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: b,
+                    end_of_pass_write_index: e,
+                }),
+            });
             pass.set_bind_group(0, &self.compute_bg, &[]);
+            let segments = BANDS * self.species;
             pass.set_pipeline(&self.reset);
-            pass.dispatch_workgroups(self.species.div_ceil(64).max(1), 1, 1);
-            pass.set_pipeline(&self.cull);
+            pass.dispatch_workgroups(segments.div_ceil(64).max(1), 1, 1);
+            pass.set_pipeline(&self.classify);
             pass.dispatch_workgroups(self.instances.div_ceil(256).max(1), 1, 1);
             pass.set_pipeline(&self.args_pipeline);
-            pass.dispatch_workgroups(self.species.div_ceil(64).max(1), 1, 1);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.scatter);
+            pass.dispatch_workgroups(self.instances.div_ceil(256).max(1), 1, 1);
         }
         {
             let mut pass = crate::target::begin_pass(
-                &mut enc,
-                "geometry",
-                &target.colour_view,
-                &target.depth_view,
+                encoder,
+                "geometry draw",
+                colour,
+                depth,
                 self.background.clear_colour(),
-                None,
+                ts(2).map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: b,
+                    end_of_pass_write_index: e,
+                }),
             );
             if self.background == Background::Sky {
                 pass.set_pipeline(&self.ground_pipeline);
                 pass.set_bind_group(0, &self.ground_bg, &[]);
                 pass.draw(0..4, 0..1);
             }
-            pass.set_pipeline(&self.draw);
             pass.set_bind_group(0, &self.draw_bg, &[]);
-            for s in 0..self.species {
-                pass.draw_indirect(&self.args, u64::from(s) * 16);
+            let first_billboard = self.method.get().first_billboard_band();
+            for band in 0..BANDS {
+                if band == 0 {
+                    pass.set_pipeline(&self.draw);
+                }
+                if band == first_billboard {
+                    pass.set_pipeline(&self.billboard);
+                }
+                for s in 0..self.species {
+                    pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);
+                }
             }
         }
+        if let Some((set, resolve, _)) = &self.queries {
+            encoder.resolve_query_set(set, 0..4, resolve, 0);
+        }
+        Ok(())
+    }
+
+    /// Write the camera, record the frame into `target`, and submit.
+    pub fn render_frame(
+        &self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        target: &Target,
+    ) -> Result<(), CameraError> {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        self.encode(
+            ctx,
+            camera,
+            &mut enc,
+            &target.colour_view,
+            &target.depth_view,
+        )?;
         ctx.queue.submit([enc.finish()]);
         Ok(())
+    }
+
+    /// Visible trees per segment (`band · species + s`) of the last submitted frame; waits.
+    pub fn read_segment_counts(&self, ctx: &GpuContext) -> Vec<u32> {
+        let n = (BANDS * self.species) as usize;
+        let args: Vec<[u32; 4]> =
+            bytemuck::pod_collect_to_vec(&ctx.read_buffer(&self.args, (n * 16) as u64)[..n * 16]);
+        args.iter().map(|a| a[1]).collect()
+    }
+
+    /// Counters and pass times of the last submitted frame; waits for the GPU.
+    pub fn read_stats(&self, ctx: &GpuContext) -> GeometryStats {
+        let n = (BANDS * self.species) as usize;
+        let args: Vec<[u32; 4]> =
+            bytemuck::pod_collect_to_vec(&ctx.read_buffer(&self.args, (n * 16) as u64)[..n * 16]);
+        let first_billboard = self.method.get().first_billboard_band();
+        let mut stats = GeometryStats {
+            per_band: vec![0; BANDS as usize],
+            ..Default::default()
+        };
+        for (seg, a) in args.iter().enumerate() {
+            let band = seg as u32 / self.species.max(1);
+            stats.visible_trees += a[1];
+            stats.per_band[band as usize] += a[1];
+            stats.triangles += u64::from(a[0] / 3) * u64::from(a[1]);
+            if band >= first_billboard {
+                stats.billboards += a[1];
+            }
+        }
+        stats.times = self.queries.as_ref().map(|(_, resolve, period)| {
+            let t: Vec<u64> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(resolve, 32));
+            let ms = |a: usize| t[a + 1].saturating_sub(t[a]) as f64 * period / 1e6;
+            PassTimes {
+                cull_ms: ms(0),
+                refine_ms: 0.0,
+                draw_ms: ms(2),
+            }
+        });
+        stats
     }
 }
 

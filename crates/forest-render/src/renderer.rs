@@ -480,29 +480,14 @@ impl QuadStream {
         }
     }
 
-    fn read_buffer(&self, ctx: &GpuContext, src: &wgpu::Buffer, size: u64) -> Vec<u8> {
-        let size = size.max(4).next_multiple_of(4);
-        let staging = buffer(
-            ctx,
-            "readback",
-            size,
-            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        );
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
-        ctx.submit_and_read(enc, &staging)
-    }
-
     /// Counters (and pass times) of the last submitted frame; waits for the GPU.
     pub fn read_stats(&self, ctx: &GpuContext) -> FrameStats {
-        let s: GpuState = bytemuck::pod_read_unaligned(&self.read_buffer(
-            ctx,
-            &self.state,
-            std::mem::size_of::<GpuState>() as u64,
-        ));
+        let s: GpuState = bytemuck::pod_read_unaligned(
+            &ctx.read_buffer(&self.state, std::mem::size_of::<GpuState>() as u64),
+        );
         let levels = self.scene.tables.max_levels.max(1) as usize;
         let times = self.queries.as_ref().map(|(_, resolve, period)| {
-            let t: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read_buffer(ctx, resolve, 48));
+            let t: Vec<u64> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(resolve, 48));
             let ms = |a: usize| t[a + 1].saturating_sub(t[a]) as f64 * period / 1e6;
             PassTimes {
                 cull_ms: ms(0),
@@ -525,7 +510,7 @@ impl QuadStream {
     pub fn read_quads(&self, ctx: &GpuContext) -> Vec<Quad> {
         let n = self.read_stats(ctx).quads as usize;
         let buf = &self.quads[(self.iterations % 2) as usize];
-        let bytes = self.read_buffer(ctx, buf, (n * std::mem::size_of::<Quad>()) as u64);
+        let bytes = ctx.read_buffer(buf, (n * std::mem::size_of::<Quad>()) as u64);
         bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<Quad>()])
     }
 

@@ -2,7 +2,7 @@
 
 mod common;
 
-use forest_render::geometry::{GeometryRenderer, GeometrySpecies, downsample};
+use forest_render::geometry::{GeometryRenderer, downsample};
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{GpuScene, QuadStream};
@@ -11,26 +11,15 @@ use forest_render::{GpuScene, QuadStream};
 fn quad_stream_resembles_the_supersampled_full_geometry() {
     let ctx = common::ctx();
     let forest = common::forest(300);
-    let species: Vec<GeometrySpecies> = ["bush", "pine"]
-        .iter()
-        .zip(common::atlases())
-        .map(|(s, a)| GeometrySpecies {
-            mesh: forest_bake::Mesh::load(
-                &common::root().join(format!("assets/trees/{s}/{s}.obj")),
-            )
-            .unwrap(),
-            lighting: a.manifest.lighting,
-        })
-        .collect();
     let geo = GeometryRenderer::new(
         &ctx,
-        &species,
+        common::prepared(),
         &forest,
         TARGET_FORMAT,
         Background::Transparent,
     )
     .unwrap();
-    assert_eq!(geo.triangles.len(), 2);
+    assert_eq!(geo.figures.len(), 2);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
     let opts = RendererOptions {
         viewport: (160, 120),

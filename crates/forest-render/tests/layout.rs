@@ -163,11 +163,10 @@ fn draw_structs_match_the_host() {
 }
 
 #[test]
-fn geometry_vertex_matches_the_host() {
+fn geometry_structs_match_the_host() {
     use forest_bake::RefVertex;
-    check(
-        &forest_render::passes::GEOMETRY_DRAW_WGSL.concat(),
-        &[(
+    let expected: Vec<Expect> = vec![
+        (
             "GeoVertex",
             size_of::<RefVertex>(),
             vec![
@@ -176,9 +175,70 @@ fn geometry_vertex_matches_the_host() {
                 ("normal", offset_of!(RefVertex, normal)),
                 ("material", offset_of!(RefVertex, material)),
                 ("uv", offset_of!(RefVertex, uv)),
+                ("element", offset_of!(RefVertex, element)),
                 ("pad", offset_of!(RefVertex, pad)),
             ],
-        )],
+        ),
+        (
+            "GeoSpecies",
+            size_of::<GpuGeoSpecies>(),
+            vec![
+                ("sphere", offset_of!(GpuGeoSpecies, sphere)),
+                ("lod_first", offset_of!(GpuGeoSpecies, lod_first)),
+                ("lod_count", offset_of!(GpuGeoSpecies, lod_count)),
+                (
+                    "branch_vertices",
+                    offset_of!(GpuGeoSpecies, branch_vertices),
+                ),
+                ("leaves", offset_of!(GpuGeoSpecies, leaves)),
+                ("leaf_base", offset_of!(GpuGeoSpecies, leaf_base)),
+                ("r", offset_of!(GpuGeoSpecies, r)),
+                ("mean_leaf", offset_of!(GpuGeoSpecies, mean_leaf)),
+            ],
+        ),
+        (
+            "Method",
+            size_of::<GpuMethod>(),
+            vec![
+                ("mode", offset_of!(GpuMethod, mode)),
+                ("depth_sort", offset_of!(GpuMethod, depth_sort)),
+                ("area", offset_of!(GpuMethod, area)),
+                ("contrast", offset_of!(GpuMethod, contrast)),
+                ("d0", offset_of!(GpuMethod, d0)),
+                ("exponent", offset_of!(GpuMethod, exponent)),
+                ("fade", offset_of!(GpuMethod, fade)),
+                ("pad", offset_of!(GpuMethod, pad)),
+                ("lod", offset_of!(GpuMethod, lod)),
+            ],
+        ),
+        (
+            "GeoMaterial",
+            size_of::<GpuGeoMaterial>(),
+            vec![
+                ("kd", offset_of!(GpuGeoMaterial, kd)),
+                ("layer", offset_of!(GpuGeoMaterial, layer)),
+                ("alpha_tested", offset_of!(GpuGeoMaterial, alpha_tested)),
+                ("pad", offset_of!(GpuGeoMaterial, pad)),
+            ],
+        ),
+        (
+            "Light",
+            size_of::<GpuLight>(),
+            vec![
+                ("sun_dir", offset_of!(GpuLight, sun_dir)),
+                ("sun", offset_of!(GpuLight, sun)),
+                ("sky", offset_of!(GpuLight, sky)),
+                ("ground", offset_of!(GpuLight, ground)),
+            ],
+        ),
+    ];
+    check(
+        &forest_render::passes::GEOMETRY_DRAW_WGSL.concat(),
+        &expected,
+    );
+    check(
+        &forest_render::passes::GEOMETRY_CULL_WGSL.concat(),
+        &expected[1..3],
     );
 }
 
