@@ -282,15 +282,16 @@ pub struct RefVertex {
     pub pad: u32,
 }
 
-/// Per-vertex sun visibility for the full-geometry reference: for each triangle corner, the
-/// mean of alpha-tested shadow rays from `SUN_SAMPLES` points of the triangle near that
-/// corner (barycentric weight 0.7 on the corner), so that the interpolated visibility follows
-/// the same shadows the bake traces per pixel. Non-indexed: three vertices per triangle.
+/// Per-vertex sun visibility for the full-geometry reference. Each triangle traces alpha-tested
+/// shadow rays from `SUN_SAMPLES` stratified points; points on transparent texels are skipped
+/// (the bake never shades them), and each corner gets the mean of the others weighted by its
+/// barycentric coordinate, so the interpolated visibility follows the shadows the bake traces
+/// per pixel. Non-indexed: three vertices per triangle.
 pub fn reference_vertices(
     mesh: &Mesh,
     lighting: &forest_format::shading::Lighting,
 ) -> Vec<RefVertex> {
-    const SUN_SAMPLES: u32 = 4;
+    const SIDE: u32 = 4;
     let scene = trace::Scene::new(mesh);
     let eps = bounding_sphere(mesh).radius * 1e-5;
     let sun = lighting.sun_dir;
@@ -301,21 +302,37 @@ pub fn reference_vertices(
         .flat_map_iter(|(ti, t)| {
             let geo = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalize_or_zero();
             let side = if geo.dot(sun) >= 0.0 { geo } else { -geo };
-            let scene = &scene;
-            (0..3).map(move |k| {
-                let mut lit = 0u32;
-                for s in 0..SUN_SAMPLES {
-                    // Points around the corner: weights (0.7, 0.15, 0.15) jittered a little.
-                    let j = 0.1 * (s as f32 / SUN_SAMPLES as f32 - 0.4);
-                    let w = [0.7 - j, 0.15 + j, 0.15];
-                    let p = t.p[k] * w[0] + t.p[(k + 1) % 3] * w[1] + t.p[(k + 2) % 3] * w[2];
-                    if !scene.occluded(p + side * eps, sun, eps, f32::INFINITY, ti as u32) {
-                        lit += 1;
+            let tested = mesh.materials[t.material as usize].alpha.is_some();
+            // Stratified points on the triangle (square → triangle warp), corner-weighted sums.
+            let (mut lit, mut weight) = ([0f32; 3], [0f32; 3]);
+            let (mut lit_all, mut weight_all) = ([0f32; 3], [0f32; 3]);
+            for s in 0..SIDE * SIDE {
+                let u = ((s % SIDE) as f32 + 0.5) / SIDE as f32;
+                let v = ((s / SIDE) as f32 + 0.5) / SIDE as f32;
+                let r = u.sqrt();
+                let b = [1.0 - r, r * (1.0 - v), r * v];
+                let p = t.p[0] * b[0] + t.p[1] * b[1] + t.p[2] * b[2];
+                let uv = t.uv[0] * b[0] + t.uv[1] * b[1] + t.uv[2] * b[2];
+                let seen = !scene.occluded(p + side * eps, sun, eps, f32::INFINITY, ti as u32);
+                let opaque = !tested || mesh.alpha(t.material, uv) >= mesh::ALPHA_CUTOFF;
+                for k in 0..3 {
+                    lit_all[k] += b[k] * f32::from(u8::from(seen));
+                    weight_all[k] += b[k];
+                    if opaque {
+                        lit[k] += b[k] * f32::from(u8::from(seen));
+                        weight[k] += b[k];
                     }
                 }
+            }
+            (0..3).map(move |k| {
+                let visibility = if weight[k] > 0.0 {
+                    lit[k] / weight[k]
+                } else {
+                    lit_all[k] / weight_all[k].max(1e-9)
+                };
                 RefVertex {
                     pos: t.p[k].to_array(),
-                    sun_visibility: lit as f32 / SUN_SAMPLES as f32,
+                    sun_visibility: visibility,
                     normal: t.n[k].to_array(),
                     material: t.material,
                     uv: t.uv[k].to_array(),

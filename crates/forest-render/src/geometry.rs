@@ -293,9 +293,21 @@ fn material_layer(
 }
 
 /// Mip chain of an RGBA8 image down to 1×1 (triangle filter), level 0 first, concatenated.
+/// Alpha is rescaled per level so that the share of texels passing the 0.5 alpha test stays
+/// that of level 0 (Castaño's coverage-preserving mips): plain averaging erodes alpha-tested
+/// leaves into nothing at a distance.
 fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
+    let coverage = |m: &image::RgbaImage, scale: f32| {
+        m.pixels()
+            .filter(|p| f32::from(p[3]) * scale >= 127.5)
+            .count() as f32
+            / (m.width() * m.height()) as f32
+    };
+    let target = coverage(img, 1.0);
     let mut data = Vec::new();
     let mut m = img.clone();
+    // Filtering must not mix in the colour of transparent texels (the bake never sees them).
+    forest_bake::lod::dilate_colour(&mut m);
     let mips = img.width().max(img.height()).ilog2() + 1;
     for level in 0..mips {
         if level > 0 {
@@ -304,6 +316,24 @@ fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
                 (img.height() >> level).max(1),
             );
             m = image::imageops::resize(&m, w, h, image::imageops::FilterType::Triangle);
+            if target > 0.0 && target < 1.0 {
+                // Bisect the alpha scale whose coverage matches level 0's.
+                let (mut lo, mut hi) = (0.0f32, 8.0f32);
+                for _ in 0..20 {
+                    let mid = 0.5 * (lo + hi);
+                    if coverage(&m, mid) < target {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let mut scaled = m.clone();
+                for p in scaled.pixels_mut() {
+                    p[3] = (f32::from(p[3]) * hi).round().min(255.0) as u8;
+                }
+                data.extend_from_slice(scaled.as_raw());
+                continue;
+            }
         }
         data.extend_from_slice(m.as_raw());
     }
@@ -408,6 +438,7 @@ fn draw_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
 
 /// The CPU preparation of the species (reference vertices with traced sun visibility, LOD set,
 /// billboard images), reusable for any forest of these species.
+#[derive(Clone)]
 pub struct PreparedGeometry {
     vertices: Vec<RefVertex>,
     geo_species: Vec<GpuGeoSpecies>,
@@ -512,6 +543,16 @@ impl PreparedGeometry {
             figures,
             lighting,
         }
+    }
+
+    /// A copy with every vertex's traced sun visibility replaced by `f(visibility)`: for
+    /// measuring what self-shadowing contributes (tests, experiments).
+    pub fn map_sun_visibility(&self, f: impl Fn(f32) -> f32) -> Self {
+        let mut out = self.clone();
+        out.vertices
+            .iter_mut()
+            .for_each(|v| v.sun_visibility = f(v.sun_visibility));
+        out
     }
 
     /// Bytes of the model data uploaded for all species: vertices, tables, material and
