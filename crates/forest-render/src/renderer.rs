@@ -145,9 +145,10 @@ pub struct QuadStream {
     bg_cull: wgpu::BindGroup,
     bg_ab: wgpu::BindGroup,
     bg_ba: wgpu::BindGroup,
-    bg_draw: wgpu::BindGroup,
+    bg_draw: [wgpu::BindGroup; 2],
+    levels: u32,
     args_group: wgpu::BindGroup,
-    iterations: u32,
+    iterations: Cell<u32>,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     writes: Cell<(u64, u64)>,
     camera_set: Cell<bool>,
@@ -282,12 +283,12 @@ impl QuadStream {
         let bg_cull = compute_bg("cull", &quads[1], &quads[0]);
         let bg_ab = compute_bg("refine A->B", &quads[0], &quads[1]);
         let bg_ba = compute_bg("refine B->A", &quads[1], &quads[0]);
+        let levels = t.max_levels;
         let iterations = if opts.refine {
             t.max_levels.saturating_sub(1)
         } else {
             0
         };
-        let final_quads = &quads[(iterations % 2) as usize];
         let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -299,20 +300,24 @@ impl QuadStream {
             mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
-        let bg_draw = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("draw"),
-            layout: &draw.bind_layout,
-            entries: &crate::passes::numbered(vec![
-                camera.as_entire_binding(),
-                scene.instances.as_entire_binding(),
-                scene.species.as_entire_binding(),
-                scene.frames.as_entire_binding(),
-                final_quads.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&nodes_view),
-                wgpu::BindingResource::TextureView(&colour_view),
-                wgpu::BindingResource::Sampler(&sampler),
-                ground.as_entire_binding(),
-            ]),
+        // One draw group per stream buffer: the final stream is A after an even number of
+        // refinement iterations, B after an odd one (refinement can be switched at run time).
+        let bg_draw = [&quads[0], &quads[1]].map(|final_quads| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("draw"),
+                layout: &draw.bind_layout,
+                entries: &crate::passes::numbered(vec![
+                    camera.as_entire_binding(),
+                    scene.instances.as_entire_binding(),
+                    scene.species.as_entire_binding(),
+                    scene.frames.as_entire_binding(),
+                    final_quads.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&nodes_view),
+                    wgpu::BindingResource::TextureView(&colour_view),
+                    wgpu::BindingResource::Sampler(&sampler),
+                    ground.as_entire_binding(),
+                ]),
+            })
         });
         let owned: Vec<(&'static str, wgpu::Buffer)> = [
             ("camera", &camera),
@@ -364,7 +369,8 @@ impl QuadStream {
             bg_ba,
             bg_draw,
             args_group,
-            iterations,
+            iterations: Cell::new(iterations),
+            levels,
             queries,
             writes: Cell::new((0, 0)),
             camera_set: Cell::new(false),
@@ -373,9 +379,18 @@ impl QuadStream {
         })
     }
 
-    /// Number of refinement iterations per frame (`max levels − 1`).
+    /// Number of refinement iterations per frame (`max levels − 1`; 0 without refinement).
     pub fn iterations(&self) -> u32 {
-        self.iterations
+        self.iterations.get()
+    }
+
+    /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
+    pub fn set_refine(&self, refine: bool) {
+        self.iterations.set(if refine {
+            self.levels.saturating_sub(1)
+        } else {
+            0
+        });
     }
 
     fn bindings(&self) -> crate::passes::StreamBindings<'_> {
@@ -451,7 +466,7 @@ impl QuadStream {
                 timestamp_writes: ts(2),
             });
             self.refine
-                .record(&mut pass, self.iterations, &self.bindings(), &self.scan);
+                .record(&mut pass, self.iterations(), &self.bindings(), &self.scan);
         }
         {
             let mut pass = crate::target::begin_pass(
@@ -470,7 +485,7 @@ impl QuadStream {
             );
             self.draw.record(
                 &mut pass,
-                &self.bg_draw,
+                &self.bg_draw[(self.iterations() % 2) as usize],
                 &self.args,
                 self.background == Background::Sky,
             );
@@ -509,7 +524,7 @@ impl QuadStream {
     /// The final quad stream of the last submitted frame; waits for the GPU.
     pub fn read_quads(&self, ctx: &GpuContext) -> Vec<Quad> {
         let n = self.read_stats(ctx).quads as usize;
-        let buf = &self.quads[(self.iterations % 2) as usize];
+        let buf = &self.quads[(self.iterations() % 2) as usize];
         let bytes = ctx.read_buffer(buf, (n * std::mem::size_of::<Quad>()) as u64);
         bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<Quad>()])
     }

@@ -293,3 +293,63 @@ fn every_method_renders_empty_single_and_million_tree_forests() {
         }
     }
 }
+
+#[test]
+fn switching_methods_at_run_time_reproduces_each_methods_own_frame() {
+    use forest_render::methods::{ForestRenderer, Method};
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    let (_, cam) = common::cameras(forest.extent()).remove(0);
+    let opts = |refine| RendererOptions {
+        viewport: cam.viewport,
+        background: Background::Transparent,
+        refine,
+        ..Default::default()
+    };
+    let stream = || GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let alone = |refine| {
+        let s = QuadStream::new(&ctx, stream(), &opts(refine)).unwrap();
+        let t = Target::new(&ctx, cam.viewport.0, cam.viewport.1);
+        s.render_frame(&ctx, &cam, &t).unwrap();
+        t.read(&ctx)
+    };
+    let (quads, impostor) = (alone(true), alone(false));
+    assert_ne!(quads, impostor, "refinement changes the image");
+    let lods = MeshMethod::Lods(Lods {
+        distances: [4.0, 8.0, 16.0],
+    });
+    let geo = geometry(&ctx, &forest);
+    let lods_alone = draw(&ctx, &geo, lods, &cam);
+
+    let without = ForestRenderer::new(QuadStream::new(&ctx, stream(), &opts(true)).unwrap(), None);
+    let err = without
+        .set_method(&ctx, Method::Mesh(lods))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("OBJ models"), "{err}");
+    assert_eq!(without.method(), Method::Quads, "a refused switch changes nothing");
+
+    let all = ForestRenderer::new(
+        QuadStream::new(&ctx, stream(), &opts(false)).unwrap(),
+        Some(geometry(&ctx, &forest)),
+    );
+    let target = Target::new(&ctx, cam.viewport.0, cam.viewport.1);
+    for (method, expected) in [
+        (Method::Impostor, &impostor),
+        (Method::Mesh(lods), &lods_alone),
+        (Method::Quads, &quads),
+        (Method::Impostor, &impostor),
+        (Method::Quads, &quads),
+    ] {
+        all.set_method(&ctx, method).unwrap();
+        all.render_frame(&ctx, &cam, &target).unwrap();
+        let stats = all.read_stats(&ctx);
+        assert!(stats.visible_trees > 0 && stats.primitives > 0, "{stats:?}");
+        assert!(
+            &target.read(&ctx) == expected,
+            "{} after switching differs from its own renderer",
+            method.name()
+        );
+    }
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
