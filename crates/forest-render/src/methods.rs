@@ -122,7 +122,13 @@ impl ForestRenderer {
         target: &Target,
     ) -> Result<(), CameraError> {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
-        self.encode(ctx, camera, &mut enc, &target.colour_view, &target.depth_view)?;
+        self.encode(
+            ctx,
+            camera,
+            &mut enc,
+            &target.colour_view,
+            &target.depth_view,
+        )?;
         ctx.queue.submit([enc.finish()]);
         Ok(())
     }

@@ -327,7 +327,11 @@ fn switching_methods_at_run_time_reproduces_each_methods_own_frame() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("OBJ models"), "{err}");
-    assert_eq!(without.method(), Method::Quads, "a refused switch changes nothing");
+    assert_eq!(
+        without.method(),
+        Method::Quads,
+        "a refused switch changes nothing"
+    );
 
     let all = ForestRenderer::new(
         QuadStream::new(&ctx, stream(), &opts(false)).unwrap(),
