@@ -2,14 +2,10 @@
 //! giving one clear error line, a non-zero exit and nothing written.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn forest(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_forest"))
-        .args(args)
-        .output()
-        .expect("the forest binary runs")
-}
+mod cli;
+
+use cli::forest;
 
 fn bush() -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -1,14 +1,11 @@
 //! End-to-end: `forest bake` → `forest scene` → `forest render`, and their bad inputs.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn forest(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_forest"))
-        .args(args)
-        .output()
-        .expect("the forest binary runs")
-}
+mod cli;
+
+use cli::{forest, model};
 
 fn ok(out: &Output) -> String {
     assert!(
@@ -32,13 +29,6 @@ fn err(out: &Output) -> String {
         .collect();
     assert_eq!(lines.len(), 1, "one line: {e}");
     e
-}
-
-fn model(s: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../../assets/trees/{s}/{s}.obj"))
-        .display()
-        .to_string()
 }
 
 #[test]

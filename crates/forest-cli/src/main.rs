@@ -22,7 +22,7 @@ enum Cli {
     Scene(scene::SceneArgs),
     /// Render views of a forest to PNG, headless.
     Render(render::RenderArgs),
-    /// Run a benchmark suite and write its CSV.
+    /// Run benchmark suites: CSV, charts (PNG + SVG) and, for `all`, REPORT.md.
     Bench(bench::BenchArgs),
     /// Accuracy of an image against a reference: mean FLIP, SSIM, PSNR, coverage IoU.
     Compare(compare::CompareArgs),

@@ -1,0 +1,155 @@
+//! Budget: model no more than a scene needs — the bake resolution, levels and quad capacity a
+//! given scene (viewport, nearest viewing distance, ε) needs, against the defaults.
+
+use anyhow::Result;
+use forest_render::Camera;
+use forest_render::methods::Method;
+use forest_render::renderer::Background;
+use forest_render::target::Target;
+use glam::Vec3;
+
+use super::accuracy::{nearest_tree, reference};
+use super::chart::{Chart, Series};
+use super::report::Section;
+use super::{Bench, Table, ms};
+
+/// Run the budget suite: the bake resolution, levels and quad capacity a scene needs.
+pub fn run(b: &Bench) -> Result<Section> {
+    let (trees, side, viewport) = super::accuracy::scene(b);
+    let forest = b.forest(trees, side, 7)?;
+    // The scene: nearest viewing distance 10 m, ε 4, 60° fov.
+    let (near, epsilon, fov) = (10.0f32, 4.0f32, 60.0f32);
+    let focal = viewport.1 as f32 / 2.0 / (fov.to_radians() / 2.0).tan();
+    let radius = b
+        .species
+        .iter()
+        .map(|s| s.atlas.manifest.bounding_sphere.radius)
+        .fold(0.0f32, f32::max);
+    // A slab image texel should not cover more than a pixel at the nearest distance.
+    let needed = ((2.0 * radius * focal / near).ceil() as u32)
+        .next_power_of_two()
+        .clamp(32, 1024);
+    let defaults = b.species[0].atlas.manifest.params;
+    let resolutions: Vec<u32> = if b.quick {
+        vec![32, 64]
+    } else {
+        let mut r = vec![needed / 2, needed, defaults.resolution];
+        r.sort_unstable();
+        r.dedup();
+        r
+    };
+    let (tree, _) = nearest_tree(&forest, Vec3::ZERO);
+    let cam = Camera {
+        eye: tree + Vec3::new(near * 0.6, 1.7, near * 0.8),
+        target: tree + Vec3::new(0.0, 2.5, 0.0),
+        fov_y_deg: fov,
+        near: 0.1,
+        far: side * 3.0,
+        viewport,
+        epsilon,
+    };
+    let geo = b.renderer(&forest, viewport, epsilon, true, Background::Transparent)?;
+    let reference = reference(b, &geo, &cam)?;
+    drop(geo);
+    let mut table = Table::new(&[
+        "resolution",
+        "levels",
+        "disk_bytes",
+        "gpu_bytes",
+        "capacity_quads",
+        "needed_quads",
+        "flip_mean",
+        "frame_ms",
+    ]);
+    let mut points = Vec::new();
+    let target = Target::new(&b.ctx, viewport.0, viewport.1);
+    let dir = tempfile_dir(&b.out)?;
+    for &res in &resolutions {
+        let params = forest_format::BakeParams {
+            resolution: res,
+            ..defaults
+        };
+        let mut species = Vec::new();
+        let (mut disk, mut gpu) = (0u64, 0u64);
+        for (k, obj) in b.models.iter().enumerate() {
+            let out = forest_bake::bake_file(obj, &params, &|_, _| {})?;
+            let path = dir.join(format!("{k}-{res}.atlas"));
+            out.atlas.save(&path)?;
+            disk += std::fs::read_dir(&path)?
+                .filter_map(|e| e.ok()?.metadata().ok())
+                .map(|m| m.len())
+                .sum::<u64>();
+            gpu += out.atlas.manifest.gpu_bytes();
+            species.push(forest_render::scene::SpeciesData::load(&path)?);
+        }
+        let scene = forest_render::GpuScene::new(&b.ctx, &species, &forest)?;
+        let opts = forest_render::RendererOptions {
+            viewport,
+            min_epsilon: epsilon,
+            background: Background::Transparent,
+            ..Default::default()
+        };
+        let stream = forest_render::QuadStream::new(&b.ctx, scene, &opts)?;
+        let r = forest_render::methods::ForestRenderer::new(stream, None);
+        let (s, t) = b.measure(&r, Method::Quads, &cam, &target, b.frames)?;
+        let m = forest_metrics::compare(&reference, &target.read(&b.ctx))?;
+        let levels = species[0].atlas.manifest.nodes_per_level.len();
+        println!(
+            "budget: {res} px, {levels} levels: {disk} B disk, {gpu} B GPU, FLIP {:.4}",
+            m.flip_mean
+        );
+        points.push((gpu as f64 / 1048576.0, f64::from(m.flip_mean)));
+        table.push(vec![
+            res.to_string(),
+            levels.to_string(),
+            disk.to_string(),
+            gpu.to_string(),
+            r.stream.capacity.quads.to_string(),
+            s.primitives.to_string(),
+            format!("{:.5}", m.flip_mean),
+            ms(t),
+        ]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    b.write("budget.csv", &table.csv())?;
+    b.chart(
+        "budget",
+        &Chart {
+            title: format!("Bake resolution for a scene: nearest tree {near} m, ε {epsilon}"),
+            x_label: "atlas GPU MiB (all species)".into(),
+            y_label: "mean FLIP at the nearest view".into(),
+            series: vec![Series {
+                name: "slab resolution (px)".into(),
+                points,
+                line: true,
+                ..Default::default()
+            }],
+            ..Default::default()
+        },
+    )?;
+    let text = format!(
+        "Given a scene — {}x{} pixels, 60° field of view, nearest tree {near} m away, ε = \
+         {epsilon} — a slab-image texel should cover at most a pixel at the nearest distance: \
+         2·r·f/d = {:.0} px for the largest bounding radius r = {radius:.1} m, so {needed} px \
+         (a power of two). The table bakes every species at half that, at that, and at the \
+         default {} px, and measures storage, the quads the view needs against the capacity \
+         allocated, and mean FLIP against the reference at that nearest view.",
+        viewport.0,
+        viewport.1,
+        2.0 * radius * focal / near,
+        defaults.resolution,
+    );
+    Ok(Section {
+        title: "Budget: model no more than a scene needs".into(),
+        text,
+        table,
+        charts: vec!["budget".into()],
+    })
+}
+
+/// A scratch folder for the budget's bakes inside the results folder.
+fn tempfile_dir(out: &std::path::Path) -> Result<std::path::PathBuf> {
+    let d = out.join(".budget-atlases");
+    std::fs::create_dir_all(&d)?;
+    Ok(d)
+}

@@ -1,0 +1,256 @@
+//! Charts of the benchmark suites with plotters: each chart is written as PNG and SVG from one
+//! drawing function. Logarithmic axes plot `log10` of the values on a linear axis with labels
+//! turned back into values (one code path for both kinds of axis).
+
+use std::path::Path;
+
+use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// One named series of points.
+#[derive(Clone, Debug, Default)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// Points in data units.
+    pub points: Vec<(f64, f64)>,
+    /// Join the points in order with a line (else markers only).
+    pub line: bool,
+    /// Draw the series' Pareto front (smaller x and smaller y are better) as a line.
+    pub front: bool,
+}
+
+/// A 2D chart.
+#[derive(Clone, Debug, Default)]
+pub struct Chart {
+    /// Caption.
+    pub title: String,
+    /// X axis label.
+    pub x_label: String,
+    /// Y axis label.
+    pub y_label: String,
+    /// Logarithmic x axis (values must be positive; others are dropped).
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The data.
+    pub series: Vec<Series>,
+}
+
+/// The points no other point beats in both coordinates (smaller is better), by ascending x.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut p: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for q in p {
+        if front.last().is_none_or(|l| q.1 < l.1) {
+            front.push(q);
+        }
+    }
+    front
+}
+
+fn register_font() {
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        let bytes: &'static [u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
+        // Registration only fails on a malformed font, which the embedded one is not.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, bytes);
+    });
+}
+
+const SIZE: (u32, u32) = (900, 600);
+
+/// Series colours, in series order (methods are always added in the same order, so a method
+/// keeps its colour across charts).
+const PALETTE: [(u8, u8, u8); 8] = [
+    (214, 39, 40),
+    (255, 127, 14),
+    (40, 40, 40),
+    (31, 119, 180),
+    (44, 160, 44),
+    (148, 103, 189),
+    (140, 86, 75),
+    (23, 190, 207),
+];
+
+fn axis(v: f64, log: bool) -> Option<f64> {
+    if !v.is_finite() {
+        None
+    } else if log {
+        (v > 0.0).then(|| v.log10())
+    } else {
+        Some(v)
+    }
+}
+
+fn label(v: f64, log: bool) -> String {
+    let x = if log { 10f64.powf(v) } else { v };
+    let a = x.abs();
+    if log && (1.0..1e5).contains(&a) {
+        // Two significant digits: 25, 32, 40, 50, 63, …
+        let p = 10f64.powi(a.log10().floor() as i32 - 1);
+        return format!("{}", (x / p).round() * p);
+    }
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e5).contains(&a) {
+        format!("{x:.0e}")
+    } else if a >= 100.0 {
+        format!("{x:.0}")
+    } else if a >= 1.0 {
+        format!("{x:.3}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .into()
+    } else {
+        format!("{x:.4}").trim_end_matches('0').into()
+    }
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, c: &Chart) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing a chart: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let pts: Vec<Vec<(f64, f64)>> = c
+        .series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .filter_map(|&(x, y)| Some((axis(x, c.log_x)?, axis(y, c.log_y)?)))
+                .collect()
+        })
+        .collect();
+    let all: Vec<&(f64, f64)> = pts.iter().flatten().collect();
+    let range = |f: fn(&(f64, f64)) -> f64| {
+        let lo = all.iter().map(|p| f(p)).fold(f64::INFINITY, f64::min);
+        let hi = all.iter().map(|p| f(p)).fold(f64::NEG_INFINITY, f64::max);
+        if !lo.is_finite() {
+            return 0.0..1.0;
+        }
+        let pad = ((hi - lo) * 0.08).max(if lo.abs() > 0.0 { lo.abs() * 0.05 } else { 0.5 });
+        (lo - pad)..(hi + pad)
+    };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&c.title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(range(|p| p.0), range(|p| p.1))
+        .map_err(err)?;
+    let (lx, ly) = (c.log_x, c.log_y);
+    chart
+        .configure_mesh()
+        .x_desc(&c.x_label)
+        .y_desc(&c.y_label)
+        .x_label_formatter(&|v| label(*v, lx))
+        .y_label_formatter(&|v| label(*v, ly))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for (k, (s, p)) in c.series.iter().zip(&pts).enumerate() {
+        let (r, g, b) = PALETTE[k % PALETTE.len()];
+        let colour = RGBColor(r, g, b);
+        if s.line {
+            chart
+                .draw_series(LineSeries::new(p.iter().copied(), colour.stroke_width(2)))
+                .map_err(err)?;
+        }
+        if s.front {
+            chart
+                .draw_series(LineSeries::new(pareto_front(p), colour.stroke_width(2)))
+                .map_err(err)?;
+        }
+        chart
+            .draw_series(p.iter().map(|&q| Circle::new(q, 4, colour.filled())))
+            .map_err(err)?
+            .label(&s.name)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Write `stem.png` and `stem.svg` (each to a temporary name, then renamed).
+pub fn save(c: &Chart, stem: &Path) -> Result<()> {
+    register_font();
+    let svg = stem.with_extension("svg");
+    let tmp = forest_bake::tmp_name(&svg);
+    draw(SVGBackend::new(&tmp, SIZE).into_drawing_area(), c)?;
+    std::fs::rename(&tmp, &svg)?;
+    let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    draw(
+        BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area(),
+        c,
+    )?;
+    let png = stem.with_extension("png");
+    let tmp = forest_bake::tmp_name(&png);
+    image::RgbImage::from_raw(SIZE.0, SIZE.1, buf)
+        .ok_or_else(|| anyhow!("chart buffer size"))?
+        .save_with_format(&tmp, image::ImageFormat::Png)?;
+    std::fs::rename(&tmp, &png)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pareto_front_keeps_only_unbeaten_points() {
+        let p = [
+            (1.0, 5.0),
+            (2.0, 3.0),
+            (3.0, 4.0),
+            (4.0, 1.0),
+            (2.5, 3.0),
+            (f64::NAN, 0.0),
+        ];
+        assert_eq!(pareto_front(&p), vec![(1.0, 5.0), (2.0, 3.0), (4.0, 1.0)]);
+        assert!(pareto_front(&[]).is_empty());
+    }
+
+    #[test]
+    fn charts_are_written_as_png_and_svg() {
+        let dir = tempfile::tempdir().unwrap();
+        let c = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            series: vec![Series {
+                name: "a".into(),
+                points: vec![(1.0, 1.0), (10.0, 2.0), (0.0, 3.0)],
+                line: true,
+                front: true,
+            }],
+            ..Default::default()
+        };
+        save(&c, &dir.path().join("c")).unwrap();
+        let png = image::open(dir.path().join("c.png")).unwrap();
+        assert_eq!((png.width(), png.height()), SIZE);
+        // Something besides the white background was drawn.
+        assert!(png.to_rgb8().pixels().any(|p| p.0 != [255, 255, 255]));
+        let svg = std::fs::read_to_string(dir.path().join("c.svg")).unwrap();
+        assert!(
+            svg.contains("<svg") && svg.contains(">t<"),
+            "caption in the SVG"
+        );
+    }
+}

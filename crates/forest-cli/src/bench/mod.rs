@@ -1,0 +1,368 @@
+//! `forest bench`: benchmark suites. Each writes CSV (stable columns, header row) and charts
+//! (PNG + SVG) into the results folder; `all` runs every suite and writes REPORT.md. Figures
+//! are printed and written, never asserted.
+
+mod accuracy;
+mod budget;
+pub mod chart;
+mod path;
+mod report;
+mod stability;
+mod storage;
+mod table1;
+
+use std::cell::OnceCell;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use forest_format::forest::Forest;
+use forest_format::generate::{GenerateParams, generate};
+use forest_render::geometry::{GeometryRenderer, PreparedGeometry};
+use forest_render::methods::{ForestRenderer, Method, MethodStats};
+use forest_render::renderer::{Background, RendererOptions};
+use forest_render::scene::SpeciesData;
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+
+/// The suites, in the order `all` runs them.
+pub const SUITES: [&str; 6] = [
+    "storage",
+    "table1",
+    "path",
+    "accuracy",
+    "stability",
+    "budget",
+];
+
+/// Arguments of `forest bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Suite: storage, table1, path, accuracy, stability, budget, or all (every suite and
+    /// REPORT.md).
+    #[arg(value_parser = ["storage", "table1", "path", "accuracy", "stability", "budget", "all"])]
+    pub suite: String,
+    /// Species atlases (comma-separated).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub species: Vec<PathBuf>,
+    /// OBJ models of the species, same order (for the geometry-based methods and the
+    /// reference). Default: `assets/trees/NAME/FILE` for an atlas `NAME.atlas` baked from FILE.
+    #[arg(long, value_delimiter = ',')]
+    pub models: Vec<PathBuf>,
+    /// Results folder.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Quick mode: tiny forests, small viewports, few frames and settings (for CI: proves the
+    /// suites run; the figures mean little).
+    #[arg(long)]
+    pub quick: bool,
+    /// Frames measured per setting (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub frames: u32,
+}
+
+/// What every suite works with.
+pub struct Bench {
+    /// The GPU.
+    pub ctx: GpuContext,
+    /// Adapter name and backend, for the tables.
+    pub device: String,
+    /// Whether the adapter is a CPU rasteriser (lavapipe): the slowest settings are sampled.
+    pub cpu: bool,
+    /// Atlas paths.
+    pub species_paths: Vec<PathBuf>,
+    /// Loaded atlases.
+    pub species: Vec<SpeciesData>,
+    /// OBJ models (empty when none could be found).
+    pub models: Vec<PathBuf>,
+    prepared: OnceCell<PreparedGeometry>,
+    /// Results folder.
+    pub out: PathBuf,
+    /// Quick mode.
+    pub quick: bool,
+    /// Frames measured per setting.
+    pub frames: u32,
+}
+
+/// The median (the lower middle for even counts); 0 for none.
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        0.0
+    } else {
+        v[(v.len() - 1) / 2]
+    }
+}
+
+/// Default model of an atlas: `assets/trees/NAME/FILE` (NAME from `NAME.atlas`, FILE the OBJ
+/// the manifest names).
+fn default_model(atlas_path: &Path, data: &SpeciesData) -> Option<PathBuf> {
+    let name = atlas_path.file_stem()?.to_str()?;
+    let p = Path::new("assets/trees")
+        .join(name)
+        .join(&data.atlas.manifest.source.file);
+    p.is_file().then_some(p)
+}
+
+impl Bench {
+    fn new(args: &BenchArgs) -> Result<Self> {
+        let species = args
+            .species
+            .iter()
+            .map(|p| SpeciesData::load(p).map_err(anyhow::Error::from))
+            .collect::<Result<Vec<_>>>()?;
+        let models = if args.models.is_empty() {
+            args.species
+                .iter()
+                .zip(&species)
+                .map(|(p, s)| default_model(p, s))
+                .collect::<Option<Vec<_>>>()
+                .unwrap_or_default()
+        } else if args.models.len() != species.len() {
+            bail!(
+                "--models names {} OBJ files for {} species",
+                args.models.len(),
+                species.len()
+            );
+        } else {
+            args.models.clone()
+        };
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("creating {}", args.out.display()))?;
+        let ctx = GpuContext::headless()?;
+        if !ctx
+            .device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+        {
+            bail!(
+                "the adapter {} has no timestamp queries: no pass times to report",
+                ctx.adapter_info.name
+            );
+        }
+        let device = format!("{} ({:?})", ctx.adapter_info.name, ctx.adapter_info.backend);
+        let cpu = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
+        Ok(Self {
+            ctx,
+            device,
+            cpu,
+            species_paths: args.species.clone(),
+            species,
+            models,
+            prepared: OnceCell::new(),
+            out: args.out.clone(),
+            quick: args.quick,
+            frames: if args.quick { 1 } else { args.frames.max(1) },
+        })
+    }
+
+    /// The geometry methods' preparation of the species (once).
+    pub fn prepared(&self) -> Result<&PreparedGeometry> {
+        if let Some(p) = self.prepared.get() {
+            return Ok(p);
+        }
+        if self.models.is_empty() {
+            bail!(
+                "this suite draws the full-geometry reference and needs the species' OBJ models: \
+                 pass --models (none found under assets/trees/)"
+            );
+        }
+        let p = crate::render::prepare_models(&self.models, &self.species)?;
+        Ok(self.prepared.get_or_init(|| p))
+    }
+
+    /// A generated forest of the bench species: `trees` over a `side`-metre square.
+    pub fn forest(&self, trees: u32, side: f32, seed: u64) -> Result<Forest> {
+        generate(&GenerateParams {
+            trees,
+            species: self
+                .species_paths
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect(),
+            area_per_tree: side * side / trees.max(1) as f32,
+            clump_size: (side / 15.0).max(5.0),
+            seed,
+            ..GenerateParams::default()
+        })
+        .map_err(anyhow::Error::msg)
+    }
+
+    /// Every method's renderer for `forest` (the geometry ones when `geometry`).
+    pub fn renderer(
+        &self,
+        forest: &Forest,
+        viewport: (u32, u32),
+        min_epsilon: f32,
+        geometry: bool,
+        background: Background,
+    ) -> Result<ForestRenderer> {
+        let scene = GpuScene::new(&self.ctx, &self.species, forest)?;
+        let opts = RendererOptions {
+            format: TARGET_FORMAT,
+            viewport,
+            min_epsilon,
+            background,
+            ..Default::default()
+        };
+        let stream = QuadStream::new(&self.ctx, scene, &opts)?;
+        let geo = if geometry {
+            Some(GeometryRenderer::new(
+                &self.ctx,
+                self.prepared()?,
+                forest,
+                TARGET_FORMAT,
+                background,
+            )?)
+        } else {
+            None
+        };
+        Ok(ForestRenderer::new(stream, geo))
+    }
+
+    /// Render `frames` + 1 frames of `method` (the first unmeasured: pipelines may compile
+    /// then); the last frame's counters and the median GPU frame time (cull + refine + draw).
+    pub fn measure(
+        &self,
+        r: &ForestRenderer,
+        method: Method,
+        cam: &Camera,
+        target: &Target,
+        frames: u32,
+    ) -> Result<(MethodStats, f64)> {
+        r.set_method(&self.ctx, method)?;
+        let mut times = Vec::new();
+        let mut stats = MethodStats::default();
+        for f in 0..=frames {
+            r.render_frame(&self.ctx, cam, target)?;
+            stats = r.read_stats(&self.ctx);
+            if f > 0 {
+                let t = stats.times.unwrap_or_default();
+                times.push(t.cull_ms + t.refine_ms + t.draw_ms);
+            }
+        }
+        let errors = self.ctx.take_errors();
+        if !errors.is_empty() {
+            bail!("the GPU reported: {}", errors.join("; "));
+        }
+        Ok((stats, median(times)))
+    }
+
+    /// Frames to measure for a method: one for full geometry and stochastic simplification on
+    /// a CPU rasteriser (seconds per frame there), else the configured count.
+    pub fn frames_for(&self, method: Method) -> u32 {
+        let slow = matches!(
+            method,
+            Method::Mesh(
+                forest_render::geometry::MeshMethod::Full { .. }
+                    | forest_render::geometry::MeshMethod::Stochastic(_)
+            )
+        );
+        if self.cpu && slow { 1 } else { self.frames }
+    }
+
+    /// Write `name` in the results folder atomically.
+    pub fn write(&self, name: &str, contents: &str) -> Result<PathBuf> {
+        let path = self.out.join(name);
+        let tmp = forest_bake::tmp_name(&path);
+        std::fs::write(&tmp, contents).with_context(|| format!("writing {}", path.display()))?;
+        std::fs::rename(&tmp, &path).with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+        Ok(path)
+    }
+
+    /// Save a chart as `stem.png` and `stem.svg` in the results folder.
+    pub fn chart(&self, stem: &str, c: &chart::Chart) -> Result<()> {
+        chart::save(c, &self.out.join(stem))?;
+        println!("wrote {}.png, .svg", self.out.join(stem).display());
+        Ok(())
+    }
+}
+
+/// A CSV table: header and rows of already-formatted cells.
+#[derive(Clone, Debug, Default)]
+pub struct Table {
+    /// Column names.
+    pub header: Vec<&'static str>,
+    /// Rows.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// An empty table with these columns.
+    pub fn new(header: &[&'static str]) -> Self {
+        Self {
+            header: header.to_vec(),
+            rows: Vec::new(),
+        }
+    }
+
+    /// Add a row (one cell per column).
+    pub fn push(&mut self, row: Vec<String>) {
+        debug_assert_eq!(row.len(), self.header.len());
+        self.rows.push(row);
+    }
+
+    /// CSV text; cells with commas or quotes are quoted.
+    pub fn csv(&self) -> String {
+        let cell = |c: &str| {
+            if c.contains([',', '"']) {
+                format!("\"{}\"", c.replace('"', "\"\""))
+            } else {
+                c.to_string()
+            }
+        };
+        let mut s = self.header.join(",") + "\n";
+        for r in &self.rows {
+            s += &(r.iter().map(|c| cell(c)).collect::<Vec<_>>().join(",") + "\n");
+        }
+        s
+    }
+
+    /// A Markdown table.
+    pub fn markdown(&self) -> String {
+        let mut s = format!("| {} |\n|", self.header.join(" | "));
+        for _ in &self.header {
+            s += "---|";
+        }
+        s += "\n";
+        for r in &self.rows {
+            let _ = writeln!(s, "| {} |", r.join(" | "));
+        }
+        s
+    }
+}
+
+/// Format milliseconds.
+pub fn ms(v: f64) -> String {
+    format!("{v:.3}")
+}
+
+/// Run `forest bench`.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let b = Bench::new(args)?;
+    println!("forest bench {} on {}", args.suite, b.device);
+    let mut report = report::Report::default();
+    let suites: Vec<&str> = if args.suite == "all" {
+        SUITES.to_vec()
+    } else {
+        vec![args.suite.as_str()]
+    };
+    for s in suites {
+        let section = match s {
+            "storage" => storage::run(&b)?,
+            "table1" => table1::run(&b)?,
+            "path" => path::run(&b)?,
+            "accuracy" => accuracy::run(&b)?,
+            "stability" => stability::run(&b)?,
+            "budget" => budget::run(&b)?,
+            _ => unreachable!("clap checks the suite"),
+        };
+        report.sections.push(section);
+    }
+    if args.suite == "all" {
+        b.write("REPORT.md", &report.markdown(&b))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,138 @@
+//! A walkthrough of 100 views through the forest (the paper's Figure 7): frame time and
+//! primitives per view for every method.
+
+use anyhow::Result;
+use forest_render::Camera;
+use forest_render::geometry::{Lods, MeshMethod, Stochastic};
+use forest_render::methods::Method;
+use forest_render::renderer::Background;
+use forest_render::target::Target;
+use glam::Vec3;
+
+use super::chart::{Chart, Series};
+use super::report::Section;
+use super::{Bench, Table, ms};
+
+/// View `i` of `n` along the walkthrough of a forest of side `side`: eye height 1.7 m, across
+/// the forest on a gentle S-curve, looking ahead and swinging left and right.
+pub fn view(i: u32, n: u32, side: f32, viewport: (u32, u32)) -> Camera {
+    let t = i as f32 / (n.max(2) - 1) as f32;
+    let x = (t - 0.5) * side * 0.7;
+    let z = (t * std::f32::consts::TAU).sin() * side * 0.1;
+    let yaw = (t * 3.0 * std::f32::consts::TAU).sin() * 0.6;
+    let eye = Vec3::new(x, 1.7, z);
+    Camera {
+        eye,
+        target: eye + Vec3::new(yaw.cos(), 0.05, yaw.sin()) * 50.0,
+        fov_y_deg: 60.0,
+        near: 0.1,
+        far: side * 3.0,
+        viewport,
+        epsilon: 16.0,
+    }
+}
+
+/// Run the suite.
+pub fn run(b: &Bench) -> Result<Section> {
+    let (trees, side, viewport, views) = if b.quick {
+        (300, 60.0, (160, 120), 4)
+    } else {
+        (20_000, 450.0, (800, 600), 100)
+    };
+    let geometry = !b.models.is_empty();
+    let forest = b.forest(trees, side, 11)?;
+    let r = b.renderer(&forest, viewport, 16.0, geometry, Background::Sky)?;
+    let target = Target::new(&b.ctx, viewport.0, viewport.1);
+    let mut methods = vec![(Method::Quads, 1), (Method::Impostor, 1)];
+    if geometry {
+        // On a CPU rasteriser full geometry and stochastic simplification take seconds per
+        // frame: every 10th view is measured (said in the report), the rest every view.
+        let stride = if b.cpu && !b.quick { 10 } else { 1 };
+        methods.push((Method::Mesh(MeshMethod::Lods(Lods::default())), 1));
+        methods.push((
+            Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
+            stride,
+        ));
+        methods.push((Method::Mesh(MeshMethod::Full { depth_sort: true }), stride));
+    }
+    let mut table = Table::new(&["view", "method", "frame_ms", "primitives", "visible_trees"]);
+    let mut series = Vec::new();
+    let mut means = Vec::new();
+    for (method, stride) in methods {
+        let mut s = Series {
+            name: method.name().into(),
+            line: true,
+            ..Default::default()
+        };
+        for i in (0..views).step_by(stride) {
+            let cam = view(i, views, side, viewport);
+            let (st, t) = b.measure(&r, method, &cam, &target, b.frames_for(method))?;
+            s.points.push((f64::from(i), t));
+            table.push(vec![
+                i.to_string(),
+                method.name().into(),
+                ms(t),
+                st.primitives.to_string(),
+                st.visible_trees.to_string(),
+            ]);
+        }
+        let mean = s.points.iter().map(|p| p.1).sum::<f64>() / s.points.len().max(1) as f64;
+        let worst = s.points.iter().map(|p| p.1).fold(0.0, f64::max);
+        println!(
+            "path, {}: mean {mean:.2} ms, worst {worst:.2} ms",
+            method.name()
+        );
+        means.push((method.name(), mean, worst, stride));
+        series.push(s);
+    }
+    b.write("path.csv", &table.csv())?;
+    b.chart(
+        "path",
+        &Chart {
+            title: format!(
+                "Walkthrough: {trees} trees, {views} views, {}x{}",
+                viewport.0, viewport.1
+            ),
+            x_label: "view along the path".into(),
+            y_label: "GPU ms per frame".into(),
+            log_y: true,
+            series,
+            ..Default::default()
+        },
+    )?;
+    let quads = means.first().map(|m| m.1).unwrap_or(f64::NAN);
+    let text = format!(
+        "{views} views along an S-shaped walk at eye height through {trees} trees over \
+         {side:.0} m (the paper's Figure 7), {}x{}, ε 16, default parameters.\n\n{}",
+        viewport.0,
+        viewport.1,
+        means
+            .iter()
+            .map(|(m, mean, worst, stride)| format!(
+                "- {m}: mean {mean:.2} ms, worst {worst:.2} ms ({:.1}× the quad stream's mean){}",
+                mean / quads,
+                if *stride > 1 {
+                    format!(", every {stride}th view measured")
+                } else {
+                    String::new()
+                }
+            ))
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    let mut summary = Table::new(&["method", "mean_ms", "worst_ms", "views_measured"]);
+    for (m, mean, worst, stride) in &means {
+        summary.push(vec![
+            m.to_string(),
+            ms(*mean),
+            ms(*worst),
+            views.div_ceil(*stride as u32).to_string(),
+        ]);
+    }
+    Ok(Section {
+        title: "Walkthrough (Figure 7)".into(),
+        text,
+        table: summary,
+        charts: vec!["path".into()],
+    })
+}

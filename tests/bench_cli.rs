@@ -1,0 +1,95 @@
+//! `forest bench all --quick`: every suite runs on tiny atlases and writes its CSV (with the
+//! stable columns), its charts and REPORT.md. Figures are not asserted, only produced.
+
+mod cli;
+
+use cli::{forest, model};
+
+#[test]
+fn quick_benchmarks_write_every_table_chart_and_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut atlases = Vec::new();
+    for s in ["bush", "pine"] {
+        let atlas = dir.path().join(format!("{s}.atlas"));
+        let out = forest(&[
+            "bake",
+            &model(s),
+            "-o",
+            atlas.to_str().unwrap(),
+            "--resolution",
+            "32",
+            "--directions",
+            "5",
+            "--spp",
+            "1",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        atlases.push(atlas.display().to_string());
+    }
+    let results = dir.path().join("results");
+    let out = forest(&[
+        "bench",
+        "all",
+        "--quick",
+        "--species",
+        &atlases.join(","),
+        "--models",
+        &format!("{},{}", model("bush"), model("pine")),
+        "--out",
+        results.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = |f: &str| {
+        std::fs::read_to_string(results.join(f))
+            .unwrap_or_else(|e| panic!("{f}: {e}"))
+            .lines()
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    assert!(
+        header("table1.csv")
+            .starts_with("trees,view,visible_trees,quads,cull_ms,refine_ms,draw_ms,total_ms")
+    );
+    assert!(header("accuracy.csv").starts_with("method,param,view,frame_ms,flip_mean,ssim,psnr"));
+    assert!(header("stability.csv").starts_with("case,method,flip_mean,flicker,pops"));
+    assert!(header("storage.csv").starts_with("method,species,disk_bytes,gpu_bytes"));
+    for f in [
+        "path.csv",
+        "budget.csv",
+        "storage_forest.csv",
+        "storage_stream.csv",
+    ] {
+        assert!(!header(f).is_empty(), "{f}");
+    }
+    // Every method appears in the accuracy and stability tables.
+    let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
+    for m in ["quads", "impostor", "geometry", "stochastic", "lods"] {
+        assert!(
+            accuracy.lines().any(|l| l.starts_with(&format!("{m},"))),
+            "{m}"
+        );
+    }
+    let report = std::fs::read_to_string(results.join("REPORT.md")).unwrap();
+    let mut charts = 0;
+    for line in report.lines().filter(|l| l.starts_with("![")) {
+        let png = line.split("](").nth(1).unwrap().split(')').next().unwrap();
+        let img = image::open(results.join(png)).unwrap_or_else(|e| panic!("{png}: {e}"));
+        assert!(img.width() > 100);
+        assert!(results.join(png.replace(".png", ".svg")).is_file());
+        charts += 1;
+    }
+    assert!(charts >= 8, "{charts} charts in the report");
+    assert!(
+        !results.join(".budget-atlases").exists(),
+        "scratch bakes removed"
+    );
+}
