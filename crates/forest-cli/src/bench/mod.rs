@@ -222,7 +222,8 @@ impl Bench {
     }
 
     /// Render `frames` + 1 frames of `method` (the first unmeasured: pipelines may compile
-    /// then); the last frame's counters and the median GPU frame time (cull + refine + draw).
+    /// then; with `frames` = 0 the one frame is measured); the last frame's counters and the
+    /// median GPU frame time (cull + refine + draw).
     pub fn measure(
         &self,
         r: &ForestRenderer,
@@ -237,7 +238,7 @@ impl Bench {
         for f in 0..=frames {
             r.render_frame(&self.ctx, cam, target)?;
             stats = r.read_stats(&self.ctx);
-            if f > 0 {
+            if f > 0 || frames == 0 {
                 let t = stats.times.unwrap_or_default();
                 times.push(t.cull_ms + t.refine_ms + t.draw_ms);
             }
