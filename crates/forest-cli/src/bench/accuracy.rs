@@ -37,9 +37,27 @@ pub fn nearest_tree(forest: &Forest, p: Vec3) -> (Vec3, f32) {
         .unwrap_or((Vec3::ZERO, 1.0))
 }
 
-/// The three views: close-up of the tree nearest the centre, mid-range inside the forest,
-/// bird's-eye over it.
-pub fn views(forest: &Forest, side: f32, viewport: (u32, u32)) -> Vec<(&'static str, Camera)> {
+/// A point at eye height near `start`, stepping towards the forest's centre, with no tree
+/// base within `clearance` metres (so the camera is not inside a crown).
+pub fn clear_eye(forest: &Forest, start: Vec3, clearance: f32) -> Vec3 {
+    let step = -start.normalize_or_zero();
+    (0..200)
+        .map(|k| start + step * k as f32)
+        .find(|p| {
+            let (t, s) = nearest_tree(forest, *p);
+            Vec3::new(t.x - p.x, 0.0, t.z - p.z).length() >= clearance * s
+        })
+        .unwrap_or(start)
+}
+
+/// The three views: close-up of the tree nearest the centre, mid-range inside the forest
+/// (from a spot clear of crowns, `clearance` = the largest crown radius), bird's-eye over it.
+pub fn views(
+    forest: &Forest,
+    side: f32,
+    viewport: (u32, u32),
+    clearance: f32,
+) -> Vec<(&'static str, Camera)> {
     let (tree, scale) = nearest_tree(forest, Vec3::ZERO);
     let cam = |eye: Vec3, target: Vec3| Camera {
         eye,
@@ -60,7 +78,10 @@ pub fn views(forest: &Forest, side: f32, viewport: (u32, u32)) -> Vec<(&'static 
         ),
         (
             "mid-range",
-            cam(Vec3::new(0.0, 1.7, side * 0.25), Vec3::new(-5.0, 3.0, 0.0)),
+            {
+                let eye = clear_eye(forest, Vec3::new(0.0, 1.7, side * 0.25), clearance);
+                cam(eye, Vec3::new(eye.x - 5.0, 3.0, eye.z - side * 0.25))
+            },
         ),
         (
             "birds-eye",
@@ -164,7 +185,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     ]);
     let mut charts = Vec::new();
     let mut summary = Vec::new();
-    for (view, cam) in views(&forest, side, viewport) {
+    for (view, cam) in views(&forest, side, viewport, b.clearance()) {
         let reference = reference(b, &r, &cam)?;
         let mut series: Vec<Series> = Vec::new();
         for (method, param) in settings(b.quick) {

@@ -79,6 +79,20 @@ const PALETTE: [(u8, u8, u8); 8] = [
     (23, 190, 207),
 ];
 
+/// A method keeps one colour on every chart (series named after it, or after it and a colon);
+/// other series take the palette in order.
+fn colour_of(name: &str, k: usize) -> (u8, u8, u8) {
+    let method = name.split(':').next().unwrap_or(name);
+    match method {
+        "quads" => PALETTE[0],
+        "impostor" => PALETTE[1],
+        "geometry" | "geometry-unsorted" => PALETTE[2],
+        "stochastic" => PALETTE[3],
+        "lods" => PALETTE[4],
+        _ => PALETTE[k % PALETTE.len()],
+    }
+}
+
 fn axis(v: f64, log: bool) -> Option<f64> {
     if !v.is_finite() {
         None
@@ -92,10 +106,11 @@ fn axis(v: f64, log: bool) -> Option<f64> {
 fn label(v: f64, log: bool) -> String {
     let x = if log { 10f64.powf(v) } else { v };
     let a = x.abs();
-    if log && (1.0..1e5).contains(&a) {
-        // Two significant digits: 25, 32, 40, 50, 63, …
-        let p = 10f64.powi(a.log10().floor() as i32 - 1);
-        return format!("{}", (x / p).round() * p);
+    if log && (1e-4..1e5).contains(&a) {
+        // Two significant digits: 0.25, 0.32, …, 25, 32, 40, 50, 63, …
+        let e = a.log10().floor() as i32 - 1;
+        let p = 10f64.powi(e);
+        return format!("{:.*}", (-e).max(0) as usize, (x / p).round() * p);
     }
     if a == 0.0 {
         "0".into()
@@ -139,12 +154,18 @@ where
         let pad = ((hi - lo) * 0.08).max(if lo.abs() > 0.0 { lo.abs() * 0.05 } else { 0.5 });
         (lo - pad)..(hi + pad)
     };
+    // Room above the data for the legend.
+    let y_range = {
+        let r = range(|p| p.1);
+        let legend = (r.end - r.start) * (0.08 * c.series.len() as f64 + 0.05);
+        r.start..r.end + legend
+    };
     let mut chart = ChartBuilder::on(&root)
         .caption(&c.title, ("sans-serif", 22))
         .margin(14)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(range(|p| p.0), range(|p| p.1))
+        .build_cartesian_2d(range(|p| p.0), y_range)
         .map_err(err)?;
     let (lx, ly) = (c.log_x, c.log_y);
     chart
@@ -157,7 +178,7 @@ where
         .draw()
         .map_err(err)?;
     for (k, (s, p)) in c.series.iter().zip(&pts).enumerate() {
-        let (r, g, b) = PALETTE[k % PALETTE.len()];
+        let (r, g, b) = colour_of(&s.name, k);
         let colour = RGBColor(r, g, b);
         if s.line {
             chart

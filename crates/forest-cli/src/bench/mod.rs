@@ -1,5 +1,5 @@
 //! `forest bench`: benchmark suites. Each writes CSV (stable columns, header row) and charts
-//! (PNG + SVG) into the results folder; `all` runs every suite and writes REPORT.md. Figures
+//! (PNG + SVG) into the results folder and updates REPORT.md; `all` runs every suite. Figures
 //! are printed and written, never asserted.
 
 mod accuracy;
@@ -39,8 +39,8 @@ pub const SUITES: [&str; 6] = [
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Suite: storage, table1, path, accuracy, stability, budget, or all (every suite and
-    /// REPORT.md).
+    /// Suite: storage, table1, path, accuracy, stability, budget, or all. Every run updates
+    /// REPORT.md with the sections of all suites run into the results folder so far.
     #[arg(value_parser = ["storage", "table1", "path", "accuracy", "stability", "budget", "all"])]
     pub suite: String,
     /// Species atlases (comma-separated).
@@ -155,6 +155,14 @@ impl Bench {
             quick: args.quick,
             frames: if args.quick { 1 } else { args.frames.max(1) },
         })
+    }
+
+    /// The largest crown (bounding-sphere) radius of the species, metres at scale 1.
+    pub fn clearance(&self) -> f32 {
+        self.species
+            .iter()
+            .map(|s| s.atlas.manifest.bounding_sphere.radius)
+            .fold(1.0, f32::max)
     }
 
     /// The geometry methods' preparation of the species (once).
@@ -344,7 +352,6 @@ pub fn ms(v: f64) -> String {
 pub fn run(args: &BenchArgs) -> Result<()> {
     let b = Bench::new(args)?;
     println!("forest bench {} on {}", args.suite, b.device);
-    let mut report = report::Report::default();
     let suites: Vec<&str> = if args.suite == "all" {
         SUITES.to_vec()
     } else {
@@ -360,10 +367,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "budget" => budget::run(&b)?,
             _ => unreachable!("clap checks the suite"),
         };
-        report.sections.push(section);
-    }
-    if args.suite == "all" {
-        b.write("REPORT.md", &report.markdown(&b))?;
+        report::write(&b, s, &section)?;
     }
     Ok(())
 }
