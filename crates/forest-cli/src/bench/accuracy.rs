@@ -76,13 +76,10 @@ pub fn views(
                 tree + Vec3::new(0.0, 2.5 * scale, 0.0),
             ),
         ),
-        (
-            "mid-range",
-            {
-                let eye = clear_eye(forest, Vec3::new(0.0, 1.7, side * 0.25), clearance);
-                cam(eye, Vec3::new(eye.x - 5.0, 3.0, eye.z - side * 0.25))
-            },
-        ),
+        ("mid-range", {
+            let eye = clear_eye(forest, Vec3::new(0.0, 1.7, side * 0.25), clearance);
+            cam(eye, Vec3::new(eye.x - 5.0, 3.0, eye.z - side * 0.25))
+        }),
         (
             "birds-eye",
             cam(Vec3::new(0.0, side * 0.35, side * 0.6), Vec3::ZERO),
