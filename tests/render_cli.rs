@@ -112,6 +112,48 @@ fn bake_scene_render_end_to_end() {
     ]));
     assert!(d.join("small.png").is_file());
 
+    // `forest view` plays a camera path back headless, one PNG per key, with any method.
+    let walk = d.join("walk.json");
+    let mut path = forest_format::camera_path::CameraPath::new(60.0);
+    for i in 0..3 {
+        let x = i as f32;
+        path.push(glam::Vec3::new(x, 1.7, 20.0), glam::Vec3::new(x, 2.0, 0.0));
+    }
+    path.save(&walk).unwrap();
+    let frames = d.join("frames");
+    std::fs::create_dir(&frames).unwrap();
+    for method in ["quads", "lods"] {
+        let text = ok(&forest(&[
+            "view",
+            &p("f.forest"),
+            "--path",
+            walk.to_str().unwrap(),
+            "--frames",
+            frames.to_str().unwrap(),
+            "--size",
+            "64x48",
+            "--method",
+            method,
+            "--models",
+            &format!("{},{}", model("bush"), model("aspen")),
+        ]));
+        assert!(text.contains(&format!("3 frames of {method}")), "{text}");
+        for i in 0..3 {
+            let img = image::open(frames.join(format!("frame-{i:05}.png"))).unwrap();
+            assert_eq!((img.width(), img.height()), (64, 48));
+        }
+    }
+    std::fs::write(&walk, "{\"version\":1,\"fov_deg\":60,\"keys\":[]}").unwrap();
+    let e = err(&forest(&[
+        "view",
+        &p("f.forest"),
+        "--path",
+        walk.to_str().unwrap(),
+        "--frames",
+        frames.to_str().unwrap(),
+    ]));
+    assert!(e.contains("no keys"), "{e}");
+
     // Bad inputs: one line, non-zero exit, nothing written.
     let e = err(&forest(&[
         "render",

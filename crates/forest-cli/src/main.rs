@@ -9,6 +9,7 @@ mod bench;
 mod compare;
 mod render;
 mod scene;
+mod view;
 
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
@@ -26,6 +27,8 @@ enum Cli {
     Bench(bench::BenchArgs),
     /// Accuracy of an image against a reference: mean FLIP, SSIM, PSNR, coverage IoU.
     Compare(compare::CompareArgs),
+    /// Walkthrough viewer; for now plays a camera path back headless to numbered PNGs.
+    View(view::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
         Cli::Scene(args) => scene::run(&args),
         Cli::Render(args) => render::run(&args),
         Cli::Bench(args) => bench::run(&args),
+        Cli::View(args) => view::run(&args),
         Cli::Compare(args) => compare::run(&args),
     };
     match result {

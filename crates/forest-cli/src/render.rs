@@ -46,16 +46,8 @@ pub struct RenderArgs {
     /// Draw over a transparent background without ground (alpha = tree coverage, for metrics).
     #[arg(long)]
     pub transparent: bool,
-    /// Rendering method: the quad stream; static impostors (the stream without refinement);
-    /// full geometry (the reference and brute-force baseline); stochastic simplification;
-    /// discrete LODs + billboards. The last three need --models.
-    #[arg(long, default_value = "quads", value_parser = METHODS)]
-    pub method: String,
-    /// OBJ models of the forest's species, in its species order (geometry-based methods).
-    #[arg(long, value_delimiter = ',')]
-    pub models: Vec<PathBuf>,
     #[command(flatten)]
-    pub mesh: MeshArgs,
+    pub m: MethodArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1)]
     pub supersample: u32,
@@ -64,9 +56,17 @@ pub struct RenderArgs {
 /// The `--method` values.
 pub const METHODS: [&str; 5] = ["quads", "impostor", "geometry", "stochastic", "lods"];
 
-/// Parameters of the geometry-based methods.
+/// The method and its parameters (shared by `forest render` and `forest view`).
 #[derive(clap::Args, Debug, Clone)]
-pub struct MeshArgs {
+pub struct MethodArgs {
+    /// Rendering method: the quad stream; static impostors (the stream without refinement);
+    /// full geometry (the reference and brute-force baseline); stochastic simplification;
+    /// discrete LODs + billboards. The last three need --models.
+    #[arg(long, default_value = "quads", value_parser = METHODS)]
+    pub method: String,
+    /// OBJ models of the forest's species, in its species order (geometry-based methods).
+    #[arg(long, value_delimiter = ',')]
+    pub models: Vec<PathBuf>,
     /// Full geometry: draw trees in submission order instead of nearest distance band first.
     #[arg(long)]
     pub unsorted: bool,
@@ -90,7 +90,7 @@ pub struct MeshArgs {
     pub lod_distances: Vec<f32>,
 }
 
-impl MeshArgs {
+impl MethodArgs {
     /// The geometry method `name` names (None for the quad-stream methods).
     pub fn method(&self, name: &str) -> Result<Option<MeshMethod>> {
         let m = match name {
@@ -120,6 +120,22 @@ impl MeshArgs {
     }
 }
 
+impl MethodArgs {
+    /// The geometry method chosen (None for the quad-stream methods), requiring one OBJ model
+    /// per species for it.
+    pub fn checked_method(&self, species: usize) -> Result<Option<MeshMethod>> {
+        let m = self.method(&self.method)?;
+        if m.is_some() && self.models.len() != species {
+            bail!(
+                "--method {} needs --models with one OBJ per species ({} given, the forest has {species})",
+                self.method,
+                self.models.len()
+            );
+        }
+        Ok(m)
+    }
+}
+
 pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let v: Vec<f32> = s
         .split(',')
@@ -135,7 +151,7 @@ pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
     }
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once('x')
         .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT"))?;
@@ -227,15 +243,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !(1..=8).contains(&args.supersample) {
         bail!("supersample = {}: must be 1 to 8", args.supersample);
     }
-    let mesh_method = args.mesh.method(&args.method)?;
-    if mesh_method.is_some() && args.models.len() != forest.species.len() {
-        bail!(
-            "--method {} needs --models with one OBJ per species ({} given, the forest has {})",
-            args.method,
-            args.models.len(),
-            forest.species.len()
-        );
-    }
+    let mesh_method = args.m.checked_method(forest.species.len())?;
     let ctx = GpuContext::headless()?;
     if let Some(m) = mesh_method {
         return render_geometry(args, m, &ctx, &forest, &species, &cameras);
@@ -250,7 +258,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         min_epsilon: args.epsilon.min(8.0),
         viewport: (sw, sh),
         background: background(args),
-        refine: args.method != "impostor",
+        refine: args.m.method != "impostor",
         ..Default::default()
     };
     let stream = QuadStream::new(&ctx, scene, &opts)?;
@@ -325,6 +333,11 @@ fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Resu
     if supersample > 1 {
         img = forest_render::geometry::downsample(&img, supersample);
     }
+    write_png(&img, out)
+}
+
+/// Write a PNG atomically (temporary name, then rename).
+pub fn write_png(img: &image::RgbaImage, out: &Path) -> Result<()> {
     let tmp = forest_bake::tmp_name(out);
     img.save_with_format(&tmp, image::ImageFormat::Png)
         .with_context(|| format!("writing {}", out.display()))?;
@@ -358,7 +371,7 @@ fn render_geometry(
     species: &[SpeciesData],
     cameras: &[(String, Camera)],
 ) -> Result<()> {
-    let prepared = prepare_models(&args.models, species)?;
+    let prepared = prepare_models(&args.m.models, species)?;
     let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
     geo.set_method(ctx, method)?;
     let (sw, sh) = (
@@ -378,7 +391,7 @@ fn render_geometry(
                 "{}",
                 serde_json::json!({
                     "view": name, "output": out.display().to_string(),
-                    "adapter": ctx.adapter_info.name, "method": args.method,
+                    "adapter": ctx.adapter_info.name, "method": args.m.method,
                     "visible_trees": stats.visible_trees, "triangles": stats.triangles,
                     "billboards": stats.billboards, "per_band": stats.per_band,
                     "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
@@ -387,7 +400,7 @@ fn render_geometry(
         } else {
             println!(
                 "{name}: {} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms ({}) -> {}",
-                args.method,
+                args.m.method,
                 args.supersample,
                 stats.visible_trees,
                 stats.triangles,

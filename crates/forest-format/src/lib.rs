@@ -7,9 +7,12 @@
 //!   the barycentric blend of the 1–3 directions around a view direction;
 //! - [`slab`]: the image-space conventions that map a slab pixel back to object space;
 //! - [`shading`]: the one shading model every renderer of the project uses;
-//! - [`atlas`]: the baked atlas (manifest, colour, nodes), its atomic writer and checked loader.
+//! - [`atlas`]: the baked atlas (manifest, colour, nodes), its atomic writer and checked loader;
+//! - [`forest`], [`generate`]: forest files and the clumped-forest generator;
+//! - [`camera_path`]: recorded camera paths for the viewer.
 
 pub mod atlas;
+pub mod camera_path;
 pub mod directions;
 pub mod error;
 pub mod forest;
