@@ -157,7 +157,7 @@ where
     // Room above the data for the legend.
     let y_range = {
         let r = range(|p| p.1);
-        let legend = (r.end - r.start) * (0.08 * c.series.len() as f64 + 0.05);
+        let legend = (r.end - r.start) * (0.05 * c.series.len() as f64 + 0.03);
         r.start..r.end + legend
     };
     let mut chart = ChartBuilder::on(&root)
