@@ -251,7 +251,7 @@ mod tests {
     fn charts_are_written_as_png_and_svg() {
         let dir = tempfile::tempdir().unwrap();
         let c = Chart {
-            title: "t".into(),
+            title: "Caption of the test".into(),
             x_label: "x".into(),
             y_label: "y".into(),
             log_x: true,
