@@ -270,7 +270,7 @@ mod tests {
         assert!(png.to_rgb8().pixels().any(|p| p.0 != [255, 255, 255]));
         let svg = std::fs::read_to_string(dir.path().join("c.svg")).unwrap();
         assert!(
-            svg.contains("<svg") && svg.contains(">t<"),
+            svg.contains("<svg") && svg.contains("Caption of the test"),
             "caption in the SVG"
         );
     }
