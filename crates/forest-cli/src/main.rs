@@ -10,6 +10,7 @@ mod compare;
 mod render;
 mod scene;
 mod view;
+mod window;
 
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
@@ -27,7 +28,7 @@ enum Cli {
     Bench(bench::BenchArgs),
     /// Accuracy of an image against a reference: mean FLIP, SSIM, PSNR, coverage IoU.
     Compare(compare::CompareArgs),
-    /// Walkthrough viewer; for now plays a camera path back headless to numbered PNGs.
+    /// Walkthrough viewer (a window), or a camera path rendered headless to numbered PNGs.
     View(view::ViewArgs),
 }
 

@@ -1,6 +1,5 @@
-//! `forest view`: the walkthrough viewer. This part plays a recorded camera path back headless
-//! to numbered PNGs (`--path FILE --frames DIR`) with any method; the interactive window
-//! (winit + egui) is the open part of issue 6.
+//! `forest view`: the walkthrough viewer — a window (see [`crate::window`]), or, with
+//! `--path FILE --frames DIR`, a recorded camera path played back headless to numbered PNGs.
 
 use std::path::PathBuf;
 
@@ -26,6 +25,9 @@ pub struct ViewArgs {
     /// Render the path headless to DIR/frame-00000.png, … and exit.
     #[arg(long, requires = "path")]
     pub frames: Option<PathBuf>,
+    /// Where R saves a recorded camera path (interactive mode).
+    #[arg(long, default_value = "camera-path.json")]
+    pub record: PathBuf,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -39,10 +41,7 @@ pub struct ViewArgs {
 /// Run `forest view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
     let Some(frames) = &args.frames else {
-        bail!(
-            "the interactive window is not built yet; play a camera path back headless with \
-             --path FILE --frames DIR"
-        );
+        return interactive(args);
     };
     let path_file = args
         .path
@@ -118,4 +117,60 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         ctx.adapter_info.name
     );
     Ok(())
+}
+
+/// The window: walk through the forest with every method at hand.
+fn interactive(args: &ViewArgs) -> Result<()> {
+    let (forest, species) = load_scene(&args.forest)?;
+    let mesh_method = args.m.checked_method(forest.species.len())?;
+    let prepared = if args.m.models.is_empty() {
+        None
+    } else {
+        Some(prepare_models(&args.m.models, &species)?)
+    };
+    let far = (forest.extent() * 3.0 + 100.0).max(1000.0);
+    let methods = crate::window::offered(mesh_method, prepared.is_some());
+    let (size, epsilon) = (args.size, args.epsilon);
+    let build: crate::window::Build = Box::new(move |ctx, format| {
+        let opts = RendererOptions {
+            format,
+            // Sized for the starting window and ε: a larger window or a smaller ε may overflow,
+            // which the HUD's overflow counter reports (nothing is written out of bounds).
+            viewport: size,
+            min_epsilon: epsilon,
+            background: Background::Sky,
+            ..Default::default()
+        };
+        let geometry = match &prepared {
+            Some(p) => Some(forest_render::geometry::GeometryRenderer::new(
+                ctx,
+                p,
+                &forest,
+                format,
+                Background::Sky,
+            )?),
+            None => None,
+        };
+        Ok(ForestRenderer::new(
+            QuadStream::new(ctx, GpuScene::new(ctx, &species, &forest)?, &opts)?,
+            geometry,
+        ))
+    });
+    let walker = crate::window::Walker {
+        eye: Vec3::new(0.0, crate::window::EYE_HEIGHT, 0.0),
+        yaw: 0.0,
+        pitch: 0.0,
+        speed: 5.0,
+        walk: true,
+    };
+    crate::window::Viewer::new(
+        build,
+        size,
+        walker,
+        epsilon,
+        far,
+        methods,
+        args.record.clone(),
+    )
+    .run()
 }
