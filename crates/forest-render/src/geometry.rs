@@ -226,6 +226,14 @@ pub struct SpeciesFigures {
     pub leaves: u32,
     /// `r` of the area-preservation factor.
     pub r: f32,
+    /// Bytes of the species' model data on the GPU: vertices, tables, material and billboard
+    /// textures with mips.
+    pub model_bytes: u64,
+}
+
+/// Bytes of RGBA8 layers with their mip chains (a third more than level 0).
+fn layer_bytes(layers: &[image::RgbaImage]) -> u64 {
+    layers.iter().map(|l| l.as_raw().len() as u64 * 4 / 3).sum()
 }
 
 /// Billboard image side (texels) and samples per texel.
@@ -465,6 +473,12 @@ impl PreparedGeometry {
         let mut figures = Vec::new();
         for s in species {
             let material_base = materials.len() as u32;
+            let (layers_base, billboards_base, vertices_base, leaves_base) = (
+                layers.len(),
+                billboard_layers.len(),
+                vertices.len(),
+                leaf_end.len(),
+            );
             for m in &s.mesh.materials {
                 let layer = if m.colour.is_some() || m.alpha.is_some() {
                     layers.push(material_layer(&s.mesh, m.colour, m.alpha));
@@ -508,11 +522,6 @@ impl PreparedGeometry {
                 r: set.r,
                 mean_leaf: mean.extend(0.0).to_array(),
             });
-            figures.push(SpeciesFigures {
-                lod_triangles: counts.map(|c| u64::from(c) / 3),
-                leaves: set.leaf_end.len() as u32,
-                r: set.r,
-            });
             leaf_end.extend(&set.leaf_end);
             leaf_centre.extend(set.leaf_centre.iter().map(|c| c.extend(0.0).to_array()));
             billboard_layers.extend(forest_bake::lod::billboard_images(
@@ -527,6 +536,20 @@ impl PreparedGeometry {
                     ..*v
                 });
             }
+            let leaves = leaf_end.len() - leaves_base;
+            figures.push(SpeciesFigures {
+                lod_triangles: counts.map(|c| u64::from(c) / 3),
+                leaves: leaves as u32,
+                r: set.r,
+                model_bytes: (std::mem::size_of_val(&vertices[vertices_base..])
+                    + std::mem::size_of::<GpuGeoSpecies>()
+                    + std::mem::size_of_val(&materials[material_base as usize..])
+                    + std::mem::size_of_val(&leaf_end[leaves_base..])
+                    + std::mem::size_of_val(&leaf_centre[leaves_base..]))
+                    as u64
+                    + layer_bytes(&layers[layers_base..])
+                    + layer_bytes(&billboard_layers[billboards_base..]),
+            });
         }
         let lighting = species
             .first()
@@ -558,16 +581,7 @@ impl PreparedGeometry {
     /// Bytes of the model data uploaded for all species: vertices, tables, material and
     /// billboard textures with mips (what the geometry methods store per species, not per tree).
     pub fn model_bytes(&self) -> u64 {
-        let tex = |layers: &[image::RgbaImage]| -> u64 {
-            layers.iter().map(|l| l.as_raw().len() as u64 * 4 / 3).sum()
-        };
-        (std::mem::size_of_val(&self.vertices[..])
-            + std::mem::size_of_val(&self.geo_species[..])
-            + std::mem::size_of_val(&self.materials[..])
-            + std::mem::size_of_val(&self.leaf_end[..])
-            + std::mem::size_of_val(&self.leaf_centre[..])) as u64
-            + tex(&self.layers)
-            + tex(&self.billboard_layers)
+        self.figures.iter().map(|f| f.model_bytes).sum()
     }
 }
 

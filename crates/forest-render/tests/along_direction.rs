@@ -3,7 +3,6 @@
 
 mod common;
 
-use forest_format::forest::{Forest, Instance};
 use forest_format::shading::{srgb_decode_table, srgb_encode};
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::Target;
@@ -14,16 +13,7 @@ fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
     let ctx = common::ctx();
     let species = common::species();
     let atlas = &species[0].atlas; // bush, 64 px, 5 directions, 2 slabs
-    let forest = Forest::new(
-        vec!["bush".into(), "pine".into()],
-        vec![Instance {
-            position: [0.0; 3],
-            rotation: 0.0,
-            scale: 1.0,
-            species: 0,
-        }],
-        15,
-    );
+    let forest = common::one_tree(0, 0.0);
     let res = atlas.manifest.params.resolution;
     let scene =
         GpuScene::with_format(&ctx, &species, &forest, forest_render::ColourFormat::Rgba8).unwrap();

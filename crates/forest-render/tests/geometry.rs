@@ -65,19 +65,9 @@ fn quad_stream_resembles_the_supersampled_full_geometry() {
 #[test]
 fn per_vertex_sun_visibility_matches_the_bakes_lighting_better_than_none() {
     use forest_bake::lod::{BILLBOARD_ELEVATIONS, billboard_images};
-    use forest_format::forest::{Forest, Instance};
     use forest_render::Camera;
     let ctx = common::ctx();
-    let forest = Forest::new(
-        vec!["bush".into(), "pine".into()],
-        vec![Instance {
-            position: [0.0; 3],
-            rotation: 0.0,
-            scale: 1.0,
-            species: 1,
-        }],
-        15,
-    );
+    let forest = common::one_tree(1, 0.0);
     let mesh = forest_bake::Mesh::load(&common::root().join("assets/trees/pine/pine.obj")).unwrap();
     let lighting = common::atlases()[1].manifest.lighting;
     let res = 128;

@@ -5,7 +5,7 @@
 mod common;
 
 use forest_bake::lod::BANDS;
-use forest_format::forest::{Forest, Instance};
+use forest_format::forest::Forest;
 use forest_render::geometry::{GeometryRenderer, Lods, MeshMethod, Stochastic};
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -212,19 +212,6 @@ fn gpu_bands_match_the_cpu_classification() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
 
-fn single_tree() -> Forest {
-    Forest::new(
-        vec!["bush".into(), "pine".into()],
-        vec![Instance {
-            position: [0.0, 0.0, 0.0],
-            rotation: 0.3,
-            scale: 1.0,
-            species: 1,
-        }],
-        15,
-    )
-}
-
 #[test]
 fn every_method_renders_empty_single_and_million_tree_forests() {
     let ctx = common::ctx();
@@ -245,7 +232,7 @@ fn every_method_renders_empty_single_and_million_tree_forests() {
     ];
     for (forest_name, forest) in [
         ("empty", &empty),
-        ("single", &single_tree()),
+        ("single", &common::one_tree(1, 0.3)),
         ("million", &million),
     ] {
         // Single tree: 12 m away, in full view. Otherwise from inside, with a far plane that

@@ -21,7 +21,7 @@ use forest_format::forest::Forest;
 use forest_format::generate::{GenerateParams, generate};
 use forest_render::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_render::methods::{ForestRenderer, Method, MethodStats};
-use forest_render::renderer::{Background, RendererOptions};
+use forest_render::renderer::{Background, PassTimes, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
@@ -240,22 +240,47 @@ impl Bench {
         target: &Target,
         frames: u32,
     ) -> Result<(MethodStats, f64)> {
+        let (stats, _, total) = self.measure_passes(r, method, cam, target, frames)?;
+        Ok((stats, total))
+    }
+
+    /// [`Self::measure`] with the median of each pass too: (counters, per-pass medians,
+    /// median frame total).
+    pub fn measure_passes(
+        &self,
+        r: &ForestRenderer,
+        method: Method,
+        cam: &Camera,
+        target: &Target,
+        frames: u32,
+    ) -> Result<(MethodStats, PassTimes, f64)> {
         r.set_method(&self.ctx, method)?;
-        let mut times = Vec::new();
+        let mut times = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut stats = MethodStats::default();
         for f in 0..=frames {
             r.render_frame(&self.ctx, cam, target)?;
             stats = r.read_stats(&self.ctx);
             if f > 0 || frames == 0 {
                 let t = stats.times.unwrap_or_default();
-                times.push(t.cull_ms + t.refine_ms + t.draw_ms);
+                times.0.push(t.cull_ms);
+                times.1.push(t.refine_ms);
+                times.2.push(t.draw_ms);
+                times.3.push(t.cull_ms + t.refine_ms + t.draw_ms);
             }
         }
         let errors = self.ctx.take_errors();
         if !errors.is_empty() {
             bail!("the GPU reported: {}", errors.join("; "));
         }
-        Ok((stats, median(times)))
+        Ok((
+            stats,
+            PassTimes {
+                cull_ms: median(times.0),
+                refine_ms: median(times.1),
+                draw_ms: median(times.2),
+            },
+            median(times.3),
+        ))
     }
 
     /// Frames to measure for a method: one for full geometry and stochastic simplification on

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use forest_render::Camera;
-use forest_render::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeometry};
+use forest_render::geometry::GeometryRenderer;
 use forest_render::methods::Method;
 use forest_render::renderer::Background;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -70,11 +70,8 @@ pub fn run(b: &Bench) -> Result<Section> {
             ]);
         }
         if let Some(obj) = b.models.get(k) {
-            let prepared = PreparedGeometry::new(&[GeometrySpecies {
-                mesh: forest_bake::Mesh::load(obj)?,
-                lighting: data.atlas.manifest.lighting,
-            }]);
-            let (disk, gpu) = (model_bytes(obj), prepared.model_bytes());
+            // The figures of the one preparation every geometry suite shares.
+            let (disk, gpu) = (model_bytes(obj), b.prepared()?.figures[k].model_bytes);
             geo_total.0 += disk;
             geo_total.1 += gpu;
             for m in ["geometry", "stochastic", "lods"] {

@@ -76,17 +76,8 @@ pub fn run(b: &Bench) -> Result<Section> {
                 viewport,
                 epsilon: 16.0,
             };
-            let mut t = (Vec::new(), Vec::new(), Vec::new());
-            let mut s = Default::default();
-            for _ in 0..b.frames {
-                let (stats, _) = b.measure(&r, Method::Quads, &cam, &target, 1)?;
-                let p = stats.times.unwrap_or_default();
-                t.0.push(p.cull_ms);
-                t.1.push(p.refine_ms);
-                t.2.push(p.draw_ms);
-                s = stats;
-            }
-            let (c, rf, d) = (super::median(t.0), super::median(t.1), super::median(t.2));
+            let (s, p, _) = b.measure_passes(&r, Method::Quads, &cam, &target, b.frames)?;
+            let (c, rf, d) = (p.cull_ms, p.refine_ms, p.draw_ms);
             series[k].points.push((f64::from(trees), c + rf + d));
             table.push(vec![
                 trees.to_string(),

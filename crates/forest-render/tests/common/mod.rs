@@ -59,6 +59,21 @@ pub fn forest(trees: u32) -> Forest {
     .unwrap()
 }
 
+/// One unit-scale tree of test species `species` (0 bush, 1 pine) at the origin, turned by
+/// `rotation` radians.
+pub fn one_tree(species: u32, rotation: f32) -> Forest {
+    Forest::new(
+        vec!["bush".into(), "pine".into()],
+        vec![forest_format::forest::Instance {
+            position: [0.0; 3],
+            rotation,
+            scale: 1.0,
+            species,
+        }],
+        15,
+    )
+}
+
 pub fn ctx() -> GpuContext {
     GpuContext::headless().expect("a GPU adapter (install mesa-vulkan-drivers)")
 }
