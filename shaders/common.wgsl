@@ -7,7 +7,8 @@ struct Camera {
     eye: vec4<f32>,
     // xyz: unit view direction (world); w: unused.
     forward: vec4<f32>,
-    // x, y: viewport size in pixels; z, w: unused.
+    // x, y: viewport size in pixels; z: debug view of the draw pass (0 off, 1 levels,
+    // 2 blend weights, 3 wireframe; see renderer::DebugView); w: unused.
     viewport: vec4<f32>,
     // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
     planes: array<vec4<f32>, 6>,

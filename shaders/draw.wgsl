@@ -24,6 +24,8 @@ struct VsOut {
     @location(0) uv: vec2<f32>,
     @location(1) @interpolate(flat) layer: u32,
     @location(2) @interpolate(flat) alpha: f32,
+    @location(3) @interpolate(flat) level: u32,
+    @location(4) @interpolate(flat) dir: u32,
 }
 
 @vertex
@@ -44,12 +46,54 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     out.uv = vec2<f32>(u, v);
     out.layer = sp.layer_base + dir * sp.slabs + quad_slab(q);
     out.alpha = quad_weight(q);
+    out.level = quad_level(q);
+    out.dir = dir;
     return out;
+}
+
+// Debug views (camera.viewport.z, see renderer::DebugView): 0 off, 1 levels, 2 blend weights,
+// 3 wireframe.
+const DEBUG_LEVELS: u32 = 1u;
+const DEBUG_WEIGHTS: u32 = 2u;
+const DEBUG_WIREFRAME: u32 = 3u;
+
+// Colour of a hierarchy level; mirrors renderer::LEVEL_COLOURS.
+fn level_colour(level: u32) -> vec3<f32> {
+    var c = array<vec3<f32>, 8>(
+        vec3<f32>(0.9, 0.1, 0.1), vec3<f32>(0.95, 0.55, 0.05), vec3<f32>(0.9, 0.9, 0.1),
+        vec3<f32>(0.1, 0.8, 0.1), vec3<f32>(0.1, 0.8, 0.8), vec3<f32>(0.1, 0.2, 0.95),
+        vec3<f32>(0.6, 0.1, 0.9), vec3<f32>(0.95, 0.95, 0.95));
+    return c[level % 8u];
+}
+
+// A distinct, saturated colour per sampling direction (hues by the golden ratio).
+fn direction_colour(dir: u32) -> vec3<f32> {
+    let h = fract(f32(dir) * 0.618034);
+    let rgb = clamp(abs(fract(vec3<f32>(h) + vec3<f32>(0.0, 2.0 / 3.0, 1.0 / 3.0)) * 6.0 - 3.0) - 1.0,
+                    vec3<f32>(0.0), vec3<f32>(1.0));
+    return 0.15 + 0.8 * rgb;
 }
 
 @fragment
 fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
     let c = textureSample(colour, colour_sampler, in.uv, in.layer);
+    // Position inside the quad in quad widths and its screen derivative (before any branch).
+    let g = in.uv * f32(1u << in.level);
+    let px = max(fwidth(g), vec2<f32>(1e-6));
+    let mode = u32(camera.viewport.z);
+    if (mode == DEBUG_LEVELS) {
+        return vec4<f32>(level_colour(in.level) * c.a, c.a) * in.alpha;
+    }
+    if (mode == DEBUG_WEIGHTS) {
+        return vec4<f32>(direction_colour(in.dir) * c.a, c.a) * in.alpha;
+    }
+    if (mode == DEBUG_WIREFRAME) {
+        // Distance to the quad's nearest edge in pixels: a line about one pixel wide.
+        let e = min(fract(g), vec2<f32>(1.0) - fract(g)) / px;
+        if (min(e.x, e.y) < 1.0) {
+            return vec4<f32>(1.0, 0.95, 0.2, 1.0) * in.alpha;
+        }
+    }
     return c * in.alpha;
 }
 

@@ -13,7 +13,8 @@ pub struct GpuCamera {
     pub eye: [f32; 4],
     /// Unit view direction (world).
     pub forward: [f32; 4],
-    /// Viewport width and height in pixels.
+    /// Viewport width and height in pixels; `z`: the draw pass's debug view
+    /// ([`crate::renderer::DebugView`] as a number, 0 = off); `w` unused.
     pub viewport: [f32; 4],
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],

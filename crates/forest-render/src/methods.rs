@@ -45,6 +45,8 @@ pub struct MethodStats {
     pub primitives: u64,
     /// Trees drawn as billboards (discrete LODs).
     pub billboards: u32,
+    /// Quads per hierarchy level (quad-stream methods; empty for the others).
+    pub per_level: Vec<u32>,
     /// Quads dropped or left unrefined for lack of room (quad-stream methods).
     pub overflow: u32,
     /// GPU pass times, where the adapter has timestamp queries.
@@ -142,6 +144,7 @@ impl ForestRenderer {
                     visible_trees: s.visible_trees,
                     primitives: s.triangles,
                     billboards: s.billboards,
+                    per_level: Vec::new(),
                     overflow: 0,
                     times: s.times,
                 }
@@ -152,6 +155,7 @@ impl ForestRenderer {
                     visible_trees: s.visible_trees,
                     primitives: u64::from(s.quads),
                     billboards: 0,
+                    per_level: s.per_level,
                     overflow: s.overflow_cull + s.overflow_refine,
                     times: s.times,
                 }

@@ -104,6 +104,65 @@ pub struct FrameStats {
     pub times: Option<PassTimes>,
 }
 
+/// What the draw pass shows: the stream's colours, or one of the viewer's debug views.
+/// Takes effect with the next camera write (it travels in the camera uniform's `viewport.z`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DebugView {
+    /// The textured quads (the product).
+    #[default]
+    Off,
+    /// Every quad in the colour of its hierarchy level ([`LEVEL_COLOURS`]), times its coverage.
+    Levels,
+    /// Every quad in the colour of its sampling direction, blended with its aspect weight, so
+    /// the mix of directions at a pixel shows the blend.
+    Weights,
+    /// The textured quads with their outlines drawn over them.
+    Wireframe,
+}
+
+impl DebugView {
+    /// Every view, in the order the viewer cycles through them.
+    pub const ALL: [DebugView; 4] = [
+        DebugView::Off,
+        DebugView::Levels,
+        DebugView::Weights,
+        DebugView::Wireframe,
+    ];
+
+    /// Short name for menus and file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            DebugView::Off => "off",
+            DebugView::Levels => "levels",
+            DebugView::Weights => "blend weights",
+            DebugView::Wireframe => "wireframe",
+        }
+    }
+}
+
+/// Colours of levels 0, 1, … in the [`DebugView::Levels`] view (linear RGB; level `l` uses
+/// entry `l % 8`). Mirrored by `level_colour` in `shaders/draw.wgsl`.
+pub const LEVEL_COLOURS: [[f32; 3]; 8] = [
+    [0.9, 0.1, 0.1],
+    [0.95, 0.55, 0.05],
+    [0.9, 0.9, 0.1],
+    [0.1, 0.8, 0.1],
+    [0.1, 0.8, 0.8],
+    [0.1, 0.2, 0.95],
+    [0.6, 0.1, 0.9],
+    [0.95, 0.95, 0.95],
+];
+
+/// Colour of sampling direction `dir` in the [`DebugView::Weights`] view (linear RGB): hues
+/// spaced by the golden ratio, softened. Mirrors `direction_colour` in `shaders/draw.wgsl`.
+pub fn direction_colour(dir: u32) -> [f32; 3] {
+    let h = (dir as f32 * 0.618034).fract();
+    [0.0, 2.0 / 3.0, 1.0 / 3.0].map(|k: f32| {
+        let v = (((h + k).fract() * 6.0 - 3.0).abs() - 1.0).clamp(0.0, 1.0);
+        0.15 + 0.8 * v
+    })
+}
+
 /// Background colour (sky) the demo clears to, linear RGB.
 pub const SKY: wgpu::Color = wgpu::Color {
     r: 0.45,
@@ -152,6 +211,7 @@ pub struct QuadStream {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     writes: Cell<(u64, u64)>,
     camera_set: Cell<bool>,
+    debug: Cell<DebugView>,
     background: Background,
     owned: Vec<(&'static str, wgpu::Buffer)>,
 }
@@ -374,6 +434,7 @@ impl QuadStream {
             queries,
             writes: Cell::new((0, 0)),
             camera_set: Cell::new(false),
+            debug: Cell::new(DebugView::Off),
             background: opts.background,
             owned,
         })
@@ -382,6 +443,16 @@ impl QuadStream {
     /// Number of refinement iterations per frame (`max levels − 1`; 0 without refinement).
     pub fn iterations(&self) -> u32 {
         self.iterations.get()
+    }
+
+    /// Choose what the draw pass shows from the next camera write on.
+    pub fn set_debug_view(&self, view: DebugView) {
+        self.debug.set(view);
+    }
+
+    /// The debug view in use.
+    pub fn debug_view(&self) -> DebugView {
+        self.debug.get()
     }
 
     /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
@@ -420,7 +491,8 @@ impl QuadStream {
     /// Write the camera: the one upload of a frame.
     pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
         camera.validate()?;
-        let g = camera.to_gpu();
+        let mut g = camera.to_gpu();
+        g.viewport[2] = self.debug.get() as u32 as f32;
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
         let (n, bytes) = self.writes.get();
