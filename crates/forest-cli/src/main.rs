@@ -7,6 +7,7 @@ use clap::Parser;
 mod bake;
 mod bench;
 mod compare;
+mod demo;
 mod render;
 mod scene;
 mod view;

@@ -1,13 +1,14 @@
 //! `forest view`: the walkthrough viewer — a window (see [`crate::window`]), or, with
 //! `--path FILE --frames DIR`, a recorded camera path played back headless to numbered PNGs.
+//! Without a forest file it opens the bundled demo forest ([`crate::demo`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::camera_path::CameraPath;
 use forest_render::methods::{ForestRenderer, Method};
-use forest_render::renderer::{Background, RendererOptions};
+use forest_render::renderer::{Background, DebugView, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 use glam::Vec3;
@@ -17,9 +18,11 @@ use crate::render::{MethodArgs, load_scene, parse_size, prepare_models, write_pn
 /// Arguments of `forest view`.
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// Forest file (binary .forest or .json).
-    pub forest: PathBuf,
-    /// Camera path (JSON, see `forest_format::camera_path`) to play back.
+    /// Forest file (binary .forest or .json); without it, the bundled demo forest (its trees
+    /// baked on first use and cached in out/, run from the repository's folder).
+    pub forest: Option<PathBuf>,
+    /// Camera path (JSON, see `forest_format::camera_path`) to play back: in the window from
+    /// its first key (P replays it), or headless with --frames.
     #[arg(long)]
     pub path: Option<PathBuf>,
     /// Render the path headless to DIR/frame-00000.png, … and exit.
@@ -28,6 +31,14 @@ pub struct ViewArgs {
     /// Where R saves a recorded camera path (interactive mode).
     #[arg(long, default_value = "camera-path.json")]
     pub record: PathBuf,
+    /// Folder F12 screenshots go to (screenshot-NNN.png, with its camera as a one-key path
+    /// screenshot-NNN.json).
+    #[arg(long, default_value = ".")]
+    pub screenshots: PathBuf,
+    /// Debug view of the quad-stream methods: off, levels (quads coloured by level), weights
+    /// (by sampling direction, blended by aspect weight), wireframe (quad outlines).
+    #[arg(long, default_value = "off", value_parser = parse_debug_view)]
+    pub debug_view: DebugView,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -38,10 +49,34 @@ pub struct ViewArgs {
     pub m: MethodArgs,
 }
 
+fn parse_debug_view(s: &str) -> Result<DebugView, String> {
+    DebugView::ALL
+        .into_iter()
+        .find(|v| v.name().split(' ').next() == Some(s))
+        .ok_or_else(|| format!("{s:?}: expected off, levels, weights or wireframe"))
+}
+
 /// Run `forest view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
+    let mut args_models = args.m.clone();
+    let forest_file = match &args.forest {
+        Some(f) => f.clone(),
+        None => {
+            let demo = crate::demo::prepare()?;
+            if args_models.models.is_empty() {
+                args_models.models = demo.models;
+            }
+            demo.forest
+        }
+    };
+    if !args.screenshots.is_dir() {
+        bail!(
+            "screenshot folder {} does not exist",
+            args.screenshots.display()
+        );
+    }
     let Some(frames) = &args.frames else {
-        return interactive(args);
+        return interactive(args, &forest_file, &args_models);
     };
     let path_file = args
         .path
@@ -51,13 +86,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     if !frames.is_dir() {
         bail!("frames folder {} does not exist", frames.display());
     }
-    let (forest, species) = load_scene(&args.forest)?;
-    let mesh_method = args.m.checked_method(forest.species.len())?;
+    let (forest, species) = load_scene(&forest_file)?;
+    let mesh_method = args_models.checked_method(forest.species.len())?;
     let ctx = GpuContext::headless()?;
     let geometry = match mesh_method {
         Some(_) => Some(forest_render::geometry::GeometryRenderer::new(
             &ctx,
-            &prepare_models(&args.m.models, &species)?,
+            &prepare_models(&args_models.models, &species)?,
             &forest,
             TARGET_FORMAT,
             Background::Sky,
@@ -75,6 +110,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         QuadStream::new(&ctx, GpuScene::new(&ctx, &species, &forest)?, &opts)?,
         geometry,
     );
+    r.stream.set_debug_view(args.debug_view);
     let method = match (args.m.method.as_str(), mesh_method) {
         (_, Some(m)) => Method::Mesh(m),
         ("impostor", None) => Method::Impostor,
@@ -120,16 +156,21 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 }
 
 /// The window: walk through the forest with every method at hand.
-fn interactive(args: &ViewArgs) -> Result<()> {
-    let (forest, species) = load_scene(&args.forest)?;
-    let mesh_method = args.m.checked_method(forest.species.len())?;
-    let prepared = if args.m.models.is_empty() {
+fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()> {
+    let (forest, species) = load_scene(forest_file)?;
+    let mesh_method = m.checked_method(forest.species.len())?;
+    let prepared = if m.models.is_empty() {
         None
     } else {
-        Some(prepare_models(&args.m.models, &species)?)
+        Some(prepare_models(&m.models, &species)?)
     };
+    let path = args.path.as_deref().map(CameraPath::load).transpose()?;
     let far = (forest.extent() * 3.0 + 100.0).max(1000.0);
     let methods = crate::window::offered(mesh_method, prepared.is_some());
+    let start = methods
+        .iter()
+        .position(|x| x.name() == m.method)
+        .unwrap_or(0);
     let (size, epsilon) = (args.size, args.epsilon);
     let build: crate::window::Build = Box::new(move |ctx, format| {
         let opts = RendererOptions {
@@ -156,21 +197,17 @@ fn interactive(args: &ViewArgs) -> Result<()> {
             geometry,
         ))
     });
-    let walker = crate::window::Walker {
-        eye: Vec3::new(0.0, crate::window::EYE_HEIGHT, 0.0),
-        yaw: 0.0,
-        pitch: 0.0,
-        speed: 5.0,
-        walk: true,
-    };
-    crate::window::Viewer::new(
+    crate::window::Viewer::new(crate::window::Settings {
         build,
         size,
-        walker,
         epsilon,
         far,
         methods,
-        args.record.clone(),
-    )
+        method: start,
+        debug_view: args.debug_view,
+        path,
+        record_to: args.record.clone(),
+        screenshots: args.screenshots.clone(),
+    })
     .run()
 }

@@ -1,11 +1,17 @@
 //! The interactive part of `forest view`: a winit window with a wgpu surface, walk/fly
-//! controls, and an egui HUD (frame time, per-pass GPU times, counters, ε, method switch).
+//! controls, and an egui HUD (frame time, per-pass GPU times, counters, quads per level, ε,
+//! method switch, debug views).
 //!
-//! Controls: W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks around,
-//! Shift runs, mouse wheel changes speed, F toggles walk/fly, F12 saves a screenshot, R starts
-//! and stops recording a camera path, Esc quits.
+//! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
+//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–5 pick a method, V
+//! cycles the debug views, H hides the HUD, F12 saves a screenshot, R starts and stops
+//! recording a camera path, P plays the `--path` back, Esc quits.
+//!
+//! On stdout the viewer says when its first frame is on screen and where each screenshot went
+//! (one line each), so scripts and the tests can drive it.
 
 use std::collections::HashSet;
+use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,6 +23,7 @@ use forest_render::context::GpuContext;
 use forest_render::geometry::MeshMethod;
 use forest_render::methods::{ForestRenderer, Method, MethodStats};
 use forest_render::passes::draw::DEPTH_FORMAT;
+use forest_render::renderer::DebugView;
 use glam::Vec3;
 use winit::application::ApplicationHandler;
 use winit::event::{DeviceEvent, ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -26,6 +33,14 @@ use winit::window::{Window, WindowId};
 
 /// Eye height above the ground in walk mode (metres).
 pub const EYE_HEIGHT: f32 = 1.7;
+
+/// The key list shown on screen.
+pub const KEYS: [&str; 4] = [
+    "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
+    "F: walk/fly · 1-5: method · V: debug view · H: hide HUD",
+    "F12: screenshot · R: record path · P: play --path · Esc: quit",
+    "",
+];
 
 /// What the window needs to build its renderer once it has a device.
 pub type Build = Box<dyn Fn(&GpuContext, wgpu::TextureFormat) -> Result<ForestRenderer>>;
@@ -53,6 +68,18 @@ impl Walker {
             self.pitch.sin(),
             -self.yaw.cos() * self.pitch.cos(),
         )
+    }
+
+    /// A walker at `eye` looking at `target` (fly mode unless the eye is at walking height).
+    pub fn looking_at(eye: Vec3, target: Vec3, speed: f32) -> Self {
+        let d = (target - eye).normalize_or(Vec3::NEG_Z);
+        Self {
+            eye,
+            yaw: d.x.atan2(-d.z),
+            pitch: d.y.clamp(-1.0, 1.0).asin().clamp(-1.48, 1.48),
+            speed,
+            walk: (eye.y - EYE_HEIGHT).abs() < 1e-3,
+        }
     }
 
     /// Move for `dt` seconds with the pressed keys.
@@ -105,6 +132,30 @@ struct Gfx {
     egui_renderer: egui_wgpu::Renderer,
 }
 
+/// What a viewer starts with.
+pub struct Settings {
+    /// Builds the renderer once the window has a device.
+    pub build: Build,
+    /// Starting window size in pixels.
+    pub size: (u32, u32),
+    /// Starting ε in pixels.
+    pub epsilon: f32,
+    /// Far plane (metres).
+    pub far: f32,
+    /// The methods offered (see [`offered`]).
+    pub methods: Vec<Method>,
+    /// Index of the starting method in `methods`.
+    pub method: usize,
+    /// Starting debug view.
+    pub debug_view: DebugView,
+    /// A camera path to play from the start (P replays it).
+    pub path: Option<CameraPath>,
+    /// Where R saves a recorded path.
+    pub record_to: PathBuf,
+    /// Folder of F12 screenshots.
+    pub screenshots: PathBuf,
+}
+
 /// The viewer application.
 pub struct Viewer {
     build: Build,
@@ -112,8 +163,16 @@ pub struct Viewer {
     walker: Walker,
     epsilon: f32,
     far: f32,
+    fov_deg: f32,
     methods: Vec<Method>,
     method: usize,
+    debug: DebugView,
+    show_hud: bool,
+    path: Option<CameraPath>,
+    /// Next key of `path` to show while playing.
+    playing: Option<usize>,
+    screenshots: PathBuf,
+    first_frame: bool,
     keys: HashSet<KeyCode>,
     looking: bool,
     last: Instant,
@@ -128,31 +187,44 @@ pub struct Viewer {
 }
 
 impl Viewer {
-    /// A viewer starting at `walker`, offering `methods` (the first is shown first).
-    pub fn new(
-        build: Build,
-        size: (u32, u32),
-        walker: Walker,
-        epsilon: f32,
-        far: f32,
-        methods: Vec<Method>,
-        record_to: PathBuf,
-    ) -> Self {
+    /// A viewer with these settings, standing at the origin (or at the path's first key).
+    pub fn new(st: Settings) -> Self {
+        let walker = match &st.path {
+            Some(p) => Walker::looking_at(
+                Vec3::from_array(p.keys[0].eye),
+                Vec3::from_array(p.keys[0].target),
+                5.0,
+            ),
+            None => Walker {
+                eye: Vec3::new(0.0, EYE_HEIGHT, 0.0),
+                yaw: 0.0,
+                pitch: 0.0,
+                speed: 5.0,
+                walk: true,
+            },
+        };
         Self {
-            build,
-            size,
+            build: st.build,
+            size: st.size,
             walker,
-            epsilon,
-            far,
-            methods,
-            method: 0,
+            epsilon: st.epsilon,
+            far: st.far,
+            fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),
+            method: st.method.min(st.methods.len().saturating_sub(1)),
+            methods: st.methods,
+            debug: st.debug_view,
+            show_hud: true,
+            playing: st.path.as_ref().map(|_| 0),
+            path: st.path,
+            screenshots: st.screenshots,
+            first_frame: true,
             keys: HashSet::new(),
             looking: false,
             last: Instant::now(),
             frame_ms: 0.0,
             stats: MethodStats::default(),
             recording: None,
-            record_to,
+            record_to: st.record_to,
             shots: 0,
             message: String::new(),
             gfx: None,
@@ -179,10 +251,17 @@ impl Viewer {
             .as_ref()
             .map(|g| (g.config.width, g.config.height))
             .unwrap_or(self.size);
+        let (eye, target) = match (&self.path, self.playing) {
+            (Some(p), Some(i)) => {
+                let k = p.keys[i.min(p.keys.len() - 1)];
+                (Vec3::from_array(k.eye), Vec3::from_array(k.target))
+            }
+            _ => (self.walker.eye, self.walker.eye + self.walker.forward()),
+        };
         Camera {
-            eye: self.walker.eye,
-            target: self.walker.eye + self.walker.forward(),
-            fov_y_deg: 60.0,
+            eye,
+            target,
+            fov_y_deg: self.fov_deg,
             near: 0.1,
             far: self.far,
             viewport: size,
@@ -233,6 +312,7 @@ impl Viewer {
         surface.configure(&ctx.device, &config);
         let renderer = (self.build)(&ctx, format)?;
         renderer.set_method(&ctx, self.methods[self.method])?;
+        renderer.stream.set_debug_view(self.debug);
         let egui = egui::Context::default();
         let egui_state = egui_winit::State::new(
             egui.clone(),
@@ -259,8 +339,12 @@ impl Viewer {
         Ok(())
     }
 
-    fn hud(&mut self, ui_ctx: &egui::Context) -> Option<usize> {
-        let mut choice = None;
+    /// The HUD; returns the method and debug view picked with the mouse, if any.
+    fn hud(&mut self, ui_ctx: &egui::Context) -> (Option<usize>, Option<DebugView>) {
+        let (mut method, mut debug) = (None, None);
+        if !self.show_hud {
+            return (method, debug);
+        }
         let s = &self.stats;
         egui::Window::new("forest").show(ui_ctx, |ui| {
             ui.label(format!(
@@ -268,35 +352,88 @@ impl Viewer {
                 self.frame_ms,
                 1000.0 / self.frame_ms.max(1e-3)
             ));
-            if let Some(t) = s.times {
-                ui.label(format!(
+            match s.times {
+                Some(t) if matches!(self.methods[self.method], Method::Mesh(_)) => ui.label(
+                    format!("GPU: cull {:.2} ms, draw {:.2} ms", t.cull_ms, t.draw_ms),
+                ),
+                Some(t) => ui.label(format!(
                     "GPU: cull {:.2} ms, refine {:.2} ms, draw {:.2} ms",
                     t.cull_ms, t.refine_ms, t.draw_ms
-                ));
-            }
+                )),
+                None => ui.label("GPU pass times: no timestamp queries on this adapter"),
+            };
+            let unit = if matches!(self.methods[self.method], Method::Mesh(_)) {
+                "triangles"
+            } else {
+                "quads"
+            };
             ui.label(format!(
-                "{} visible trees, {} primitives, {} billboards, overflow {}",
+                "{} visible trees, {} {unit}, {} billboards, overflow {}",
                 s.visible_trees, s.primitives, s.billboards, s.overflow
             ));
+            if !s.per_level.is_empty() {
+                let levels: Vec<String> = s
+                    .per_level
+                    .iter()
+                    .enumerate()
+                    .map(|(l, n)| format!("{l}: {n}"))
+                    .collect();
+                ui.label(format!("quads per level: {}", levels.join(" · ")));
+            }
             ui.add(egui::Slider::new(&mut self.epsilon, 0.5..=64.0).text("ε (px)"));
             ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
             ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
+            ui.label("method:");
             for (i, m) in self.methods.iter().enumerate() {
-                if ui.radio(i == self.method, m.name()).clicked() {
-                    choice = Some(i);
+                if ui
+                    .radio(i == self.method, format!("{} {}", i + 1, m.name()))
+                    .clicked()
+                {
+                    method = Some(i);
                 }
             }
+            ui.label("debug view (quad-stream methods):");
+            ui.horizontal(|ui| {
+                for v in DebugView::ALL {
+                    if ui.radio(v == self.debug, v.name()).clicked() {
+                        debug = Some(v);
+                    }
+                }
+            });
             ui.separator();
-            ui.label("W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run");
-            ui.label("wheel: speed · F: walk/fly · F12: screenshot · R: record path · Esc: quit");
+            for k in KEYS.iter().filter(|k| !k.is_empty()) {
+                ui.label(*k);
+            }
             if let Some(p) = &self.recording {
                 ui.label(format!("recording: {} keys", p.keys.len()));
+            }
+            if let (Some(p), Some(i)) = (&self.path, self.playing) {
+                ui.label(format!(
+                    "playing the path: key {} of {}",
+                    i + 1,
+                    p.keys.len()
+                ));
             }
             if !self.message.is_empty() {
                 ui.label(&self.message);
             }
         });
-        choice
+        (method, debug)
+    }
+
+    fn set_method(&mut self, i: usize) -> Result<()> {
+        if let (Some(g), Some(m)) = (&self.gfx, self.methods.get(i)) {
+            g.renderer.set_method(&g.ctx, *m)?;
+            self.method = i;
+        }
+        Ok(())
+    }
+
+    fn set_debug(&mut self, v: DebugView) {
+        self.debug = v;
+        if let Some(g) = &self.gfx {
+            g.renderer.stream.set_debug_view(v);
+        }
     }
 
     fn frame(&mut self) -> Result<()> {
@@ -306,19 +443,28 @@ impl Viewer {
         self.last = now;
         self.walker.step(&self.keys, dt);
         let cam = self.camera();
+        if let (Some(p), Some(i)) = (&self.path, self.playing) {
+            // One key per frame; at the end, control returns at the last key.
+            if i + 1 >= p.keys.len() {
+                self.playing = None;
+                self.walker = Walker::looking_at(cam.eye, cam.target, self.walker.speed);
+            } else {
+                self.playing = Some(i + 1);
+            }
+        }
         if let Some(p) = &mut self.recording {
             p.push(cam.eye, cam.target);
         }
         let Some(mut g) = self.gfx.take() else {
             return Ok(());
         };
-        let result = (|| -> Result<()> {
+        let result = (|| -> Result<(Option<usize>, Option<DebugView>)> {
             let output = match g.surface.get_current_texture() {
                 wgpu::CurrentSurfaceTexture::Success(t)
                 | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
                 _ => {
                     g.surface.configure(&g.ctx.device, &g.config);
-                    return Ok(());
+                    return Ok((None, None));
                 }
             };
             let view = output.texture.create_view(&Default::default());
@@ -326,7 +472,7 @@ impl Viewer {
             g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
             let raw = g.egui_state.take_egui_input(&g.window);
             let ui_ctx = g.egui.clone();
-            let mut choice = None;
+            let mut choice = (None, None);
             let mut out = ui_ctx.run_pass(raw, |c| choice = self.hud(c));
             // egui insists that texture updates are consumed: take them out now.
             let set: Vec<_> = out.textures_delta.set.drain().collect();
@@ -379,37 +525,65 @@ impl Viewer {
             g.window.pre_present_notify();
             g.ctx.queue.present(output);
             self.stats = g.renderer.read_stats(&g.ctx);
-            if let Some(i) = choice {
-                g.renderer.set_method(&g.ctx, self.methods[i])?;
-                self.method = i;
-            }
             let errors = g.ctx.take_errors();
             if !errors.is_empty() {
                 anyhow::bail!("the GPU reported: {}", errors.join("; "));
             }
-            Ok(())
+            if self.first_frame {
+                self.first_frame = false;
+                println!(
+                    "forest view: first frame on screen ({}, {:?}, {}x{})",
+                    g.ctx.adapter_info.name, g.config.format, g.config.width, g.config.height
+                );
+                std::io::stdout().flush()?;
+            }
+            Ok(choice)
         })();
         self.gfx = Some(g);
-        result
+        let (method, debug) = result?;
+        if let Some(i) = method {
+            self.set_method(i)?;
+        }
+        if let Some(v) = debug {
+            self.set_debug(v);
+        }
+        Ok(())
     }
 
+    /// Render the current view (without the HUD) offscreen with the window's pipelines and
+    /// save it, with its camera as a one-key path beside it.
     fn screenshot(&mut self) -> Result<()> {
         let Some(g) = &self.gfx else { return Ok(()) };
-        if g.config.format != forest_render::target::TARGET_FORMAT {
-            self.message = format!(
-                "screenshots need an {:?} surface; this one is {:?} (use --path/--frames)",
-                forest_render::target::TARGET_FORMAT,
-                g.config.format
-            );
-            return Ok(());
-        }
         let cam = self.camera();
-        let target = forest_render::target::Target::new(&g.ctx, cam.viewport.0, cam.viewport.1);
+        let target = forest_render::target::Target::with_format(
+            &g.ctx,
+            cam.viewport.0,
+            cam.viewport.1,
+            g.config.format,
+        )?;
         g.renderer.render_frame(&g.ctx, &cam, &target)?;
-        let out = PathBuf::from(format!("screenshot-{:03}.png", self.shots));
-        crate::render::write_png(&target.read(&g.ctx), &out)?;
+        let img = target.read(&g.ctx);
+        let errors = g.ctx.take_errors();
+        if !errors.is_empty() {
+            anyhow::bail!("the GPU reported: {}", errors.join("; "));
+        }
+        let base = self
+            .screenshots
+            .join(format!("screenshot-{:03}", self.shots));
+        let png = base.with_extension("png");
+        crate::render::write_png(&img, &png)?;
+        let mut key = CameraPath::new(cam.fov_y_deg);
+        key.push(cam.eye, cam.target);
+        key.save(&base.with_extension("json"))?;
         self.shots += 1;
-        self.message = format!("saved {}", out.display());
+        self.message = format!("saved {}", png.display());
+        println!(
+            "forest view: saved {} ({}, debug view {})",
+            png.display(),
+            self.methods[self.method].name(),
+            self.debug.name()
+        );
+        std::io::stdout().flush()?;
         Ok(())
     }
 
@@ -425,6 +599,18 @@ impl Viewer {
         match code {
             KeyCode::Escape => event_loop.exit(),
             KeyCode::KeyF => self.walker.walk = !self.walker.walk,
+            KeyCode::KeyH => self.show_hud = !self.show_hud,
+            KeyCode::KeyV => {
+                let i = DebugView::ALL.iter().position(|v| *v == self.debug);
+                let next = DebugView::ALL[(i.unwrap_or(0) + 1) % DebugView::ALL.len()];
+                self.set_debug(next);
+            }
+            KeyCode::KeyP if self.path.is_some() => self.playing = Some(0),
+            KeyCode::Digit1 => self.set_method(0)?,
+            KeyCode::Digit2 => self.set_method(1)?,
+            KeyCode::Digit3 => self.set_method(2)?,
+            KeyCode::Digit4 => self.set_method(3)?,
+            KeyCode::Digit5 => self.set_method(4)?,
             KeyCode::F12 => self.screenshot()?,
             KeyCode::KeyR => match self.recording.take() {
                 Some(p) if !p.keys.is_empty() => {

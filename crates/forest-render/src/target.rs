@@ -3,7 +3,8 @@
 use crate::context::GpuContext;
 use crate::passes::draw::DEPTH_FORMAT;
 
-/// Colour (`Rgba8UnormSrgb`) and depth textures of one size.
+/// Colour (`Rgba8UnormSrgb` unless made [`Target::with_format`]) and depth textures of one
+/// size.
 pub struct Target {
     /// Colour texture.
     pub colour: wgpu::Texture,
@@ -15,6 +16,8 @@ pub struct Target {
     pub depth_view: wgpu::TextureView,
     /// Size in pixels.
     pub size: (u32, u32),
+    /// Colour format.
+    pub format: wgpu::TextureFormat,
 }
 
 /// Begin a render pass that clears `colour` to `clear` and `depth` to 1.
@@ -54,9 +57,38 @@ pub fn begin_pass<'e>(
 /// Colour format of [`Target`].
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
+/// Colour formats a [`Target`] can be made in and read back from (8-bit RGBA or BGRA: what
+/// window surfaces offer).
+pub const READABLE_FORMATS: [wgpu::TextureFormat; 4] = [
+    wgpu::TextureFormat::Rgba8UnormSrgb,
+    wgpu::TextureFormat::Bgra8UnormSrgb,
+    wgpu::TextureFormat::Rgba8Unorm,
+    wgpu::TextureFormat::Bgra8Unorm,
+];
+
 impl Target {
-    /// Create a target of `width × height` pixels.
+    /// Create a target of `width × height` pixels in [`TARGET_FORMAT`].
     pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Self {
+        Self::make(ctx, width, height, TARGET_FORMAT)
+    }
+
+    /// Create a target in another colour format (one of [`READABLE_FORMATS`]), for pipelines
+    /// built for a window surface's format; [`Target::read`] still returns RGBA.
+    pub fn with_format(
+        ctx: &GpuContext,
+        width: u32,
+        height: u32,
+        format: wgpu::TextureFormat,
+    ) -> Result<Self, crate::context::RenderError> {
+        if !READABLE_FORMATS.contains(&format) {
+            return Err(crate::context::RenderError::Scene(format!(
+                "cannot read back a {format:?} target: use one of {READABLE_FORMATS:?}"
+            )));
+        }
+        Ok(Self::make(ctx, width, height, format))
+    }
+
+    fn make(ctx: &GpuContext, width: u32, height: u32, format: wgpu::TextureFormat) -> Self {
         let make = |label, format, usage| {
             ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -75,7 +107,7 @@ impl Target {
         };
         let colour = make(
             "target colour",
-            TARGET_FORMAT,
+            format,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );
         let depth = make(
@@ -89,10 +121,12 @@ impl Target {
             colour,
             depth,
             size: (width, height),
+            format,
         }
     }
 
-    /// Read the colour back as an sRGB RGBA8 image (waits for the GPU).
+    /// Read the colour back as an RGBA8 image (sRGB-encoded for the sRGB formats; BGRA
+    /// targets are swizzled); waits for the GPU.
     pub fn read(&self, ctx: &GpuContext) -> image::RgbaImage {
         let (w, h) = self.size;
         let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
@@ -129,6 +163,14 @@ impl Target {
         for y in 0..h as usize {
             let src = &data[y * row as usize..y * row as usize + w as usize * 4];
             img.as_mut()[y * w as usize * 4..(y + 1) * w as usize * 4].copy_from_slice(src);
+        }
+        if matches!(
+            self.format,
+            wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Bgra8Unorm
+        ) {
+            for p in img.pixels_mut() {
+                p.0.swap(0, 2);
+            }
         }
         img
     }

@@ -176,3 +176,37 @@ fn bc7_colour_renders_like_rgba8() {
     assert!(mean <= 0.05, "BC7 vs RGBA8: mean FLIP {mean:.4}");
     assert!(mean > 0.0, "BC7 is lossy: the images cannot be identical");
 }
+
+#[test]
+fn a_bgra_target_reads_back_like_an_rgba_one() {
+    // Window surfaces are often BGRA: the viewer's screenshots render into a target of the
+    // surface's format with the surface's pipelines and read it back as RGBA.
+    let ctx = common::ctx();
+    let forest = common::forest(50);
+    let (name, cam) = common::cameras(forest.extent()).remove(0);
+    let mut images = Vec::new();
+    for format in [
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+        wgpu::TextureFormat::Bgra8UnormSrgb,
+    ] {
+        let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+        let opts = RendererOptions {
+            viewport: (160, 120),
+            format,
+            ..Default::default()
+        };
+        let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+        let target = Target::with_format(&ctx, 160, 120, format).unwrap();
+        stream.render_frame(&ctx, &cam, &target).unwrap();
+        images.push(target.read(&ctx));
+        assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    }
+    assert!(
+        images[0] == images[1],
+        "{name}: BGRA read-back differs from RGBA"
+    );
+    assert!(
+        Target::with_format(&ctx, 4, 4, wgpu::TextureFormat::Rgba16Float).is_err(),
+        "an unreadable format is refused"
+    );
+}

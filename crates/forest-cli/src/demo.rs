@@ -1,0 +1,194 @@
+//! The bundled demo forest that `forest view` opens when given no forest: the five bundled tree
+//! models (`assets/trees/`) baked into `out/atlases/` on first use, and again when a model's
+//! files change, and a forest of [`TREES`] trees over them in `out/forest-view.forest`. The
+//! same commands as `scripts/demo.sh`, so the two share their cache.
+
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
+
+use anyhow::{Context, Result, bail};
+
+/// The bundled species, in the demo forest's species order.
+pub const SPECIES: [&str; 5] = ["oak", "ash", "aspen", "pine", "bush"];
+
+/// Trees in the viewer's demo forest (10 m² each: about 450 m across).
+pub const TREES: u32 = 20_000;
+
+/// The demo forest file and the OBJ models of its species (for the geometry-based methods).
+pub struct Demo {
+    /// The forest file.
+    pub forest: PathBuf,
+    /// One OBJ per species, in the forest's species order.
+    pub models: Vec<PathBuf>,
+}
+
+/// Parse `args` as the sub-command `name` would, defaults included: one place for defaults.
+fn parse_args<A: clap::Args + clap::FromArgMatches>(
+    name: &'static str,
+    args: &[&str],
+) -> Result<A> {
+    let cmd = A::augment_args(clap::Command::new(name));
+    let m = cmd.try_get_matches_from(std::iter::once(name).chain(args.iter().copied()))?;
+    Ok(A::from_arg_matches(&m)?)
+}
+
+/// The folder holding `assets/trees/`: the working folder, else the source tree this binary
+/// was built from.
+fn root() -> Result<PathBuf> {
+    let candidates = [
+        PathBuf::from("."),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."),
+    ];
+    candidates
+        .into_iter()
+        .find(|r| r.join("assets/trees/oak/oak.obj").is_file())
+        .context(
+            "no forest given and the bundled tree models (assets/trees/) are not here: run \
+             from the repository's folder, or give a forest file (forest view FOREST)",
+        )
+}
+
+fn modified(p: &Path) -> Option<SystemTime> {
+    std::fs::metadata(p).and_then(|m| m.modified()).ok()
+}
+
+/// Newest modification time of the files directly in `dir`.
+fn newest_in(dir: &Path) -> Result<SystemTime> {
+    let mut newest = SystemTime::UNIX_EPOCH;
+    for e in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let e = e?;
+        if e.file_type()?.is_file()
+            && let Some(t) = modified(&e.path())
+        {
+            newest = newest.max(t);
+        }
+    }
+    Ok(newest)
+}
+
+/// Bake what is missing or stale and (re)generate the forest when an atlas is newer.
+pub fn prepare() -> Result<Demo> {
+    prepare_in(&root()?, &[])
+}
+
+/// [`prepare`] for the models in `root/assets/trees/`, caching in `root/out/`, with
+/// `bake_args` added to every bake (the tests bake small atlases).
+fn prepare_in(root: &Path, bake_args: &[&str]) -> Result<Demo> {
+    let out = root.join("out");
+    let atlases = out.join("atlases");
+    std::fs::create_dir_all(&atlases)
+        .with_context(|| format!("creating the demo cache {}", atlases.display()))?;
+    let mut models = Vec::new();
+    let mut atlas_paths = Vec::new();
+    let mut newest_atlas = SystemTime::UNIX_EPOCH;
+    for s in SPECIES {
+        let dir = root.join("assets/trees").join(s);
+        let model = dir.join(format!("{s}.obj"));
+        let atlas = atlases.join(format!("{s}.atlas"));
+        let manifest = atlas.join(forest_format::atlas::MANIFEST_FILE);
+        let fresh = match modified(&manifest) {
+            Some(t) => t >= newest_in(&dir)? && forest_format::Atlas::load(&atlas).is_ok(),
+            None => false,
+        };
+        if !fresh {
+            eprintln!(
+                "forest view: baking the demo species {s} into {} (first use; cached)",
+                atlas.display()
+            );
+            let (m, a) = (model.display().to_string(), atlas.display().to_string());
+            let args: Vec<&str> = [m.as_str(), "-o", a.as_str()]
+                .into_iter()
+                .chain(bake_args.iter().copied())
+                .collect();
+            crate::bake::run(&parse_args("bake", &args)?)?;
+        }
+        newest_atlas = newest_atlas.max(modified(&manifest).unwrap_or(SystemTime::now()));
+        atlas_paths.push(atlas.display().to_string());
+        models.push(model);
+    }
+    let forest = out.join("forest-view.forest");
+    if modified(&forest).is_none_or(|t| t < newest_atlas) {
+        let trees = TREES.to_string();
+        let (species, f) = (atlas_paths.join(","), forest.display().to_string());
+        let args = [
+            "--trees",
+            &trees,
+            "--area-per-tree",
+            "10",
+            "--species",
+            &species,
+            "--seed",
+            "1",
+            "-o",
+            &f,
+        ];
+        crate::scene::run(&parse_args("scene", &args)?)?;
+    }
+    if !forest.is_file() {
+        bail!("the demo forest {} was not written", forest.display());
+    }
+    Ok(Demo { forest, models })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sub_command_defaults_come_from_their_own_definitions() {
+        let b: crate::bake::BakeArgs = parse_args("bake", &["m.obj", "-o", "m.atlas"]).unwrap();
+        assert_eq!((b.directions, b.slabs, b.resolution), (15, 2, 512));
+        let s: crate::scene::SceneArgs =
+            parse_args("scene", &["--species", "a.atlas", "-o", "f.forest"]).unwrap();
+        assert_eq!(s.trees, 10_000);
+        assert!(parse_args::<crate::scene::SceneArgs>("scene", &["-o", "f"]).is_err());
+    }
+
+    #[test]
+    fn the_demo_bakes_once_and_again_only_what_changed() {
+        let tmp = tempfile::tempdir().unwrap();
+        let src = root().unwrap().join("assets/trees");
+        for s in SPECIES {
+            let d = tmp.path().join("assets/trees").join(s);
+            std::fs::create_dir_all(&d).unwrap();
+            for e in std::fs::read_dir(src.join(s)).unwrap() {
+                let e = e.unwrap();
+                std::fs::copy(e.path(), d.join(e.file_name())).unwrap();
+            }
+        }
+        let small = ["--resolution", "32", "--directions", "3", "--spp", "1"];
+        let stamp = |p: &Path| modified(p).unwrap();
+        let demo = prepare_in(tmp.path(), &small).unwrap();
+        assert_eq!(demo.models.len(), SPECIES.len());
+        let forest = forest_format::forest::Forest::load(&demo.forest).unwrap();
+        assert_eq!(forest.instances.len(), TREES as usize);
+        let manifest = |s: &str| {
+            tmp.path()
+                .join(format!("out/atlases/{s}.atlas/manifest.json"))
+        };
+        let before: Vec<_> = SPECIES.iter().map(|s| stamp(&manifest(s))).collect();
+        let forest_before = stamp(&demo.forest);
+        // Nothing changed: nothing is baked or generated again.
+        prepare_in(tmp.path(), &small).unwrap();
+        let same: Vec<_> = SPECIES.iter().map(|s| stamp(&manifest(s))).collect();
+        assert_eq!(same, before);
+        assert_eq!(stamp(&demo.forest), forest_before);
+        // A changed model re-bakes its species alone, and the forest follows.
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        let mtl = tmp.path().join("assets/trees/pine/pine.mtl");
+        std::fs::write(&mtl, std::fs::read(&mtl).unwrap()).unwrap();
+        prepare_in(tmp.path(), &small).unwrap();
+        for (s, t) in SPECIES.iter().zip(&before) {
+            assert_eq!(stamp(&manifest(s)) != *t, *s == "pine", "{s}");
+        }
+        assert!(stamp(&demo.forest) > forest_before);
+    }
+
+    #[test]
+    fn the_bundled_models_are_found() {
+        let r = root().unwrap();
+        for s in SPECIES {
+            assert!(r.join(format!("assets/trees/{s}/{s}.obj")).is_file(), "{s}");
+        }
+    }
+}

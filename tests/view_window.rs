@@ -1,0 +1,405 @@
+//! `forest view` used as a person would: under Xvfb with lavapipe, the test opens the window,
+//! drives keyboard and mouse through XTEST (xdotool), takes screenshots with F12, and compares
+//! them with a stored reference and with headless renders of the cameras they recorded (mean
+//! FLIP). Needs `Xvfb` and `xdotool` (scripts/setup.sh installs them).
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use forest_format::camera_path::CameraPath;
+use glam::Vec3;
+
+mod cli;
+
+use cli::{forest, model};
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn need(tool: &str) {
+    let found = Command::new("sh")
+        .args(["-c", &format!("command -v {tool}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "{tool} is not installed: the viewer's window test needs Xvfb and xdotool \
+         (apt-get install xvfb xdotool; scripts/setup.sh does it)"
+    );
+}
+
+/// A private X server, killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Self {
+        need("Xvfb");
+        let first = 200 + std::process::id() % 500;
+        for n in first..first + 50 {
+            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
+                || Path::new(&format!("/tmp/.X{n}-lock")).exists()
+            {
+                continue;
+            }
+            let mut child = Command::new("Xvfb")
+                .args([
+                    &format!(":{n}"),
+                    "-screen",
+                    "0",
+                    "640x480x24",
+                    "-nolisten",
+                    "tcp",
+                ])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .expect("Xvfb starts");
+            let t = Instant::now();
+            while t.elapsed() < Duration::from_secs(10) {
+                if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+                    return Self {
+                        child,
+                        display: format!(":{n}"),
+                    };
+                }
+                if child.try_wait().unwrap().is_some() {
+                    break; // display taken meanwhile: try the next
+                }
+                std::thread::sleep(Duration::from_millis(50));
+            }
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        panic!("could not start Xvfb on any display from :{first}");
+    }
+
+    fn xdotool(&self, args: &[&str]) -> String {
+        let out = Command::new("xdotool")
+            .args(args)
+            .env("DISPLAY", &self.display)
+            .output()
+            .expect("xdotool runs");
+        assert!(
+            out.status.success(),
+            "xdotool {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The viewer process and its stdout, line by line.
+struct Viewer {
+    child: Child,
+    lines: mpsc::Receiver<String>,
+    seen: Vec<String>,
+}
+
+impl Viewer {
+    /// Wait for a stdout line containing `text`.
+    fn wait_for(&mut self, text: &str, secs: u64) -> String {
+        let end = Instant::now() + Duration::from_secs(secs);
+        while let Some(left) = end.checked_duration_since(Instant::now()) {
+            match self.lines.recv_timeout(left) {
+                Ok(l) => {
+                    self.seen.push(l.clone());
+                    if l.contains(text) {
+                        return l;
+                    }
+                }
+                Err(_) => break,
+            }
+        }
+        let _ = self.child.kill();
+        let err = self.child.stderr.take().map(|mut e| {
+            let mut s = String::new();
+            std::io::Read::read_to_string(&mut e, &mut s).unwrap();
+            s
+        });
+        panic!(
+            "no {text:?} from the viewer within {secs} s; stdout {:?}, stderr {err:?}",
+            self.seen
+        );
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn out_dir() -> PathBuf {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/test-output");
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn key_of(path: &Path) -> (Vec3, Vec3) {
+    let p = CameraPath::load(path).unwrap();
+    assert_eq!(p.keys.len(), 1, "{}", path.display());
+    (
+        Vec3::from_array(p.keys[0].eye),
+        Vec3::from_array(p.keys[0].target),
+    )
+}
+
+#[test]
+fn walk_look_switch_and_screenshot_in_a_window() {
+    need("xdotool");
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    for s in ["bush", "pine"] {
+        ok(&forest(&[
+            "bake",
+            &model(s),
+            "-o",
+            &p(&format!("{s}.atlas")),
+            "--resolution",
+            "64",
+            "--directions",
+            "5",
+            "--spp",
+            "1",
+        ]));
+    }
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "300",
+        "--area-per-tree",
+        "20",
+        "--species",
+        &format!("{},{}", p("bush.atlas"), p("pine.atlas")),
+        "--seed",
+        "3",
+        "-o",
+        &p("f.forest"),
+    ]));
+    // A short path the window plays first; control returns at its last key.
+    let mut path = CameraPath::new(60.0);
+    for i in 0..3 {
+        let z = 50.0 - 2.0 * i as f32;
+        path.push(Vec3::new(0.0, 8.0, z), Vec3::new(-3.0, 0.0, z - 30.0));
+    }
+    path.save(&d.join("start.json")).unwrap();
+    let last = path.keys[2];
+    let shots = d.join("shots");
+    std::fs::create_dir(&shots).unwrap();
+
+    let x = Xvfb::start();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_forest"))
+        .args([
+            "view",
+            &p("f.forest"),
+            "--size",
+            "320x240",
+            "--path",
+            &p("start.json"),
+            "--screenshots",
+            shots.to_str().unwrap(),
+            "--models",
+            &format!("{},{}", model("bush"), model("pine")),
+        ])
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the forest binary runs");
+    let (tx, rx) = mpsc::channel();
+    let stdout = child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for l in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(l).is_err() {
+                break;
+            }
+        }
+    });
+    let mut v = Viewer {
+        child,
+        lines: rx,
+        seen: Vec::new(),
+    };
+    let first = v.wait_for("first frame on screen", 240);
+    assert!(first.contains("320x240"), "{first}");
+
+    let win = x.xdotool(&["search", "--sync", "--name", "^forest view$"]);
+    let win = win.lines().next().unwrap().to_string();
+    // No window manager: give the window the keyboard focus by hand, as a WM would on click.
+    x.xdotool(&["windowfocus", "--sync", &win]);
+    x.xdotool(&["mousemove", "--window", &win, "160", "120"]);
+    // H hides the HUD (so the mouse reaches the scene); F12 saves the view: the path's end.
+    x.xdotool(&["key", "h"]);
+    x.xdotool(&["key", "F12"]);
+    v.wait_for("screenshot-000.png", 60);
+
+    // Walk forward, look right with the right mouse button held, slow down with the wheel,
+    // then switch to static impostors (key 2) and the levels debug view (V).
+    x.xdotool(&["keydown", "w"]);
+    std::thread::sleep(Duration::from_millis(1000));
+    x.xdotool(&["keyup", "w"]);
+    x.xdotool(&["mousedown", "3"]);
+    for _ in 0..4 {
+        x.xdotool(&["mousemove_relative", "--", "15", "0"]);
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    x.xdotool(&["mouseup", "3"]);
+    x.xdotool(&["click", "5"]);
+    x.xdotool(&["key", "2"]);
+    x.xdotool(&["key", "v"]);
+    x.xdotool(&["key", "F12"]);
+    let saved = v.wait_for("screenshot-001.png", 60);
+    assert!(saved.contains("(impostor, debug view levels)"), "{saved}");
+    x.xdotool(&["key", "Escape"]);
+    let t = Instant::now();
+    let status = loop {
+        if let Some(s) = v.child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(30),
+            "Esc did not close the viewer"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(status.success(), "the viewer exited with {status}");
+
+    // The first screenshot is the path's last key, and looks like the stored reference.
+    let (eye0, target0) = key_of(&shots.join("screenshot-000.json"));
+    assert!(eye0.distance(Vec3::from_array(last.eye)) < 1e-4, "{eye0}");
+    let dir0 = (target0 - eye0).normalize();
+    let want = (Vec3::from_array(last.target) - Vec3::from_array(last.eye)).normalize();
+    assert!(dir0.dot(want) > 0.9999, "{dir0} vs {want}");
+    let shot0 = image::open(shots.join("screenshot-000.png"))
+        .unwrap()
+        .to_rgba8();
+    assert_eq!(shot0.dimensions(), (320, 240));
+    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/images/view-start.png");
+    let Ok(stored) = image::open(&reference) else {
+        shot0.save(&reference).unwrap();
+        panic!(
+            "no reference image: wrote {} (inspect it and commit it)",
+            reference.display()
+        );
+    };
+    let (mean, map) = forest_metrics::flip(&stored.to_rgba8(), &shot0).unwrap();
+    println!("screenshot vs stored reference: mean FLIP {mean:.5}");
+    if mean > 0.05 {
+        shot0.save(out_dir().join("view-start-actual.png")).unwrap();
+        map.save(out_dir().join("view-start-flip.png")).unwrap();
+    }
+    assert!(
+        mean <= 0.05,
+        "screenshot vs stored reference: mean FLIP {mean:.4} > 0.05 (see target/test-output/)"
+    );
+
+    // The input moved the walker: forward along the view, turned right by the drag.
+    let (eye1, target1) = key_of(&shots.join("screenshot-001.json"));
+    let flat = Vec3::new(dir0.x, 0.0, dir0.z).normalize();
+    let walked = (eye1 - eye0).dot(flat);
+    // (A frame step is at most 0.1 s, so even a slow machine moves 0.5 m per slow frame.)
+    assert!(walked > 0.2, "walked {walked} m forward ({eye0} -> {eye1})");
+    let dir1 = (target1 - eye1).normalize();
+    let turned = flat.cross(Vec3::new(dir1.x, 0.0, dir1.z).normalize()).y;
+    assert!(turned < -0.02, "did not turn right: {dir0} -> {dir1}");
+
+    // The window draws what the headless renderer draws for that camera, method and view.
+    let frames = d.join("frames");
+    std::fs::create_dir(&frames).unwrap();
+    ok(&forest(&[
+        "view",
+        &p("f.forest"),
+        "--path",
+        shots.join("screenshot-001.json").to_str().unwrap(),
+        "--frames",
+        frames.to_str().unwrap(),
+        "--size",
+        "320x240",
+        "--method",
+        "impostor",
+        "--debug-view",
+        "levels",
+    ]));
+    let headless = image::open(frames.join("frame-00000.png"))
+        .unwrap()
+        .to_rgba8();
+    let shot1 = image::open(shots.join("screenshot-001.png"))
+        .unwrap()
+        .to_rgba8();
+    let (mean, map) = forest_metrics::flip(&headless, &shot1).unwrap();
+    println!("window vs headless renderer: mean FLIP {mean:.5}");
+    if mean > 0.01 {
+        shot1.save(out_dir().join("view-moved-actual.png")).unwrap();
+        headless
+            .save(out_dir().join("view-moved-headless.png"))
+            .unwrap();
+        map.save(out_dir().join("view-moved-flip.png")).unwrap();
+    }
+    assert!(mean <= 0.01, "window vs headless: mean FLIP {mean:.4}");
+}
+
+#[test]
+fn without_a_display_the_viewer_says_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("f.forest");
+    ok(&forest(&[
+        "bake",
+        &model("bush"),
+        "-o",
+        dir.path().join("bush.atlas").to_str().unwrap(),
+        "--resolution",
+        "32",
+        "--directions",
+        "3",
+        "--spp",
+        "1",
+    ]));
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "10",
+        "--species",
+        dir.path().join("bush.atlas").to_str().unwrap(),
+        "-o",
+        f.to_str().unwrap(),
+    ]));
+    let out = Command::new(env!("CARGO_BIN_EXE_forest"))
+        .args(["view", f.to_str().unwrap()])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("--frames"), "{e}");
+    assert_eq!(e.lines().filter(|l| l.contains("error")).count(), 1, "{e}");
+    // A missing screenshot folder is refused before any window opens.
+    let out = Command::new(env!("CARGO_BIN_EXE_forest"))
+        .args(["view", f.to_str().unwrap(), "--screenshots", "/no/such/dir"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+}
