@@ -395,6 +395,18 @@ fn without_a_display_the_viewer_says_what_to_do() {
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("--frames"), "{e}");
     assert_eq!(e.lines().filter(|l| l.contains("error")).count(), 1, "{e}");
+    // Missing or broken files: one message naming the file, before any window opens.
+    std::fs::write(dir.path().join("broken.forest"), b"not a forest").unwrap();
+    for name in ["missing.forest", "broken.forest"] {
+        let bad = dir.path().join(name);
+        let out = Command::new(env!("CARGO_BIN_EXE_forest"))
+            .args(["view", bad.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains(name), "{e}");
+    }
     // A missing screenshot folder is refused before any window opens.
     let out = Command::new(env!("CARGO_BIN_EXE_forest"))
         .args(["view", f.to_str().unwrap(), "--screenshots", "/no/such/dir"])

@@ -13,6 +13,10 @@ mod scene;
 mod view;
 mod window;
 
+/// DejaVu Sans (assets/fonts/, with its licence): the charts' and the viewer HUD's one font,
+/// embedded so text renders the same everywhere.
+pub(crate) const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
 #[command(name = "forest", version, about, long_about = None)]

@@ -314,6 +314,16 @@ impl Viewer {
         renderer.set_method(&ctx, self.methods[self.method])?;
         renderer.stream.set_debug_view(self.debug);
         let egui = egui::Context::default();
+        // egui bundles no font by default: the HUD uses the one the charts embed.
+        let mut fonts = egui::FontDefinitions::empty();
+        fonts.font_data.insert(
+            "DejaVuSans".into(),
+            Arc::new(egui::FontData::from_static(crate::FONT)),
+        );
+        for family in [egui::FontFamily::Proportional, egui::FontFamily::Monospace] {
+            fonts.families.insert(family, vec!["DejaVuSans".into()]);
+        }
+        egui.set_fonts(fonts);
         let egui_state = egui_winit::State::new(
             egui.clone(),
             egui::ViewportId::ROOT,
@@ -346,78 +356,80 @@ impl Viewer {
             return (method, debug);
         }
         let s = &self.stats;
-        egui::Window::new("forest").show(ui_ctx, |ui| {
-            ui.label(format!(
-                "{:.1} ms/frame ({:.0} fps)",
-                self.frame_ms,
-                1000.0 / self.frame_ms.max(1e-3)
-            ));
-            match s.times {
-                Some(t) if matches!(self.methods[self.method], Method::Mesh(_)) => ui.label(
-                    format!("GPU: cull {:.2} ms, draw {:.2} ms", t.cull_ms, t.draw_ms),
-                ),
-                Some(t) => ui.label(format!(
-                    "GPU: cull {:.2} ms, refine {:.2} ms, draw {:.2} ms",
-                    t.cull_ms, t.refine_ms, t.draw_ms
-                )),
-                None => ui.label("GPU pass times: no timestamp queries on this adapter"),
-            };
-            let unit = if matches!(self.methods[self.method], Method::Mesh(_)) {
-                "triangles"
-            } else {
-                "quads"
-            };
-            ui.label(format!(
-                "{} visible trees, {} {unit}, {} billboards, overflow {}",
-                s.visible_trees, s.primitives, s.billboards, s.overflow
-            ));
-            if !s.per_level.is_empty() {
-                let levels: Vec<String> = s
-                    .per_level
-                    .iter()
-                    .enumerate()
-                    .map(|(l, n)| format!("{l}: {n}"))
-                    .collect();
-                ui.label(format!("quads per level: {}", levels.join(" · ")));
-            }
-            ui.add(egui::Slider::new(&mut self.epsilon, 0.5..=64.0).text("ε (px)"));
-            ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
-            ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
-            ui.label("method:");
-            for (i, m) in self.methods.iter().enumerate() {
-                if ui
-                    .radio(i == self.method, format!("{} {}", i + 1, m.name()))
-                    .clicked()
-                {
-                    method = Some(i);
+        egui::Window::new("forest view")
+            .default_width(440.0)
+            .show(ui_ctx, |ui| {
+                ui.label(format!(
+                    "{:.1} ms/frame ({:.0} fps)",
+                    self.frame_ms,
+                    1000.0 / self.frame_ms.max(1e-3)
+                ));
+                match s.times {
+                    Some(t) if matches!(self.methods[self.method], Method::Mesh(_)) => ui.label(
+                        format!("GPU: cull {:.2} ms, draw {:.2} ms", t.cull_ms, t.draw_ms),
+                    ),
+                    Some(t) => ui.label(format!(
+                        "GPU: cull {:.2} ms, refine {:.2} ms, draw {:.2} ms",
+                        t.cull_ms, t.refine_ms, t.draw_ms
+                    )),
+                    None => ui.label("GPU pass times: no timestamp queries on this adapter"),
+                };
+                let unit = if matches!(self.methods[self.method], Method::Mesh(_)) {
+                    "triangles"
+                } else {
+                    "quads"
+                };
+                ui.label(format!(
+                    "{} visible trees, {} {unit}, {} billboards, overflow {}",
+                    s.visible_trees, s.primitives, s.billboards, s.overflow
+                ));
+                if !s.per_level.is_empty() {
+                    let levels: Vec<String> = s
+                        .per_level
+                        .iter()
+                        .enumerate()
+                        .map(|(l, n)| format!("{l}: {n}"))
+                        .collect();
+                    ui.label(format!("quads per level: {}", levels.join(" · ")));
                 }
-            }
-            ui.label("debug view (quad-stream methods):");
-            ui.horizontal(|ui| {
-                for v in DebugView::ALL {
-                    if ui.radio(v == self.debug, v.name()).clicked() {
-                        debug = Some(v);
+                ui.add(egui::Slider::new(&mut self.epsilon, 0.5..=64.0).text("ε (px)"));
+                ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
+                ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
+                ui.label("method:");
+                for (i, m) in self.methods.iter().enumerate() {
+                    if ui
+                        .radio(i == self.method, format!("{} {}", i + 1, m.name()))
+                        .clicked()
+                    {
+                        method = Some(i);
                     }
                 }
+                ui.label("debug view (quad-stream methods):");
+                ui.horizontal(|ui| {
+                    for v in DebugView::ALL {
+                        if ui.radio(v == self.debug, v.name()).clicked() {
+                            debug = Some(v);
+                        }
+                    }
+                });
+                ui.separator();
+                for k in KEYS.iter().filter(|k| !k.is_empty()) {
+                    ui.label(*k);
+                }
+                if let Some(p) = &self.recording {
+                    ui.label(format!("recording: {} keys", p.keys.len()));
+                }
+                if let (Some(p), Some(i)) = (&self.path, self.playing) {
+                    ui.label(format!(
+                        "playing the path: key {} of {}",
+                        i + 1,
+                        p.keys.len()
+                    ));
+                }
+                if !self.message.is_empty() {
+                    ui.label(&self.message);
+                }
             });
-            ui.separator();
-            for k in KEYS.iter().filter(|k| !k.is_empty()) {
-                ui.label(*k);
-            }
-            if let Some(p) = &self.recording {
-                ui.label(format!("recording: {} keys", p.keys.len()));
-            }
-            if let (Some(p), Some(i)) = (&self.path, self.playing) {
-                ui.label(format!(
-                    "playing the path: key {} of {}",
-                    i + 1,
-                    p.keys.len()
-                ));
-            }
-            if !self.message.is_empty() {
-                ui.label(&self.message);
-            }
-        });
         (method, debug)
     }
 
@@ -438,8 +450,10 @@ impl Viewer {
 
     fn frame(&mut self) -> Result<()> {
         let now = Instant::now();
-        let dt = (now - self.last).as_secs_f32().min(0.1);
-        self.frame_ms = f64::from(dt) * 1000.0;
+        let elapsed = (now - self.last).as_secs_f32();
+        self.frame_ms = f64::from(elapsed) * 1000.0;
+        // Slow frames move the walker at most 0.1 s's worth (no leaps after a stall).
+        let dt = elapsed.min(0.1);
         self.last = now;
         self.walker.step(&self.keys, dt);
         let cam = self.camera();

@@ -58,9 +58,8 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
 fn register_font() {
     static FONT: std::sync::Once = std::sync::Once::new();
     FONT.call_once(|| {
-        let bytes: &'static [u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
         // Registration only fails on a malformed font, which the embedded one is not.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, bytes);
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, crate::FONT);
     });
 }
 
