@@ -219,6 +219,8 @@ fn walk_look_switch_and_screenshot_in_a_window() {
             &p("start.json"),
             "--screenshots",
             shots.to_str().unwrap(),
+            "--record",
+            &p("walk.json"),
             "--models",
             &format!("{},{}", model("bush"), model("pine")),
         ])
@@ -272,6 +274,23 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     x.xdotool(&["key", "F12"]);
     let saved = v.wait_for("screenshot-001.png", 60);
     assert!(saved.contains("(impostor, debug view levels)"), "{saved}");
+    // R records a path while walking sideways; R again saves it.
+    x.xdotool(&["key", "r"]);
+    x.xdotool(&["keydown", "d"]);
+    std::thread::sleep(Duration::from_millis(500));
+    x.xdotool(&["keyup", "d"]);
+    x.xdotool(&["key", "r"]);
+    let saved = v.wait_for("keys to", 60);
+    let recorded = CameraPath::load(&d.join("walk.json")).unwrap();
+    assert!(recorded.keys.len() >= 2, "{saved}");
+    let (a, b) = (
+        recorded.keys[0].eye,
+        recorded.keys[recorded.keys.len() - 1].eye,
+    );
+    assert!(
+        Vec3::from_array(a).distance(Vec3::from_array(b)) > 0.1,
+        "{a:?} -> {b:?}"
+    );
     x.xdotool(&["key", "Escape"]);
     let t = Instant::now();
     let status = loop {

@@ -75,6 +75,15 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             args.screenshots.display()
         );
     }
+    if let Some(dir) = args.record.parent().filter(|p| !p.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        bail!(
+            "--record {}: folder {} does not exist",
+            args.record.display(),
+            dir.display()
+        );
+    }
     let Some(frames) = &args.frames else {
         return interactive(args, &forest_file, &args_models);
     };

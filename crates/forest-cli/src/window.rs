@@ -293,17 +293,13 @@ impl Viewer {
         )?;
         let ctx = GpuContext::from_adapter(&adapter)?;
         let caps = surface.get_capabilities(&adapter);
-        // The offscreen target's format when the surface offers it (screenshots render into
-        // one with the same pipelines), else any sRGB format.
-        let format = if caps.formats.contains(&forest_render::target::TARGET_FORMAT) {
-            forest_render::target::TARGET_FORMAT
-        } else {
-            caps.formats
-                .iter()
-                .copied()
-                .find(|f| f.is_srgb())
-                .unwrap_or(caps.formats[0])
-        };
+        // A format screenshots can read back (sRGB first), else any sRGB one, else the first.
+        let format = forest_render::target::READABLE_FORMATS
+            .into_iter()
+            .find(|f| caps.formats.contains(f))
+            .or_else(|| caps.formats.iter().copied().find(|f| f.is_srgb()))
+            .or_else(|| caps.formats.first().copied())
+            .context("the window's surface offers no colour format")?;
         let inner = window.inner_size();
         let mut config = surface
             .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
@@ -625,18 +621,28 @@ impl Viewer {
             KeyCode::Digit3 => self.set_method(2)?,
             KeyCode::Digit4 => self.set_method(3)?,
             KeyCode::Digit5 => self.set_method(4)?,
-            KeyCode::F12 => self.screenshot()?,
+            KeyCode::F12 => {
+                // A failed screenshot is reported in the HUD and on stderr; the walk goes on.
+                if let Err(e) = self.screenshot() {
+                    self.message = format!("screenshot failed: {e:#}");
+                    eprintln!("forest view: {}", self.message);
+                }
+            }
             KeyCode::KeyR => match self.recording.take() {
                 Some(p) if !p.keys.is_empty() => {
-                    p.save(&self.record_to)?;
-                    self.message = format!(
-                        "saved {} keys to {}",
-                        p.keys.len(),
-                        self.record_to.display()
-                    );
+                    self.message = match p.save(&self.record_to) {
+                        Ok(()) => format!(
+                            "saved {} keys to {}",
+                            p.keys.len(),
+                            self.record_to.display()
+                        ),
+                        // Keep walking; the message says why nothing was saved.
+                        Err(e) => format!("could not save the path: {e}"),
+                    };
+                    println!("forest view: {}", self.message);
                 }
                 Some(_) => {}
-                None => self.recording = Some(CameraPath::new(60.0)),
+                None => self.recording = Some(CameraPath::new(self.fov_deg)),
             },
             _ => {}
         }
