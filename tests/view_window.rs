@@ -215,6 +215,9 @@ fn walk_look_switch_and_screenshot_in_a_window() {
             &p("f.forest"),
             "--size",
             "320x240",
+            // A coarse ε sizes a small stream, which the end of the test outgrows.
+            "--epsilon",
+            "32",
             "--path",
             &p("start.json"),
             "--screenshots",
@@ -291,6 +294,21 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         Vec3::from_array(a).distance(Vec3::from_array(b)) > 0.1,
         "{a:?} -> {b:?}"
     );
+    // A larger window and a smaller ε than the stream was sized for: it overflows, and the
+    // viewer builds a larger stream.
+    x.xdotool(&["windowsize", &win, "640", "480"]);
+    // (It grows at whichever ε first overflows, 16 to 2 depending on the frames drawn in
+    // between; ε 2 at 640x480 fits lavapipe's 128 MiB storage-buffer limit, ε 1 would not.)
+    x.xdotool(&["key", "1"]);
+    for _ in 0..4 {
+        x.xdotool(&["key", "bracketleft"]);
+    }
+    v.wait_for("stream resized for 640x480 at ε", 120);
+    assert!(
+        !v.seen.iter().any(|l| l.contains("cannot grow")),
+        "{:?}",
+        v.seen
+    );
     x.xdotool(&["key", "Escape"]);
     let t = Instant::now();
     let status = loop {
@@ -356,6 +374,8 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         frames.to_str().unwrap(),
         "--size",
         "320x240",
+        "--epsilon",
+        "32",
         "--method",
         "impostor",
         "--debug-view",

@@ -176,38 +176,46 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
     let far = (forest.extent() * 3.0 + 100.0).max(1000.0);
     let methods = crate::window::offered(mesh_method, prepared.is_some());
-    let start = methods
-        .iter()
-        .position(|x| x.name() == m.method)
-        .unwrap_or(0);
+    let forest_for_stream = forest.clone();
+    let chosen = match (mesh_method, m.method.as_str()) {
+        (Some(x), _) => Method::Mesh(x),
+        (None, "impostor") => Method::Impostor,
+        _ => Method::Quads,
+    };
+    let start = methods.iter().position(|x| *x == chosen).unwrap_or(0);
     let (size, epsilon) = (args.size, args.epsilon);
-    let build: crate::window::Build = Box::new(move |ctx, format| {
+    let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
         let opts = RendererOptions {
             format,
-            // Sized for the starting window and ε: a larger window or a smaller ε may overflow,
-            // which the HUD's overflow counter reports (nothing is written out of bounds).
-            viewport: size,
-            min_epsilon: epsilon,
+            viewport,
+            min_epsilon: eps,
             background: Background::Sky,
             ..Default::default()
         };
-        let geometry = match &prepared {
-            Some(p) => Some(forest_render::geometry::GeometryRenderer::new(
-                ctx,
-                p,
-                &forest,
-                format,
-                Background::Sky,
-            )?),
-            None => None,
-        };
-        Ok(ForestRenderer::new(
-            QuadStream::new(ctx, GpuScene::new(ctx, &species, &forest)?, &opts)?,
-            geometry,
-        ))
+        Ok(QuadStream::new(
+            ctx,
+            GpuScene::new(ctx, &species, &forest_for_stream)?,
+            &opts,
+        )?)
+    });
+    let build_geometry: crate::window::BuildGeometry = Box::new(move |ctx, format| {
+        prepared
+            .as_ref()
+            .map(|p| {
+                forest_render::geometry::GeometryRenderer::new(
+                    ctx,
+                    p,
+                    &forest,
+                    format,
+                    Background::Sky,
+                )
+            })
+            .transpose()
+            .map_err(Into::into)
     });
     crate::window::Viewer::new(crate::window::Settings {
-        build,
+        build_stream,
+        build_geometry,
         size,
         epsilon,
         far,

@@ -3,7 +3,8 @@
 //! method switch, debug views).
 //!
 //! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
-//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–5 pick a method, V
+//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–5 pick a method, [ and
+//! ] halve and double ε, V
 //! cycles the debug views, H hides the HUD, F12 saves a screenshot, R starts and stops
 //! recording a camera path, P plays the `--path` back, Esc quits.
 //!
@@ -18,12 +19,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use forest_format::camera_path::CameraPath;
-use forest_render::Camera;
 use forest_render::context::GpuContext;
+use forest_render::geometry::GeometryRenderer;
 use forest_render::geometry::MeshMethod;
 use forest_render::methods::{ForestRenderer, Method, MethodStats};
 use forest_render::passes::draw::DEPTH_FORMAT;
 use forest_render::renderer::DebugView;
+use forest_render::{Camera, QuadStream};
 use glam::Vec3;
 use winit::application::ApplicationHandler;
 use winit::event::{DeviceEvent, ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -34,16 +36,25 @@ use winit::window::{Window, WindowId};
 /// Eye height above the ground in walk mode (metres).
 pub const EYE_HEIGHT: f32 = 1.7;
 
+/// Range of the ε slider and the [ / ] keys (pixels).
+pub const EPSILON_RANGE: (f32, f32) = (0.5, 64.0);
+
 /// The key list shown on screen.
 pub const KEYS: [&str; 4] = [
     "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
-    "F: walk/fly · 1-5: method · V: debug view · H: hide HUD",
+    "F: walk/fly · 1-5: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
     "F12: screenshot · R: record path · P: play --path · Esc: quit",
     "",
 ];
 
-/// What the window needs to build its renderer once it has a device.
-pub type Build = Box<dyn Fn(&GpuContext, wgpu::TextureFormat) -> Result<ForestRenderer>>;
+/// Builds the quad stream once the window has a device: for a colour format, a largest
+/// viewport (pixels) and a smallest ε (pixels), which size its buffers.
+pub type BuildStream =
+    Box<dyn Fn(&GpuContext, wgpu::TextureFormat, (u32, u32), f32) -> Result<QuadStream>>;
+
+/// Builds the geometry renderer (None without models) once the window has a device.
+pub type BuildGeometry =
+    Box<dyn Fn(&GpuContext, wgpu::TextureFormat) -> Result<Option<GeometryRenderer>>>;
 
 /// The walker: position, yaw and pitch (radians), speed (m/s), walk or fly.
 #[derive(Clone, Copy, Debug)]
@@ -134,8 +145,10 @@ struct Gfx {
 
 /// What a viewer starts with.
 pub struct Settings {
-    /// Builds the renderer once the window has a device.
-    pub build: Build,
+    /// Builds the quad stream (again when the window or ε outgrows it).
+    pub build_stream: BuildStream,
+    /// Builds the geometry renderer.
+    pub build_geometry: BuildGeometry,
     /// Starting window size in pixels.
     pub size: (u32, u32),
     /// Starting ε in pixels.
@@ -158,7 +171,12 @@ pub struct Settings {
 
 /// The viewer application.
 pub struct Viewer {
-    build: Build,
+    build_stream: BuildStream,
+    build_geometry: BuildGeometry,
+    /// Viewport and ε the stream's buffers were sized for.
+    sized: ((u32, u32), f32),
+    /// A size the stream could not grow to (not retried until the wish changes).
+    grow_failed: Option<((u32, u32), f32)>,
     size: (u32, u32),
     walker: Walker,
     epsilon: f32,
@@ -204,7 +222,10 @@ impl Viewer {
             },
         };
         Self {
-            build: st.build,
+            build_stream: st.build_stream,
+            build_geometry: st.build_geometry,
+            sized: (st.size, st.epsilon),
+            grow_failed: None,
             size: st.size,
             walker,
             epsilon: st.epsilon,
@@ -306,7 +327,10 @@ impl Viewer {
             .context("the window's surface is not supported by the GPU adapter")?;
         config.format = format;
         surface.configure(&ctx.device, &config);
-        let renderer = (self.build)(&ctx, format)?;
+        let renderer = ForestRenderer::new(
+            (self.build_stream)(&ctx, format, self.sized.0, self.sized.1)?,
+            (self.build_geometry)(&ctx, format)?,
+        );
         renderer.set_method(&ctx, self.methods[self.method])?;
         renderer.stream.set_debug_view(self.debug);
         let egui = egui::Context::default();
@@ -388,7 +412,11 @@ impl Viewer {
                         .collect();
                     ui.label(format!("quads per level: {}", levels.join(" · ")));
                 }
-                ui.add(egui::Slider::new(&mut self.epsilon, 0.5..=64.0).text("ε (px)"));
+                ui.add(
+                    egui::Slider::new(&mut self.epsilon, EPSILON_RANGE.0..=EPSILON_RANGE.1)
+                        .logarithmic(true)
+                        .text("ε (px)"),
+                );
                 ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
                 ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
                 ui.label("method:");
@@ -434,6 +462,42 @@ impl Viewer {
             g.renderer.set_method(&g.ctx, *m)?;
             self.method = i;
         }
+        Ok(())
+    }
+
+    /// The stream overflowed: when the window is larger or ε smaller than its buffers were
+    /// sized for, build a larger stream (the geometry renderer is kept). If that fails (the
+    /// device's limits), the HUD says so and the overflow counter stays the only effect.
+    fn grow_stream(&mut self, viewport: (u32, u32)) -> Result<()> {
+        let ((w, h), eps) = self.sized;
+        let wish = (
+            (viewport.0.max(w), viewport.1.max(h)),
+            self.epsilon.min(eps),
+        );
+        if wish == self.sized || self.grow_failed == Some(wish) {
+            return Ok(());
+        }
+        let Some(g) = &mut self.gfx else {
+            return Ok(());
+        };
+        match (self.build_stream)(&g.ctx, g.config.format, wish.0, wish.1) {
+            Ok(stream) => {
+                let geometry = g.renderer.geometry.take();
+                g.renderer = ForestRenderer::new(stream, geometry);
+                g.renderer.set_method(&g.ctx, self.methods[self.method])?;
+                g.renderer.stream.set_debug_view(self.debug);
+                self.sized = wish;
+                self.message = format!(
+                    "stream resized for {}x{} at ε {:.1}: {} quads",
+                    wish.0.0, wish.0.1, wish.1, g.renderer.stream.capacity.quads
+                );
+            }
+            Err(e) => {
+                self.grow_failed = Some(wish);
+                self.message = format!("the stream cannot grow: {e:#}");
+            }
+        }
+        println!("forest view: {}", self.message);
         Ok(())
     }
 
@@ -554,6 +618,9 @@ impl Viewer {
         if let Some(i) = method {
             self.set_method(i)?;
         }
+        if self.stats.overflow > 0 {
+            self.grow_stream(cam.viewport)?;
+        }
         if let Some(v) = debug {
             self.set_debug(v);
         }
@@ -597,19 +664,29 @@ impl Viewer {
         Ok(())
     }
 
-    fn key(&mut self, event_loop: &ActiveEventLoop, code: KeyCode, pressed: bool) -> Result<()> {
+    /// A key went down or up; `repeat`: the keyboard's auto-repeat of a held key, which moves
+    /// but does not toggle again.
+    fn key(
+        &mut self,
+        event_loop: &ActiveEventLoop,
+        code: KeyCode,
+        pressed: bool,
+        repeat: bool,
+    ) -> Result<()> {
         if pressed {
             self.keys.insert(code);
         } else {
             self.keys.remove(&code);
         }
-        if !pressed {
+        if !pressed || repeat {
             return Ok(());
         }
         match code {
             KeyCode::Escape => event_loop.exit(),
             KeyCode::KeyF => self.walker.walk = !self.walker.walk,
             KeyCode::KeyH => self.show_hud = !self.show_hud,
+            KeyCode::BracketLeft => self.epsilon = (self.epsilon / 2.0).max(EPSILON_RANGE.0),
+            KeyCode::BracketRight => self.epsilon = (self.epsilon * 2.0).min(EPSILON_RANGE.1),
             KeyCode::KeyV => {
                 let i = DebugView::ALL.iter().position(|v| *v == self.debug);
                 let next = DebugView::ALL[(i.unwrap_or(0) + 1) % DebugView::ALL.len()];
@@ -700,10 +777,19 @@ impl ApplicationHandler for Viewer {
                 }
                 Ok(())
             }
-            WindowEvent::KeyboardInput { event, .. } => match event.physical_key {
-                PhysicalKey::Code(code) => {
-                    self.key(event_loop, code, event.state == ElementState::Pressed)
-                }
+            // Synthetic events (winit's replay of keys held when focus arrives) would toggle
+            // twice what the real press toggles once.
+            WindowEvent::KeyboardInput {
+                event,
+                is_synthetic: false,
+                ..
+            } => match event.physical_key {
+                PhysicalKey::Code(code) => self.key(
+                    event_loop,
+                    code,
+                    event.state == ElementState::Pressed,
+                    event.repeat,
+                ),
                 _ => Ok(()),
             },
             WindowEvent::MouseInput {
@@ -747,19 +833,107 @@ impl ApplicationHandler for Viewer {
     }
 }
 
-/// The methods a viewer offers: the quad stream and impostors, and with models the geometry
-/// methods (with the parameters given).
+/// The methods a viewer offers, in a fixed order (keys 1–5): quads, impostor, and with models
+/// LODs, stochastic, geometry, the kind named on the command line (`mesh`) with its parameters.
 pub fn offered(mesh: Option<MeshMethod>, geometry: bool) -> Vec<Method> {
     let mut m = vec![Method::Quads, Method::Impostor];
     if geometry {
-        m.push(Method::Mesh(MeshMethod::Lods(Default::default())));
-        m.push(Method::Mesh(MeshMethod::Stochastic(Default::default())));
-        m.push(Method::Mesh(MeshMethod::Full { depth_sort: true }));
-        if let Some(x) = mesh {
-            // The method named on the command line, with its parameters, first.
-            m.retain(|y| y.name() != Method::Mesh(x).name());
-            m.insert(0, Method::Mesh(x));
+        for default in [
+            MeshMethod::Lods(Default::default()),
+            MeshMethod::Stochastic(Default::default()),
+            MeshMethod::Full { depth_sort: true },
+        ] {
+            let same_kind =
+                |x: &MeshMethod| std::mem::discriminant(x) == std::mem::discriminant(&default);
+            m.push(Method::Mesh(mesh.filter(same_kind).unwrap_or(default)));
         }
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn keys(k: &[KeyCode]) -> HashSet<KeyCode> {
+        k.iter().copied().collect()
+    }
+
+    #[test]
+    fn looking_at_inverts_forward() {
+        for (yaw, pitch) in [(0.0, 0.0), (1.0, 0.3), (-2.5, -0.7), (3.0, 1.2)] {
+            let w = Walker {
+                eye: Vec3::new(1.0, 5.0, -2.0),
+                yaw,
+                pitch,
+                speed: 5.0,
+                walk: false,
+            };
+            let back = Walker::looking_at(w.eye, w.eye + w.forward() * 7.0, 5.0);
+            assert!((back.yaw - yaw).abs() < 1e-5, "{yaw} -> {}", back.yaw);
+            assert!(
+                (back.pitch - pitch).abs() < 1e-5,
+                "{pitch} -> {}",
+                back.pitch
+            );
+            assert!(!back.walk, "eye above walking height flies");
+        }
+        let w = Walker::looking_at(Vec3::new(0.0, EYE_HEIGHT, 0.0), Vec3::X, 1.0);
+        assert!(w.walk);
+        // A degenerate target looks along −Z instead of producing NaN.
+        let w = Walker::looking_at(Vec3::ONE, Vec3::ONE, 1.0);
+        assert!(w.yaw.abs() < 1e-6 && w.pitch.abs() < 1e-6);
+    }
+
+    #[test]
+    fn walking_follows_the_ground_and_flying_follows_the_view() {
+        let mut w = Walker {
+            eye: Vec3::new(0.0, EYE_HEIGHT, 0.0),
+            yaw: std::f32::consts::FRAC_PI_2, // facing +X
+            pitch: 0.5,
+            speed: 2.0,
+            walk: true,
+        };
+        w.step(&keys(&[KeyCode::KeyW, KeyCode::KeyE]), 0.5);
+        assert!(
+            (w.eye - Vec3::new(1.0, EYE_HEIGHT, 0.0)).length() < 1e-5,
+            "{}",
+            w.eye
+        );
+        w.step(&keys(&[KeyCode::KeyD, KeyCode::ShiftLeft]), 0.25);
+        assert!(
+            (w.eye - Vec3::new(1.0, EYE_HEIGHT, 2.0)).length() < 1e-5,
+            "{}",
+            w.eye
+        );
+        w.walk = false;
+        let before = w.eye;
+        w.step(&keys(&[KeyCode::KeyW]), 1.0);
+        let moved = w.eye - before;
+        assert!((moved - w.forward() * 2.0).length() < 1e-5, "{moved}");
+        w.step(&keys(&[KeyCode::KeyQ]), 100.0);
+        assert!((w.eye.y - 0.2).abs() < 1e-6, "never below 0.2 m: {}", w.eye);
+        // Opposite keys cancel.
+        let before = w.eye;
+        w.step(&keys(&[KeyCode::KeyA, KeyCode::KeyD]), 1.0);
+        assert_eq!(w.eye, before);
+    }
+
+    #[test]
+    fn offered_methods_keep_their_order_with_the_named_parameters() {
+        assert_eq!(offered(None, false), vec![Method::Quads, Method::Impostor]);
+        let names = |m: &[Method]| m.iter().map(|x| x.name()).collect::<Vec<_>>();
+        let all = offered(None, true);
+        assert_eq!(
+            names(&all),
+            ["quads", "impostor", "lods", "stochastic", "geometry"]
+        );
+        let unsorted = offered(Some(MeshMethod::Full { depth_sort: false }), true);
+        assert_eq!(names(&unsorted)[4], "geometry-unsorted");
+        assert_eq!(unsorted.len(), 5);
+        let lods = MeshMethod::Lods(forest_render::geometry::Lods {
+            distances: [1.0, 2.0, 3.0],
+        });
+        assert_eq!(offered(Some(lods), true)[2], Method::Mesh(lods));
+    }
 }
