@@ -318,10 +318,7 @@ fn finish_view(
     name: &str,
     views: usize,
 ) -> Result<PathBuf> {
-    let errors = ctx.take_errors();
-    if !errors.is_empty() {
-        bail!("the GPU reported: {}", errors.join("; "));
-    }
+    ctx.check_errors()?;
     let out = output_for(&args.output, name, views);
     save(target, ctx, args.supersample, &out)?;
     Ok(out)

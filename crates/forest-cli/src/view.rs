@@ -142,10 +142,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         r.render_frame(&ctx, &cam, &target)
             .with_context(|| format!("{}: key {i}", path_file.display()))?;
         let stats = r.read_stats(&ctx);
-        let errors = ctx.take_errors();
-        if !errors.is_empty() {
-            bail!("the GPU reported: {}", errors.join("; "));
-        }
+        ctx.check_errors()?;
         let t = stats.times.unwrap_or_default();
         total_ms += t.cull_ms + t.refine_ms + t.draw_ms;
         write_png(

@@ -599,10 +599,7 @@ impl Viewer {
             g.window.pre_present_notify();
             g.ctx.queue.present(output);
             self.stats = g.renderer.read_stats(&g.ctx);
-            let errors = g.ctx.take_errors();
-            if !errors.is_empty() {
-                anyhow::bail!("the GPU reported: {}", errors.join("; "));
-            }
+            g.ctx.check_errors()?;
             if self.first_frame {
                 self.first_frame = false;
                 println!(
@@ -640,10 +637,7 @@ impl Viewer {
         )?;
         g.renderer.render_frame(&g.ctx, &cam, &target)?;
         let img = target.read(&g.ctx);
-        let errors = g.ctx.take_errors();
-        if !errors.is_empty() {
-            anyhow::bail!("the GPU reported: {}", errors.join("; "));
-        }
+        g.ctx.check_errors()?;
         let base = self
             .screenshots
             .join(format!("screenshot-{:03}", self.shots));

@@ -17,6 +17,9 @@ pub enum RenderError {
     /// The scene does not fit the device or is inconsistent.
     #[error("{0}")]
     Scene(String),
+    /// The device reported validation or out-of-memory errors.
+    #[error("the GPU reported: {}", .0.join("; "))]
+    Gpu(Vec<String>),
     /// An atlas or forest file problem.
     #[error(transparent)]
     Format(#[from] forest_format::FormatError),
@@ -107,6 +110,16 @@ impl GpuContext {
     pub fn take_errors(&self) -> Vec<String> {
         let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
         std::mem::take(&mut *self.errors.lock().unwrap())
+    }
+
+    /// Fail with [`RenderError::Gpu`] if errors were reported since the last call (drained).
+    pub fn check_errors(&self) -> Result<(), RenderError> {
+        let errors = self.take_errors();
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            Err(RenderError::Gpu(errors))
+        }
     }
 
     /// Submit `enc` (which copies into the `MAP_READ` buffer `staging`), wait, and return the

@@ -268,10 +268,7 @@ impl Bench {
                 times.3.push(t.cull_ms + t.refine_ms + t.draw_ms);
             }
         }
-        let errors = self.ctx.take_errors();
-        if !errors.is_empty() {
-            bail!("the GPU reported: {}", errors.join("; "));
-        }
+        self.ctx.check_errors()?;
         Ok((
             stats,
             PassTimes {
