@@ -3,12 +3,16 @@
 //! Without a forest file it opens the bundled demo forest ([`crate::demo`]).
 
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::camera_path::CameraPath;
+use forest_format::forest::Forest;
+use forest_render::geometry::{GeometryRenderer, MeshMethod, PreparedGeometry};
 use forest_render::methods::{ForestRenderer, Method};
 use forest_render::renderer::{Background, DebugView, RendererOptions};
+use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 use glam::Vec3;
@@ -56,6 +60,60 @@ fn parse_debug_view(s: &str) -> Result<DebugView, String> {
         .ok_or_else(|| format!("{s:?}: expected off, levels, weights or wireframe"))
 }
 
+/// The quad stream of `forest` for a colour format, sized for `viewport` and ε `min_epsilon`
+/// (pixels), over the sky and ground.
+fn quad_stream(
+    ctx: &GpuContext,
+    species: &[SpeciesData],
+    forest: &Forest,
+    format: wgpu::TextureFormat,
+    viewport: (u32, u32),
+    min_epsilon: f32,
+) -> Result<QuadStream> {
+    let opts = RendererOptions {
+        format,
+        viewport,
+        min_epsilon,
+        background: Background::Sky,
+        ..Default::default()
+    };
+    Ok(QuadStream::new(
+        ctx,
+        GpuScene::new(ctx, species, forest)?,
+        &opts,
+    )?)
+}
+
+/// The geometry renderer of `forest` for a colour format, over the sky and ground.
+fn geometry(
+    ctx: &GpuContext,
+    prepared: &PreparedGeometry,
+    forest: &Forest,
+    format: wgpu::TextureFormat,
+) -> Result<GeometryRenderer> {
+    Ok(GeometryRenderer::new(
+        ctx,
+        prepared,
+        forest,
+        format,
+        Background::Sky,
+    )?)
+}
+
+/// The method `--method` names, with the parameters of `mesh` for the geometry-based ones.
+fn chosen_method(m: &MethodArgs, mesh: Option<MeshMethod>) -> Method {
+    match (mesh, m.method.as_str()) {
+        (Some(x), _) => Method::Mesh(x),
+        (None, "impostor") => Method::Impostor,
+        _ => Method::Quads,
+    }
+}
+
+/// Far plane (metres): beyond the farthest tree from anywhere in the forest.
+fn far_plane(forest: &Forest) -> f32 {
+    (forest.extent() * 3.0 + 100.0).max(1000.0)
+}
+
 /// Run `forest view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
     let mut args_models = args.m.clone();
@@ -99,35 +157,30 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let mesh_method = args_models.checked_method(forest.species.len())?;
     let ctx = GpuContext::headless()?;
     let geometry = match mesh_method {
-        Some(_) => Some(forest_render::geometry::GeometryRenderer::new(
+        Some(_) => Some(geometry(
             &ctx,
             &prepare_models(&args_models.models, &species)?,
             &forest,
             TARGET_FORMAT,
-            Background::Sky,
         )?),
         None => None,
     };
-    let opts = RendererOptions {
-        format: TARGET_FORMAT,
-        viewport: args.size,
-        min_epsilon: args.epsilon,
-        background: Background::Sky,
-        ..Default::default()
-    };
     let r = ForestRenderer::new(
-        QuadStream::new(&ctx, GpuScene::new(&ctx, &species, &forest)?, &opts)?,
+        quad_stream(
+            &ctx,
+            &species,
+            &forest,
+            TARGET_FORMAT,
+            args.size,
+            args.epsilon,
+        )?,
         geometry,
     );
     r.stream.set_debug_view(args.debug_view);
-    let method = match (args.m.method.as_str(), mesh_method) {
-        (_, Some(m)) => Method::Mesh(m),
-        ("impostor", None) => Method::Impostor,
-        _ => Method::Quads,
-    };
+    let method = chosen_method(&args_models, mesh_method);
     r.set_method(&ctx, method)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
-    let far = (forest.extent() * 3.0 + 100.0).max(1000.0);
+    let far = far_plane(&forest);
     let mut total_ms = 0.0;
     for (i, key) in path.keys.iter().enumerate() {
         let cam = Camera {
@@ -171,44 +224,24 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
         Some(prepare_models(&m.models, &species)?)
     };
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
-    let far = (forest.extent() * 3.0 + 100.0).max(1000.0);
+    let far = far_plane(&forest);
     let methods = crate::window::offered(mesh_method, prepared.is_some());
-    let forest_for_stream = forest.clone();
-    let chosen = match (mesh_method, m.method.as_str()) {
-        (Some(x), _) => Method::Mesh(x),
-        (None, "impostor") => Method::Impostor,
-        _ => Method::Quads,
-    };
-    let start = methods.iter().position(|x| *x == chosen).unwrap_or(0);
+    let start = methods
+        .iter()
+        .position(|x| *x == chosen_method(m, mesh_method))
+        .unwrap_or(0);
     let (size, epsilon) = (args.size, args.epsilon);
+    // Both builders hold the forest: the stream's is called again when it must grow.
+    let forest = Rc::new(forest);
+    let f = forest.clone();
     let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
-        let opts = RendererOptions {
-            format,
-            viewport,
-            min_epsilon: eps,
-            background: Background::Sky,
-            ..Default::default()
-        };
-        Ok(QuadStream::new(
-            ctx,
-            GpuScene::new(ctx, &species, &forest_for_stream)?,
-            &opts,
-        )?)
+        quad_stream(ctx, &species, &f, format, viewport, eps)
     });
     let build_geometry: crate::window::BuildGeometry = Box::new(move |ctx, format| {
         prepared
             .as_ref()
-            .map(|p| {
-                forest_render::geometry::GeometryRenderer::new(
-                    ctx,
-                    p,
-                    &forest,
-                    format,
-                    Background::Sky,
-                )
-            })
+            .map(|p| geometry(ctx, p, &forest, format))
             .transpose()
-            .map_err(Into::into)
     });
     crate::window::Viewer::new(crate::window::Settings {
         build_stream,
