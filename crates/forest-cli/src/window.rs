@@ -4,15 +4,13 @@
 //!
 //! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
 //! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–5 pick a method, [ and
-//! ] halve and double ε, V
-//! cycles the debug views, H hides the HUD, F12 saves a screenshot, R starts and stops
-//! recording a camera path, P plays the `--path` back, Esc quits.
+//! ] halve and double ε, V cycles the debug views, H hides the HUD, F12 saves a screenshot, R
+//! starts and stops recording a camera path, P plays the `--path` back, Esc quits.
 //!
 //! On stdout the viewer says when its first frame is on screen and where each screenshot went
 //! (one line each), so scripts and the tests can drive it.
 
 use std::collections::HashSet;
-use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -40,11 +38,10 @@ pub const EYE_HEIGHT: f32 = 1.7;
 pub const EPSILON_RANGE: (f32, f32) = (0.5, 64.0);
 
 /// The key list shown on screen.
-pub const KEYS: [&str; 4] = [
+pub const KEYS: [&str; 3] = [
     "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
     "F: walk/fly · 1-5: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
     "F12: screenshot · R: record path · P: play --path · Esc: quit",
-    "",
 ];
 
 /// Builds the quad stream once the window has a device: for a colour format, a largest
@@ -327,12 +324,13 @@ impl Viewer {
             .context("the window's surface is not supported by the GPU adapter")?;
         config.format = format;
         surface.configure(&ctx.device, &config);
-        let renderer = ForestRenderer::new(
+        let renderer = assemble(
+            &ctx,
+            self.methods[self.method],
+            self.debug,
             (self.build_stream)(&ctx, format, self.sized.0, self.sized.1)?,
             (self.build_geometry)(&ctx, format)?,
-        );
-        renderer.set_method(&ctx, self.methods[self.method])?;
-        renderer.stream.set_debug_view(self.debug);
+        )?;
         let egui = egui::Context::default();
         // egui bundles no font by default: the HUD uses the one the charts embed.
         let mut fonts = egui::FontDefinitions::empty();
@@ -384,21 +382,19 @@ impl Viewer {
                     self.frame_ms,
                     1000.0 / self.frame_ms.max(1e-3)
                 ));
+                let mesh = matches!(self.methods[self.method], Method::Mesh(_));
                 match s.times {
-                    Some(t) if matches!(self.methods[self.method], Method::Mesh(_)) => ui.label(
-                        format!("GPU: cull {:.2} ms, draw {:.2} ms", t.cull_ms, t.draw_ms),
-                    ),
+                    Some(t) if mesh => ui.label(format!(
+                        "GPU: cull {:.2} ms, draw {:.2} ms",
+                        t.cull_ms, t.draw_ms
+                    )),
                     Some(t) => ui.label(format!(
                         "GPU: cull {:.2} ms, refine {:.2} ms, draw {:.2} ms",
                         t.cull_ms, t.refine_ms, t.draw_ms
                     )),
                     None => ui.label("GPU pass times: no timestamp queries on this adapter"),
                 };
-                let unit = if matches!(self.methods[self.method], Method::Mesh(_)) {
-                    "triangles"
-                } else {
-                    "quads"
-                };
+                let unit = if mesh { "triangles" } else { "quads" };
                 ui.label(format!(
                     "{} visible trees, {} {unit}, {} billboards, overflow {}",
                     s.visible_trees, s.primitives, s.billboards, s.overflow
@@ -437,8 +433,8 @@ impl Viewer {
                     }
                 });
                 ui.separator();
-                for k in KEYS.iter().filter(|k| !k.is_empty()) {
-                    ui.label(*k);
+                for k in KEYS {
+                    ui.label(k);
                 }
                 if let Some(p) = &self.recording {
                     ui.label(format!("recording: {} keys", p.keys.len()));
@@ -482,23 +478,28 @@ impl Viewer {
         };
         match (self.build_stream)(&g.ctx, g.config.format, wish.0, wish.1) {
             Ok(stream) => {
+                let quads = stream.capacity.quads;
                 let geometry = g.renderer.geometry.take();
-                g.renderer = ForestRenderer::new(stream, geometry);
-                g.renderer.set_method(&g.ctx, self.methods[self.method])?;
-                g.renderer.stream.set_debug_view(self.debug);
+                let method = self.methods[self.method];
+                g.renderer = assemble(&g.ctx, method, self.debug, stream, geometry)?;
                 self.sized = wish;
-                self.message = format!(
-                    "stream resized for {}x{} at ε {:.1}: {} quads",
-                    wish.0.0, wish.0.1, wish.1, g.renderer.stream.capacity.quads
-                );
+                let ((w, h), eps) = wish;
+                self.say(format!(
+                    "stream resized for {w}x{h} at ε {eps:.1}: {quads} quads"
+                ));
             }
             Err(e) => {
                 self.grow_failed = Some(wish);
-                self.message = format!("the stream cannot grow: {e:#}");
+                self.say(format!("the stream cannot grow: {e:#}"));
             }
         }
-        println!("forest view: {}", self.message);
         Ok(())
+    }
+
+    /// Show `text` in the HUD and print it as one stdout line (scripts and tests read these).
+    fn say(&mut self, text: String) {
+        println!("forest view: {text}");
+        self.message = text;
     }
 
     fn set_debug(&mut self, v: DebugView) {
@@ -602,11 +603,11 @@ impl Viewer {
             g.ctx.check_errors()?;
             if self.first_frame {
                 self.first_frame = false;
+                // (Rust's stdout is line-buffered: each line reaches a pipe as it is printed.)
                 println!(
                     "forest view: first frame on screen ({}, {:?}, {}x{})",
                     g.ctx.adapter_info.name, g.config.format, g.config.width, g.config.height
                 );
-                std::io::stdout().flush()?;
             }
             Ok(choice)
         })();
@@ -647,14 +648,12 @@ impl Viewer {
         key.push(cam.eye, cam.target);
         key.save(&base.with_extension("json"))?;
         self.shots += 1;
-        self.message = format!("saved {}", png.display());
-        println!(
-            "forest view: saved {} ({}, debug view {})",
+        self.say(format!(
+            "saved {} ({}, debug view {})",
             png.display(),
             self.methods[self.method].name(),
             self.debug.name()
-        );
-        std::io::stdout().flush()?;
+        ));
         Ok(())
     }
 
@@ -701,7 +700,7 @@ impl Viewer {
             }
             KeyCode::KeyR => match self.recording.take() {
                 Some(p) if !p.keys.is_empty() => {
-                    self.message = match p.save(&self.record_to) {
+                    let text = match p.save(&self.record_to) {
                         Ok(()) => format!(
                             "saved {} keys to {}",
                             p.keys.len(),
@@ -710,7 +709,7 @@ impl Viewer {
                         // Keep walking; the message says why nothing was saved.
                         Err(e) => format!("could not save the path: {e}"),
                     };
-                    println!("forest view: {}", self.message);
+                    self.say(text);
                 }
                 Some(_) => {}
                 None => self.recording = Some(CameraPath::new(self.fov_deg)),
@@ -719,6 +718,20 @@ impl Viewer {
         }
         Ok(())
     }
+}
+
+/// A renderer of `stream` and `geometry` showing `method` and `debug`.
+fn assemble(
+    ctx: &GpuContext,
+    method: Method,
+    debug: DebugView,
+    stream: QuadStream,
+    geometry: Option<GeometryRenderer>,
+) -> Result<ForestRenderer> {
+    let r = ForestRenderer::new(stream, geometry);
+    r.set_method(ctx, method)?;
+    r.stream.set_debug_view(debug);
+    Ok(r)
 }
 
 fn depth_view(ctx: &GpuContext, config: &wgpu::SurfaceConfiguration) -> wgpu::TextureView {
