@@ -3,7 +3,7 @@
 
 mod cli;
 
-use cli::{forest, model};
+use cli::{bake_small, forest, model};
 
 #[test]
 fn quick_benchmarks_write_every_table_chart_and_the_report() {
@@ -11,23 +11,7 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
     let mut atlases = Vec::new();
     for s in ["bush", "pine"] {
         let atlas = dir.path().join(format!("{s}.atlas"));
-        let out = forest(&[
-            "bake",
-            &model(s),
-            "-o",
-            atlas.to_str().unwrap(),
-            "--resolution",
-            "32",
-            "--directions",
-            "5",
-            "--spp",
-            "1",
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        bake_small(s, &atlas, 32, 5);
         atlases.push(atlas.display().to_string());
     }
     let results = dir.path().join("results");

@@ -5,16 +5,7 @@ use std::process::Output;
 
 mod cli;
 
-use cli::{forest, model};
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+use cli::{bake_small, forest, model, ok};
 
 fn err(out: &Output) -> String {
     assert!(
@@ -37,18 +28,7 @@ fn bake_scene_render_end_to_end() {
     let d = dir.path();
     let p = |n: &str| d.join(n).display().to_string();
     for s in ["bush", "aspen"] {
-        ok(&forest(&[
-            "bake",
-            &model(s),
-            "-o",
-            &p(&format!("{s}.atlas")),
-            "--resolution",
-            "64",
-            "--directions",
-            "5",
-            "--spp",
-            "1",
-        ]));
+        bake_small(s, &d.join(format!("{s}.atlas")), 64, 5);
     }
     let species = format!("{},{}", p("bush.atlas"), p("aspen.atlas"));
     let text = ok(&forest(&[

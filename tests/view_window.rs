@@ -5,7 +5,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -14,16 +14,7 @@ use glam::Vec3;
 
 mod cli;
 
-use cli::{forest, model};
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+use cli::{bake_small, forest, model, ok};
 
 fn need(tool: &str) {
     let found = Command::new("sh")
@@ -171,18 +162,7 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     let d = dir.path();
     let p = |n: &str| d.join(n).display().to_string();
     for s in ["bush", "pine"] {
-        ok(&forest(&[
-            "bake",
-            &model(s),
-            "-o",
-            &p(&format!("{s}.atlas")),
-            "--resolution",
-            "64",
-            "--directions",
-            "5",
-            "--spp",
-            "1",
-        ]));
+        bake_small(s, &d.join(format!("{s}.atlas")), 64, 5);
     }
     ok(&forest(&[
         "scene",
@@ -403,18 +383,7 @@ fn walk_look_switch_and_screenshot_in_a_window() {
 fn without_a_display_the_viewer_says_what_to_do() {
     let dir = tempfile::tempdir().unwrap();
     let f = dir.path().join("f.forest");
-    ok(&forest(&[
-        "bake",
-        &model("bush"),
-        "-o",
-        dir.path().join("bush.atlas").to_str().unwrap(),
-        "--resolution",
-        "32",
-        "--directions",
-        "3",
-        "--spp",
-        "1",
-    ]));
+    bake_small("bush", &dir.path().join("bush.atlas"), 32, 3);
     ok(&forest(&[
         "scene",
         "--trees",

@@ -19,3 +19,30 @@ pub fn model(s: &str) -> String {
         .display()
         .to_string()
 }
+
+/// The stdout of a run that must succeed (its stderr is the failure message).
+pub fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Bake bundled model `species` into `atlas`, small enough for tests: `resolution` px,
+/// `directions` directions, 1 sample per pixel.
+pub fn bake_small(species: &str, atlas: &Path, resolution: u32, directions: u32) {
+    ok(&forest(&[
+        "bake",
+        &model(species),
+        "-o",
+        atlas.to_str().expect("a UTF-8 path"),
+        "--resolution",
+        &resolution.to_string(),
+        "--directions",
+        &directions.to_string(),
+        "--spp",
+        "1",
+    ]));
+}

@@ -6,7 +6,7 @@ mod common;
 use forest_format::shading::{srgb_decode_table, srgb_encode};
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::Target;
-use forest_render::{Camera, GpuScene, QuadStream};
+use forest_render::{GpuScene, QuadStream};
 
 #[test]
 fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
@@ -33,16 +33,7 @@ fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
         if frame.dir.y > 0.99 {
             continue; // the zenith: a look-at camera has no up vector there
         }
-        let dist = sphere.radius * 1000.0;
-        let cam = Camera {
-            eye: sphere.center + frame.dir * dist,
-            target: sphere.center,
-            fov_y_deg: (2.0 * (sphere.radius / dist).atan()).to_degrees(),
-            near: dist - 2.0 * sphere.radius,
-            far: dist + 2.0 * sphere.radius,
-            viewport: (res, res),
-            epsilon: 0.5,
-        };
+        let cam = common::along(sphere.center, sphere.radius, frame.dir, res, 0.5);
         stream.render_frame(&ctx, &cam, &target).unwrap();
         let img = target.read(&ctx);
         assert_eq!(ctx.take_errors(), Vec::<String>::new());

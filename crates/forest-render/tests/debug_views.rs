@@ -140,16 +140,7 @@ fn weights_view_shows_the_one_direction_seen_exactly_along() {
         if frame.dir.y > 0.99 {
             continue; // the zenith: a look-at camera has no up vector there
         }
-        let dist = sphere.radius * 1000.0;
-        let cam = Camera {
-            eye: sphere.center + frame.dir * dist,
-            target: sphere.center,
-            fov_y_deg: (2.0 * (sphere.radius / dist).atan()).to_degrees(),
-            near: dist - 2.0 * sphere.radius,
-            far: dist + 2.0 * sphere.radius,
-            viewport: (SIZE, SIZE),
-            epsilon: 0.5,
-        };
+        let cam = common::along(sphere.center, sphere.radius, frame.dir, SIZE, 0.5);
         let colours = covered_colours(&render(&ctx, &s, &t, &cam, DebugView::Weights));
         assert!(
             colours.len() > 100,

@@ -65,7 +65,6 @@ fn quad_stream_resembles_the_supersampled_full_geometry() {
 #[test]
 fn per_vertex_sun_visibility_matches_the_bakes_lighting_better_than_none() {
     use forest_bake::lod::{BILLBOARD_ELEVATIONS, billboard_images};
-    use forest_render::Camera;
     let ctx = common::ctx();
     let forest = common::one_tree(1, 0.0);
     let mesh = forest_bake::Mesh::load(&common::root().join("assets/trees/pine/pine.obj")).unwrap();
@@ -103,16 +102,7 @@ fn per_vertex_sun_visibility_matches_the_bakes_lighting_better_than_none() {
         for (e, image) in BILLBOARD_ELEVATIONS.iter().zip(&baked).take(3) {
             let e = e.to_radians();
             let dir = glam::Vec3::new(0.0, e.sin(), e.cos());
-            let dist = sphere.radius * 1000.0;
-            let cam = Camera {
-                eye: sphere.center + dir * dist,
-                target: sphere.center,
-                fov_y_deg: (2.0 * (sphere.radius / dist).atan()).to_degrees(),
-                near: dist - 2.0 * sphere.radius,
-                far: dist + 2.0 * sphere.radius,
-                viewport: (res * 4, res * 4),
-                epsilon: 1.0,
-            };
+            let cam = common::along(sphere.center, sphere.radius, dir, res * 4, 1.0);
             geo.render_frame(&ctx, &cam, &big).unwrap();
             let img = downsample(&big.read(&ctx), 4);
             let m = forest_metrics::compare(image, &img).unwrap();

@@ -90,6 +90,22 @@ pub fn camera(eye: Vec3, target: Vec3, epsilon: f32) -> Camera {
     }
 }
 
+/// A nearly orthographic camera looking along `-dir` at the sphere (`center`, `radius`) from
+/// 1000 radii away, framing it in a square `size`-pixel viewport: the view of a bake
+/// direction. `dir` must not be vertical (a look-at camera has no up vector there).
+pub fn along(center: Vec3, radius: f32, dir: Vec3, size: u32, epsilon: f32) -> Camera {
+    let dist = radius * 1000.0;
+    Camera {
+        eye: center + dir * dist,
+        target: center,
+        fov_y_deg: (2.0 * (radius / dist).atan()).to_degrees(),
+        near: dist - 2.0 * radius,
+        far: dist + 2.0 * radius,
+        viewport: (size, size),
+        epsilon,
+    }
+}
+
 /// The named test cameras over a forest of extent ~`side` metres around the origin.
 pub fn cameras(side: f32) -> Vec<(&'static str, Camera)> {
     vec![
