@@ -8,7 +8,8 @@ struct Camera {
     // xyz: unit view direction (world); w: unused.
     forward: vec4<f32>,
     // x, y: viewport size in pixels; z: debug view of the draw pass (0 off, 1 levels,
-    // 2 blend weights, 3 wireframe; see renderer::DebugView); w: unused.
+    // 2 blend weights, 3 wireframe; see renderer::DebugView); w: stream flags (FLAG_*, see
+    // renderer::StreamOptions).
     viewport: vec4<f32>,
     // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
     planes: array<vec4<f32>, 6>,
@@ -35,6 +36,11 @@ struct Species {
     tri_count: u32,
     layer_base: u32,
     node_base: u32,
+    // Direction triangles for views from below, after the tri_count upper ones.
+    lower_tri_count: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // One direction frame: dir, right, up (xyz of each), object space.
@@ -48,7 +54,9 @@ struct Frame {
 //   instance: instance index.
 //   node: global node index (species node base + local index).
 //   pos: level (bits 0..4) | x (4..16) | y (16..28) | slab (28..32).
-//   dir_weight: direction index within the species (bits 0..16) | blend alpha, unorm16 (16..32).
+//   dir_weight: direction index within the species (bits 0..8) | lo (8..20) | hi (20..32): the
+//     aspect's share [lo, hi) of its tree's blend, cumulative over the tree's aspects in
+//     drawing order, in units of 1/WEIGHT_ONE.
 struct Quad {
     instance: u32,
     node: u32,
@@ -79,6 +87,11 @@ struct Args {
 }
 
 const WG: u32 = 256u;
+const WEIGHT_ONE: u32 = 4095u;
+// Stream flags in camera.viewport.w; mirror renderer::FLAG_*.
+const FLAG_DITHER: u32 = 1u;
+const FLAG_NEAREST: u32 = 2u;
+const FLAG_DEPTH_ERROR: u32 = 4u;
 const BLOCK: u32 = 512u;
 const NONE: u32 = 0xffffffffu;
 const NODE_TEX_WIDTH: u32 = 4096u;
@@ -88,8 +101,19 @@ fn quad_level(q: Quad) -> u32 { return q.pos & 15u; }
 fn quad_x(q: Quad) -> u32 { return (q.pos >> 4u) & 4095u; }
 fn quad_y(q: Quad) -> u32 { return (q.pos >> 16u) & 4095u; }
 fn quad_slab(q: Quad) -> u32 { return q.pos >> 28u; }
-fn quad_dir(q: Quad) -> u32 { return q.dir_weight & 65535u; }
-fn quad_weight(q: Quad) -> f32 { return f32(q.dir_weight >> 16u) / 65535.0; }
+fn quad_dir(q: Quad) -> u32 { return q.dir_weight & 255u; }
+fn quad_lo(q: Quad) -> u32 { return (q.dir_weight >> 8u) & 4095u; }
+fn quad_hi(q: Quad) -> u32 { return q.dir_weight >> 20u; }
+fn pack_dir(dir: u32, lo: u32, hi: u32) -> u32 { return dir | (lo << 8u) | (hi << 20u); }
+fn stream_flags(c: Camera) -> u32 { return u32(c.viewport.w); }
+
+// Slab-relative depth error bound of a node's 4-bit code (forest_format::node::ERROR_BOUNDS).
+fn node_error(node: vec2<u32>) -> f32 {
+    var b = array<f32, 16>(0.0, 0.0078125, 0.011048543, 0.015625, 0.022097087, 0.03125,
+        0.044194173, 0.0625, 0.088388346, 0.125, 0.17677669, 0.25, 0.35355338, 0.5,
+        0.70710677, 1.0);
+    return b[(node.x >> 24u) & 15u];
+}
 fn pack_pos(level: u32, x: u32, y: u32, slab: u32) -> u32 {
     return level | (x << 4u) | (y << 16u) | (slab << 28u);
 }
@@ -115,7 +139,8 @@ fn slab_point(sp: Species, f: Frame, slab: u32, u: f32, v: f32, t: f32) -> vec3<
         + f.dir.xyz * ((1.0 - 2.0 * d) * r);
 }
 
-// Octahedral projection of the upper hemisphere (see forest_format::directions::disk_point).
+// Octahedral projection of the upper hemisphere (see forest_format::directions::disk_point);
+// for views from below the caller negates y (disk_point_lower).
 fn disk_point(d: vec3<f32>) -> vec2<f32> {
     let den = abs(d.x) + max(d.y, 0.0) + abs(d.z);
     if (den > 0.0) {

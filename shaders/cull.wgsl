@@ -15,16 +15,26 @@ fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
     return a.x * b.y - a.y * b.x;
 }
 
+// Views from below use the lower triangles and the projection with y negated.
 fn blend(sp: Species, view: vec3<f32>) -> Blend {
-    let p = disk_point(view);
+    let below = view.y < 0.0 && sp.lower_tri_count > 0u;
+    var flip = vec3<f32>(1.0, 1.0, 1.0);
+    var first = sp.tri_base;
+    var count = sp.tri_count;
+    if (below) {
+        flip.y = -1.0;
+        first = sp.tri_base + sp.tri_count;
+        count = sp.lower_tri_count;
+    }
+    let p = disk_point(view * flip);
     var best_d = 3.4e38;
     var best = Blend(vec3<u32>(0u), vec3<f32>(1.0, 0.0, 0.0));
     var have_edge = false;
-    for (var k = 0u; k < sp.tri_count; k++) {
-        let t = dir_tris[sp.tri_base + k].xyz;
-        let a = disk_point(frames[sp.dir_base + t.x].dir.xyz);
-        let b = disk_point(frames[sp.dir_base + t.y].dir.xyz);
-        let c = disk_point(frames[sp.dir_base + t.z].dir.xyz);
+    for (var k = 0u; k < count; k++) {
+        let t = dir_tris[first + k].xyz;
+        let a = disk_point(frames[sp.dir_base + t.x].dir.xyz * flip);
+        let b = disk_point(frames[sp.dir_base + t.y].dir.xyz * flip);
+        let c = disk_point(frames[sp.dir_base + t.z].dir.xyz * flip);
         let den = cross2(b - a, c - a);
         if (abs(den) < 1e-12) { continue; }
         let wb = cross2(p - a, c - a) / den;
@@ -81,37 +91,55 @@ fn visible(inst: Instance, sp: Species) -> bool {
     return true;
 }
 
-fn unorm16(x: f32) -> u32 {
-    return u32(floor(clamp(x, 0.0, 1.0) * 65535.0 + 0.5));
+fn unorm12(x: f32) -> u32 {
+    return u32(floor(clamp(x, 0.0, 1.0) * 4095.0 + 0.5));
+}
+
+// Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, the
+// remainder given to the largest (first on ties); with FLAG_NEAREST the largest alone.
+// Quantising first puts every later decision on integers, so a weight a rounding error away
+// from zero cannot make the GPU and the CPU reference (reference::aspect_weights) disagree.
+fn aspect_weights(w: vec3<f32>) -> vec3<u32> {
+    var q = vec3<u32>(unorm12(w.x), unorm12(w.y), unorm12(w.z));
+    var big = 0u;
+    if (q.y > q[big]) { big = 1u; }
+    if (q.z > q[big]) { big = 2u; }
+    if ((stream_flags(camera) & FLAG_NEAREST) != 0u) {
+        var one = vec3<u32>(0u);
+        one[big] = WEIGHT_ONE;
+        return one;
+    }
+    let sum = q.x + q.y + q.z;
+    q[big] = q[big] + WEIGHT_ONE - sum;
+    return q;
 }
 
 // Level-0 quads of one tree, in drawing order: slabs back to front; within a slab the present
-// aspects, each with alpha w_a / (sum of the weights of the aspects drawn so far in this slab),
-// so that "over" compositing yields the weighted average where the aspects are opaque.
-// Writes them from `out` on (skipping indices below `skip`) when `emit`; returns the count.
+// aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
+// weight (present or blank), which the draw pass turns into a dither interval or an "over"
+// alpha (hi − lo) / hi. Writes them from `out` on (skipping indices below `skip`) when `emit`;
+// returns the count.
 fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
     let inst = instances[inst_id];
     let sp = species[inst.species];
     let eye_obj = to_object_dir(inst, camera.eye.xyz - to_world(inst, sp.sphere.xyz));
     let bl = blend(sp, eye_obj);
-    // Weights are quantised first, so that every decision below is on integers and a weight
-    // a rounding error away from zero cannot make the GPU and the CPU reference disagree.
-    let w16 = vec3<u32>(unorm16(bl.w.x), unorm16(bl.w.y), unorm16(bl.w.z));
+    let w12 = aspect_weights(bl.w);
     var n = 0u;
     for (var s = 0u; s < sp.slabs; s++) {
         let slab = sp.slabs - 1u - s;
         var acc = 0u;
         for (var a = 0u; a < 3u; a++) {
-            let w = w16[a];
+            let w = w12[a];
             if (w == 0u) { continue; }
+            let lo = acc;
+            acc = acc + w;
             let layer = sp.layer_base + bl.idx[a] * sp.slabs + slab;
             let root = roots[layer];
             if (root == NONE) { continue; }
-            acc = acc + w;
             if (emit && out + n >= skip) {
-                let alpha = unorm16(f32(w) / f32(acc));
                 quads_out[out + n - skip] = Quad(inst_id, root,
-                    pack_pos(0u, 0u, 0u, slab), bl.idx[a] | (alpha << 16u));
+                    pack_pos(0u, 0u, 0u, slab), pack_dir(bl.idx[a], lo, acc));
             }
             n = n + 1u;
         }

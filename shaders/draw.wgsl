@@ -1,8 +1,14 @@
 // Pass 3, draw: every quad of the final stream becomes 4 vertices (a triangle strip, one
 // instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
 // the sampling frame of its direction and slab (object space), then the instance transform.
-// Textured from the colour array (premultiplied, sRGB-decoded by the format), alpha-blended
-// with the aspect weight: colour = src + dst·(1 − src.a).
+// Textured from the colour array (premultiplied, sRGB-decoded by the format) and blended
+// colour = src + dst·(1 − src.a). A tree's 1–3 aspects combine by an ordered dither (each
+// pixel shows the aspect whose share [lo, hi) of the blend holds the pixel's threshold, so
+// coverage is the weighted mean of the aspects' coverages) or, without FLAG_DITHER, "over"
+// each other with alpha (hi − lo) / hi.
+//
+// A finest-level quad whose depth error still projects longer than ε (with
+// FLAG_DEPTH_ERROR) is drawn flat at its mean depth rather than stretched along its plane.
 //
 // Depth: the quads are drawn strictly back to front (presorted trees, back slab first), so
 // ordering comes from the stream and blending needs no depth writes; writing depth would make
@@ -26,6 +32,8 @@ struct VsOut {
     @location(2) @interpolate(flat) alpha: f32,
     @location(3) @interpolate(flat) level: u32,
     @location(4) @interpolate(flat) dir: u32,
+    // Share [lo, hi) of the blend (x, y) and the instance (z).
+    @location(5) @interpolate(flat) share: vec3<u32>,
 }
 
 @vertex
@@ -39,13 +47,21 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let size = 1.0 / f32(1u << quad_level(q));
     let u = (f32(quad_x(q)) + f32(vi & 1u)) * size;
     let v = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
-    let t = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    var t = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    let flags = stream_flags(camera);
+    if ((flags & FLAG_DEPTH_ERROR) != 0u && (node.x >> 28u) == 0u && error_long(q, node)) {
+        t = node_mean_depth(node);
+    }
     let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
     var out: VsOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.uv = vec2<f32>(u, v);
     out.layer = sp.layer_base + dir * sp.slabs + quad_slab(q);
-    out.alpha = quad_weight(q);
+    let lo = quad_lo(q);
+    let hi = quad_hi(q);
+    out.alpha = select(0.0, f32(hi - lo) / f32(hi), hi > 0u);
+    if ((flags & FLAG_DITHER) != 0u) { out.alpha = 1.0; }
+    out.share = vec3<u32>(lo, hi, q.instance);
     out.level = quad_level(q);
     out.dir = dir;
     return out;
@@ -74,6 +90,20 @@ fn direction_colour(dir: u32) -> vec3<f32> {
     return 0.15 + 0.8 * rgb;
 }
 
+// Ordered-dither threshold of a pixel for a tree, in [0, WEIGHT_ONE): an 8×8 Bayer matrix,
+// shifted per instance so that neighbouring trees do not share a pattern.
+fn dither_threshold(pixel: vec2<f32>, instance: u32) -> u32 {
+    let x = u32(pixel.x) & 7u;
+    let y = u32(pixel.y) & 7u;
+    let xy = x ^ y;
+    let b = ((xy & 1u) << 5u) | ((y & 1u) << 4u) | ((xy & 2u) << 2u) | ((y & 2u) << 1u)
+        | ((xy & 4u) >> 1u) | ((y & 4u) >> 2u);
+    var h = instance * 747796405u + 2891336453u;
+    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+    let u = fract((f32(b) + 0.5) / 64.0 + f32(h >> 8u) / 16777216.0);
+    return min(u32(u * f32(WEIGHT_ONE)), WEIGHT_ONE - 1u);
+}
+
 @fragment
 fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
     let c = textureSample(colour, colour_sampler, in.uv, in.layer);
@@ -81,6 +111,10 @@ fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
     let g = in.uv * f32(1u << in.level);
     let px = max(fwidth(g), vec2<f32>(1e-6));
     let mode = u32(camera.viewport.z);
+    if ((stream_flags(camera) & FLAG_DITHER) != 0u) {
+        let u = dither_threshold(in.clip.xy, in.share.z);
+        if (u < in.share.x || u >= in.share.y) { discard; }
+    }
     if (mode == DEBUG_LEVELS) {
         return vec4<f32>(level_colour(in.level) * c.a, c.a) * in.alpha;
     }

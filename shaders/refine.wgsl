@@ -6,26 +6,11 @@
 
 // Clip-space position of corner c (0 TL, 1 TR, 2 BL, 3 BR) of a quad.
 fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
-    let inst = instances[q.instance];
-    let sp = species[inst.species];
-    let f = frames[sp.dir_base + quad_dir(q)];
     let size = 1.0 / f32(1u << quad_level(q));
     let u = (f32(quad_x(q)) + f32(c & 1u)) * size;
     let v = (f32(quad_y(q)) + f32(c >> 1u)) * size;
     let t = f32((node.y >> (8u * c)) & 255u) / 255.0;
-    let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
-    let m = camera.view_proj;
-    return m[0] * w.x + m[1] * w.y + m[2] * w.z + m[3];
-}
-
-// Whether the projected edge a-b is longer than ε pixels; both corners in front of the eye.
-fn edge_long(a: vec4<f32>, b: vec4<f32>) -> bool {
-    let sx = camera.viewport.x * 0.5;
-    let sy = camera.viewport.y * 0.5;
-    let dx = (a.x * b.w - b.x * a.w) * sx;
-    let dy = (a.y * b.w - b.y * a.w) * sy;
-    let lim = camera.eye.w * a.w * b.w;
-    return dx * dx + dy * dy > lim * lim;
+    return quad_clip_at(q, u, v, t);
 }
 
 // 0: keep; otherwise 1 + the number of extra quads refining it makes (children − 1).
@@ -44,6 +29,9 @@ fn wants(q: Quad) -> u32 {
     if (!long) {
         long = edge_long(clip[0], clip[1]) || edge_long(clip[1], clip[3])
             || edge_long(clip[3], clip[2]) || edge_long(clip[2], clip[0]);
+    }
+    if (!long && (stream_flags(camera) & FLAG_DEPTH_ERROR) != 0u) {
+        long = error_long(q, node);
     }
     if (!long) { return 0u; }
     return countOneBits(mask);
@@ -93,7 +81,7 @@ fn refine_emit(@builtin(global_invocation_id) gid: vec3<u32>) {
     let node_base = species[inst.species].node_base;
     let node = node_at(q.node);
     let mask = node.x >> 28u;
-    var child = node_base + (node.x & 0x0fffffffu);
+    var child = node_base + (node.x & 0x00ffffffu);
     let level = quad_level(q) + 1u;
     for (var c = 0u; c < 4u; c++) {
         if ((mask & (1u << c)) == 0u) { continue; }

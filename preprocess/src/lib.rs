@@ -116,7 +116,7 @@ pub fn bake_mesh(
     let start = Instant::now();
     let sphere = bounding_sphere(mesh);
     let scene = trace::Scene::new(mesh);
-    let dirs = forest_format::directions::hemisphere_directions(params.directions);
+    let dirs = forest_format::directions::sampling_directions(params.directions, params.below);
     let frames: Vec<_> = dirs
         .iter()
         .map(|&d| forest_format::slab::DirectionFrame::new(d))
@@ -149,7 +149,14 @@ pub fn bake_mesh(
                 .iter()
                 .map(|&d| sphere_to_slab_depth(d, slab, params.slabs).clamp(0.0, 1.0))
                 .collect();
-            quadtree::build_layer(&alpha, &depth, params.resolution, params.min_quad)
+            quadtree::build_layer(
+                &alpha,
+                &depth,
+                params.resolution,
+                params.min_quad,
+                params.slabs,
+                params.plane_fit,
+            )
         })
         .collect();
 
@@ -181,7 +188,9 @@ pub fn bake_mesh(
         for t in &trees {
             if let Some(level) = t.levels.get(k) {
                 for n in level {
-                    nodes.push(QuadNode::new(n.mask, next_child as u32, n.depth));
+                    nodes.push(
+                        QuadNode::new(n.mask, next_child as u32, n.depth).with_error(n.error),
+                    );
                     next_child += u64::from(n.mask.count_ones());
                 }
                 *count += level.len() as u64;

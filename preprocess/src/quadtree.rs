@@ -8,7 +8,10 @@
 //! Moments are summed bottom-up, so building all levels costs one pass over the pixels plus
 //! a third of the finest level's node count.
 
-use forest_format::node::quantize_depth;
+use forest_format::PlaneFit;
+#[cfg(test)]
+use forest_format::node::error_bound;
+use forest_format::node::{error_code, quantize_depth};
 
 /// Weighted moments of the pixels of a node (coordinates in pixels, depth slab-relative).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -155,6 +158,9 @@ pub struct LocalNode {
     pub mask: u8,
     /// Quantised corner depths, slab-relative.
     pub depth: [u8; 4],
+    /// Depth-error code ([`forest_format::node::error_code`]) of the largest distance between a
+    /// pixel's depth and the bilinear surface of the quantised corners at that pixel.
+    pub error: u8,
 }
 
 /// One layer's quad hierarchy: per level, the non-blank nodes in breadth-first order (children
@@ -165,17 +171,146 @@ pub struct LayerTree {
     pub levels: Vec<Vec<LocalNode>>,
 }
 
+/// Depth bins of the gap search: one per unorm8 quantisation step of the corner depths.
+const BINS: usize = 256;
+
+/// A depth gap, in pixel widths of depth, that splits a node's pixels into separate clusters:
+/// a surface less steep than this many pixels of depth per pixel across leaves no empty run
+/// this long between its sorted depths.
+pub const GAP_PIXELS: f32 = 3.0;
+
+/// The pixels of one node that its plane is fitted to: their depth range and moments.
+struct Cluster {
+    moments: Moments,
+    t_min: f64,
+    t_max: f64,
+}
+
+/// The heaviest cluster of the node's pixels once they are split wherever `gap_bins` or more
+/// consecutive depth bins are empty (ties: the front one, nearer the sampling camera).
+fn front_cluster(
+    alpha: &[u8],
+    depth: &[f32],
+    r: usize,
+    rect: (usize, usize, usize),
+    gap_bins: usize,
+) -> Option<Cluster> {
+    let (x0, y0, side) = rect;
+    let bin = |t: f32| ((t.clamp(0.0, 1.0) * (BINS - 1) as f32).round() as usize).min(BINS - 1);
+    let mut hist = [0f64; BINS];
+    for y in y0..y0 + side {
+        for x in x0..x0 + side {
+            let a = alpha[y * r + x];
+            if a > 0 {
+                hist[bin(depth[y * r + x])] += f64::from(a);
+            }
+        }
+    }
+    // Runs of bins separated by at least `gap_bins` empty bins; keep the heaviest.
+    let mut best: Option<(f64, usize, usize)> = None;
+    let mut cur: Option<(f64, usize, usize)> = None;
+    let mut empty = 0usize;
+    for (b, &w) in hist.iter().enumerate() {
+        if w > 0.0 {
+            cur = match cur {
+                Some((sum, lo, _)) if empty < gap_bins => Some((sum + w, lo, b)),
+                _ => {
+                    if let Some(c) = cur
+                        && best.is_none_or(|bb| c.0 > bb.0)
+                    {
+                        best = Some(c);
+                    }
+                    Some((w, b, b))
+                }
+            };
+            empty = 0;
+        } else {
+            empty += 1;
+        }
+    }
+    if let Some(c) = cur
+        && best.is_none_or(|bb| c.0 > bb.0)
+    {
+        best = Some(c);
+    }
+    let (_, lo, hi) = best?;
+    let mut m = Moments::default();
+    let (mut t_min, mut t_max) = (f64::INFINITY, f64::NEG_INFINITY);
+    for y in y0..y0 + side {
+        for x in x0..x0 + side {
+            let a = alpha[y * r + x];
+            let t = depth[y * r + x];
+            if a == 0 || !(lo..=hi).contains(&bin(t)) {
+                continue;
+            }
+            let t = f64::from(t);
+            m.add(f64::from(a) / 255.0, x as f64 + 0.5, y as f64 + 0.5, t);
+            t_min = t_min.min(t);
+            t_max = t_max.max(t);
+        }
+    }
+    Some(Cluster {
+        moments: m,
+        t_min,
+        t_max,
+    })
+}
+
+/// The largest distance between a covered pixel's depth and the bilinear surface through the
+/// quantised corner depths `q` of the square `(x0, y0, side)`, slab-relative.
+fn depth_error(
+    alpha: &[u8],
+    depth: &[f32],
+    r: usize,
+    rect: (usize, usize, usize),
+    q: [u8; 4],
+) -> f32 {
+    let (x0, y0, side) = rect;
+    let c = q.map(|d| f32::from(d) / 255.0);
+    let mut err = 0f32;
+    for y in y0..y0 + side {
+        let fy = ((y - y0) as f32 + 0.5) / side as f32;
+        let left = c[0] + (c[2] - c[0]) * fy;
+        let right = c[1] + (c[3] - c[1]) * fy;
+        for x in x0..x0 + side {
+            if alpha[y * r + x] == 0 {
+                continue;
+            }
+            let fx = ((x - x0) as f32 + 0.5) / side as f32;
+            err = err.max((depth[y * r + x] - (left + (right - left) * fx)).abs());
+        }
+    }
+    err
+}
+
 /// Build the hierarchy of one layer from its 8-bit alpha and slab-relative depth (`t`, only
-/// read where alpha > 0), both `resolution²` row-major.
+/// read where alpha > 0), both `resolution²` row-major. `slabs` (of the bake) sets how deep a
+/// pixel is in slab units (`slabs / resolution`), which scales the gap of
+/// [`PlaneFit::GapAware`].
+///
+/// With [`PlaneFit::GapAware`] each node fits the heaviest depth cluster of its pixels
+/// ([`GAP_PIXELS`]) and clamps its corners to that cluster's depth range, so no node's corners
+/// span a gap between clusters; with [`PlaneFit::LeastSquares`] it fits all its pixels and
+/// clamps to the slab. Either way each node records its depth error.
 ///
 /// # Panics
 /// If the sizes disagree or `min_quad` is not a power of two below `resolution` (the bake
 /// checks its parameters first).
-pub fn build_layer(alpha: &[u8], depth: &[f32], resolution: u32, min_quad: u32) -> LayerTree {
+pub fn build_layer(
+    alpha: &[u8],
+    depth: &[f32],
+    resolution: u32,
+    min_quad: u32,
+    slabs: u32,
+    fit: PlaneFit,
+) -> LayerTree {
     let r = resolution as usize;
     assert_eq!(alpha.len(), r * r);
     assert_eq!(depth.len(), r * r);
     assert!(min_quad.is_power_of_two() && min_quad < resolution);
+    let gap_bins = ((GAP_PIXELS * slabs as f32 / resolution as f32) * (BINS - 1) as f32)
+        .ceil()
+        .max(2.0) as usize;
     let levels = forest_format::node::level_count(resolution, min_quad) as usize;
     // Moments per level, dense 2^k × 2^k.
     let mut moments: Vec<Vec<Moments>> = Vec::with_capacity(levels);
@@ -224,13 +359,30 @@ pub fn build_layer(alpha: &[u8], depth: &[f32], resolution: u32, min_quad: u32) 
     let mut frontier = vec![(0u32, 0u32)];
     for k in 0..levels {
         let n = 1u32 << k;
-        let size = f64::from(resolution >> k);
+        let side = r >> k;
+        let size = side as f64;
         let mut nodes = Vec::with_capacity(frontier.len());
         let mut next = Vec::new();
         for &(x, y) in &frontier {
-            let m = &moments[k][(y * n + x) as usize];
-            let plane = m.plane().expect("only non-blank nodes are visited");
-            let c = plane.corners(f64::from(x) * size, f64::from(y) * size, size);
+            let rect = (x as usize * side, y as usize * side, side);
+            let (x0, y0) = (f64::from(x) * size, f64::from(y) * size);
+            let c = match fit {
+                PlaneFit::LeastSquares => {
+                    let m = &moments[k][(y * n + x) as usize];
+                    let plane = m.plane().expect("only non-blank nodes are visited");
+                    plane.corners(x0, y0, size)
+                }
+                PlaneFit::GapAware => {
+                    let cl = front_cluster(alpha, depth, r, rect, gap_bins)
+                        .expect("only non-blank nodes are visited");
+                    let plane = cl.moments.plane().expect("a cluster has weight");
+                    plane
+                        .corners(x0, y0, size)
+                        .map(|d| d.clamp(cl.t_min, cl.t_max))
+                }
+            };
+            let quantised = c.map(|d| quantize_depth(d as f32));
+            let error = error_code(depth_error(alpha, depth, r, rect, quantised));
             let mut mask = 0u8;
             if k + 1 < levels {
                 for i in 0..4u32 {
@@ -245,7 +397,8 @@ pub fn build_layer(alpha: &[u8], depth: &[f32], resolution: u32, min_quad: u32) 
                 x,
                 y,
                 mask,
-                depth: c.map(|d| quantize_depth(d as f32)),
+                depth: quantised,
+                error,
             });
         }
         tree.levels.push(nodes);
@@ -271,7 +424,7 @@ mod tests {
                 alpha[y * r + x] = (1 + (x * 7 + y * 13) % 255) as u8;
             }
         }
-        let tree = build_layer(&alpha, &depth, r as u32, 4);
+        let tree = build_layer(&alpha, &depth, r as u32, 4, 2, PlaneFit::LeastSquares);
         assert_eq!(tree.levels.len(), 5);
         for (k, level) in tree.levels.iter().enumerate() {
             assert_eq!(level.len(), 1 << (2 * k), "level {k} is full");
@@ -317,10 +470,14 @@ mod tests {
         let r = 32usize;
         let mut alpha = vec![0u8; r * r];
         let depth = vec![0.5f32; r * r];
-        assert!(build_layer(&alpha, &depth, 32, 4).levels.is_empty());
+        assert!(
+            build_layer(&alpha, &depth, 32, 4, 2, PlaneFit::GapAware)
+                .levels
+                .is_empty()
+        );
         // One opaque pixel at (5, 9): exactly one node per level, on the path to it.
         alpha[9 * r + 5] = 255;
-        let tree = build_layer(&alpha, &depth, 32, 4);
+        let tree = build_layer(&alpha, &depth, 32, 4, 2, PlaneFit::GapAware);
         assert_eq!(tree.levels.len(), 4);
         for (k, level) in tree.levels.iter().enumerate() {
             assert_eq!(level.len(), 1, "level {k}");
@@ -348,5 +505,95 @@ mod tests {
             m.plane().unwrap()
         };
         assert_eq!((single.gx, single.gy, single.t), (0.0, 0.0, 0.7));
+    }
+
+    /// Two parallel cards, one at slab depth 0.2 over the left half of every quad, one at 0.8
+    /// over the right half: `(alpha, depth)` of a `r`² layer.
+    fn two_cards(r: usize) -> (Vec<u8>, Vec<f32>) {
+        let mut alpha = vec![255u8; r * r];
+        let mut depth = vec![0f32; r * r];
+        for y in 0..r {
+            for x in 0..r {
+                // Left half of each 4-px column pair is near, right half far; a few texels
+                // weigh less, which must not matter.
+                depth[y * r + x] = if x % 4 < 2 { 0.2 } else { 0.8 };
+                if (x + y) % 7 == 0 {
+                    alpha[y * r + x] = 200;
+                }
+            }
+        }
+        (alpha, depth)
+    }
+
+    #[test]
+    fn no_gap_aware_node_spans_the_gap_between_two_cards() {
+        let r = 32;
+        let (alpha, depth) = two_cards(r);
+        let near = quantize_depth(0.2);
+        let far = quantize_depth(0.8);
+        let tree = build_layer(&alpha, &depth, r as u32, 4, 2, PlaneFit::GapAware);
+        assert_eq!(tree.levels.len(), 4);
+        for (k, level) in tree.levels.iter().enumerate() {
+            for n in level {
+                // Every corner lies on one card: all at the near depth or all at the far one.
+                let on_near = n.depth.iter().all(|&d| d == near);
+                let on_far = n.depth.iter().all(|&d| d == far);
+                assert!(on_near || on_far, "level {k} node {n:?} spans the gap");
+                // The other card's pixels are 0.6 away: the error code bounds that.
+                assert!(
+                    error_bound(n.error) >= 0.6 - 1.0 / 255.0,
+                    "level {k}: {n:?}"
+                );
+                assert!(
+                    error_bound(n.error.saturating_sub(1)) < 0.6,
+                    "level {k}: {n:?}"
+                );
+            }
+        }
+        // The paper's least-squares fit bridges the gap with a steep plane: the same input
+        // gives nodes whose corners reach from near the one card to near the other.
+        let ls = build_layer(&alpha, &depth, r as u32, 4, 2, PlaneFit::LeastSquares);
+        let bridging = ls.levels[3]
+            .iter()
+            .filter(|n| {
+                let (lo, hi) = (n.depth.iter().min().unwrap(), n.depth.iter().max().unwrap());
+                *lo < near + 20 && *hi > far - 20
+            })
+            .count();
+        assert_eq!(bridging, ls.levels[3].len());
+    }
+
+    #[test]
+    fn a_single_card_has_no_depth_error_and_a_lone_far_pixel_sets_it() {
+        let r = 16usize;
+        let mut alpha = vec![255u8; r * r];
+        let mut depth = vec![0f32; r * r];
+        for y in 0..r {
+            for x in 0..r {
+                depth[y * r + x] = 0.3 + 0.01 * x as f32;
+            }
+        }
+        let tree = build_layer(&alpha, &depth, r as u32, 4, 1, PlaneFit::GapAware);
+        assert!(
+            tree.levels.iter().flatten().all(|n| n.error == 0),
+            "{tree:?}"
+        );
+        // One far pixel: it is its own cluster (ignored by the fit) but sets the error of the
+        // nodes that hold it, and only those.
+        depth[5 * r + 6] = 0.95;
+        alpha[0] = 0;
+        let tree = build_layer(&alpha, &depth, r as u32, 4, 1, PlaneFit::GapAware);
+        for (k, level) in tree.levels.iter().enumerate() {
+            let side = r >> k;
+            for n in level {
+                let holds = n.x as usize == 6 / side && n.y as usize == 5 / side;
+                let want = 0.95 - (0.3 + 0.01 * 6.5);
+                if holds {
+                    assert!(error_bound(n.error) >= want - 0.01, "level {k}: {n:?}");
+                } else {
+                    assert_eq!(n.error, 0, "level {k}: {n:?}");
+                }
+            }
+        }
     }
 }

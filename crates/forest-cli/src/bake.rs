@@ -14,9 +14,17 @@ pub struct BakeArgs {
     /// Output atlas folder (conventionally NAME.atlas); an existing atlas there is replaced.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Sampling directions over the upper hemisphere.
+    /// Sampling directions over the upper hemisphere (horizon to zenith).
     #[arg(long, default_value_t = 15)]
     pub directions: u32,
+    /// Sampling directions below the horizon, for trees seen from below (walkthroughs): a ring
+    /// at −45° and the nadir at the default 5; 0 clamps views from below onto the horizon.
+    #[arg(long, default_value_t = 5)]
+    pub below: u32,
+    /// How quad planes are fitted: gap-aware (no plane bridges a depth gap) or least-squares
+    /// (the paper's fit over all of a quad's pixels).
+    #[arg(long, default_value = "gap-aware", value_parser = ["gap-aware", "least-squares"])]
+    pub plane_fit: String,
     /// Parallel slabs per direction.
     #[arg(long, default_value_t = 2)]
     pub slabs: u32,
@@ -80,6 +88,12 @@ impl BakeArgs {
     fn params(&self) -> BakeParams {
         BakeParams {
             directions: self.directions,
+            below: self.below,
+            plane_fit: if self.plane_fit == "least-squares" {
+                forest_format::PlaneFit::LeastSquares
+            } else {
+                forest_format::PlaneFit::GapAware
+            },
             slabs: self.slabs,
             resolution: self.resolution,
             min_quad: self.min_quad,
@@ -208,13 +222,16 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             out.triangles, m.source.degenerate_triangles, m.bounding_sphere.radius
         );
         println!(
-            "  {} directions x {} slabs of {}² px, {} levels (smallest quad {} px), {} spp",
+            "  {} + {} directions (above + below the horizon) x {} slabs of {}² px, {} levels \
+             (smallest quad {} px), {} spp, {} plane fit",
             params.directions,
+            params.below,
             params.slabs,
             params.resolution,
             m.levels,
             params.min_quad,
-            params.spp
+            params.spp,
+            params.plane_fit.name()
         );
         println!(
             "  nodes per level {:?}, {} in all",
@@ -253,11 +270,12 @@ pub fn info(args: &InfoArgs) -> Result<()> {
         );
     } else {
         println!(
-            "{}: {} ({} triangles), {} directions x {} slabs of {}² px, {} levels, {} nodes, GPU {:.2} MB",
+            "{}: {} ({} triangles), {} + {} directions x {} slabs of {}² px, {} levels, {} nodes, GPU {:.2} MB",
             args.atlas.display(),
             m.source.file,
             m.source.triangles,
             m.params.directions,
+            m.params.below,
             m.params.slabs,
             m.params.resolution,
             m.levels,

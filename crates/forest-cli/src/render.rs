@@ -8,7 +8,7 @@ use forest_format::forest::Forest;
 use forest_render::geometry::{
     GeometryRenderer, GeometrySpecies, Lods, MeshMethod, PreparedGeometry, Stochastic,
 };
-use forest_render::renderer::RendererOptions;
+use forest_render::renderer::{AspectBlend, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
@@ -88,9 +88,31 @@ pub struct MethodArgs {
     /// LODs: distances (m, per unit tree scale) where LOD 1, LOD 2 and billboards start.
     #[arg(long, value_delimiter = ',', default_values_t = Lods::default().distances)]
     pub lod_distances: Vec<f32>,
+    /// Quad stream: how a tree's 1–3 aspects combine: dither (each pixel shows one aspect,
+    /// chosen by weight: coverage is the weighted mean), over (alpha-blended over each other,
+    /// the paper's blend: coverage is their union), nearest (the largest weight alone).
+    #[arg(long, default_value = "dither", value_parser = ["dither", "over", "nearest"])]
+    pub blend: String,
+    /// Quad stream: refine by projected edge length alone (the paper's metric), not also by
+    /// each quad's projected depth error, and draw finest quads on their planes however far
+    /// their pixels lie from them.
+    #[arg(long)]
+    pub no_depth_error: bool,
 }
 
 impl MethodArgs {
+    /// The quad stream's run-time options.
+    pub fn stream_options(&self) -> StreamOptions {
+        StreamOptions {
+            blend: match self.blend.as_str() {
+                "over" => AspectBlend::Over,
+                "nearest" => AspectBlend::Nearest,
+                _ => AspectBlend::Dither,
+            },
+            depth_error: !self.no_depth_error,
+        }
+    }
+
     /// The geometry method `name` names (None for the quad-stream methods).
     pub fn method(&self, name: &str) -> Result<Option<MeshMethod>> {
         let m = match name {
@@ -262,6 +284,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ..Default::default()
     };
     let stream = QuadStream::new(&ctx, scene, &opts)?;
+    stream.set_options(args.m.stream_options());
     let target = Target::new(&ctx, sw, sh);
     for (name, cam) in &cameras {
         let mut cam = *cam;

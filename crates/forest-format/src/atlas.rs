@@ -25,7 +25,7 @@ use crate::{directions, nodes_codec};
 /// The `format` field of every atlas manifest.
 pub const ATLAS_FORMAT: &str = "forest-atlas";
 /// The atlas format version this crate reads and writes.
-pub const ATLAS_VERSION: u32 = 1;
+pub const ATLAS_VERSION: u32 = 2;
 /// Manifest file name inside an atlas folder.
 pub const MANIFEST_FILE: &str = "manifest.json";
 /// Alpha mosaic file name.
@@ -60,11 +60,41 @@ impl ColourEncoding {
     }
 }
 
+/// How a quad-hierarchy node's depth plane is fitted to its pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlaneFit {
+    /// Split the node's pixels at depth gaps, fit the heaviest cluster (front on ties), and
+    /// keep the corner depths within that cluster's depth range: no plane bridges a gap.
+    #[default]
+    GapAware,
+    /// One weighted least-squares plane over all the node's pixels (the paper's fit); corners
+    /// clamped to the slab only.
+    LeastSquares,
+}
+
+impl PlaneFit {
+    /// Short name for the CLI and the benchmark tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlaneFit::GapAware => "gap-aware",
+            PlaneFit::LeastSquares => "least-squares",
+        }
+    }
+}
+
 /// Every parameter of a bake, with the defaults of the paper.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BakeParams {
-    /// Number of sampling directions over the upper hemisphere (1..=256; default 15).
+    /// Number of sampling directions over the upper hemisphere, horizon and zenith included
+    /// (1..=256; default 15).
     pub directions: u32,
+    /// Sampling directions below the horizon, for trees seen from below (default 5: four at
+    /// −45° and the nadir; 0 clamps views from below onto the horizon). `directions + below`
+    /// is at most 256.
+    pub below: u32,
+    /// How node planes are fitted.
+    pub plane_fit: PlaneFit,
     /// Parallel slabs per direction (1..=16; default 2).
     pub slabs: u32,
     /// Slab image side in pixels, a power of two (2..=8192; default 512).
@@ -85,6 +115,8 @@ impl Default for BakeParams {
     fn default() -> Self {
         Self {
             directions: 15,
+            below: 5,
+            plane_fit: PlaneFit::GapAware,
             slabs: 2,
             resolution: 512,
             min_quad: 4,
@@ -97,9 +129,14 @@ impl Default for BakeParams {
 }
 
 impl BakeParams {
-    /// Number of slab images (layers): `directions × slabs`.
+    /// Number of slab images (layers): `(directions + below) × slabs`.
     pub fn layers(&self) -> u32 {
-        self.directions * self.slabs
+        self.total_directions() * self.slabs
+    }
+
+    /// Sampling directions in all: `directions + below`.
+    pub fn total_directions(&self) -> u32 {
+        self.directions + self.below
     }
 
     /// Number of quad levels, `log2(resolution) − log2(min_quad) + 1`.
@@ -124,6 +161,12 @@ impl BakeParams {
             return p(format!(
                 "directions = {}: must be 1 to 256",
                 self.directions
+            ));
+        }
+        if self.below > 256 - self.directions {
+            return p(format!(
+                "below = {}: directions + below must be at most 256 (directions = {})",
+                self.below, self.directions
             ));
         }
         if !(1..=16).contains(&self.slabs) {
@@ -221,8 +264,10 @@ pub struct AtlasManifest {
     pub bounding_sphere: Sphere,
     /// Sampling directions with their image frames (`params.directions` of them).
     pub directions: Vec<DirectionFrame>,
-    /// Triangulation of the directions (see [`crate::directions`]).
+    /// Triangulation of the directions seen from above the horizon (see [`crate::directions`]).
     pub direction_triangles: Vec<[u32; 3]>,
+    /// Triangulation of the directions seen from below the horizon (empty when `below` is 0).
+    pub lower_triangles: Vec<[u32; 3]>,
     /// Quad levels per slab image.
     pub levels: u32,
     /// Root node index of each layer (`direction·slabs + slab`); `None` for a blank layer.
@@ -291,11 +336,12 @@ impl AtlasManifest {
                 self.params.levels()
             ));
         }
-        if self.directions.len() != self.params.directions as usize {
+        let total = self.params.total_directions();
+        if self.directions.len() != total as usize {
             return bad(format!(
                 "{} direction frames for {} directions",
                 self.directions.len(),
-                self.params.directions
+                total
             ));
         }
         for (i, f) in self.directions.iter().enumerate() {
@@ -309,11 +355,11 @@ impl AtlasManifest {
         if let Some(t) = self
             .direction_triangles
             .iter()
-            .find(|t| t.iter().any(|&i| i >= self.params.directions))
+            .chain(&self.lower_triangles)
+            .find(|t| t.iter().any(|&i| i >= total))
         {
             return bad(format!(
-                "direction triangle {t:?} names a direction beyond {}",
-                self.params.directions
+                "direction triangle {t:?} names a direction beyond {total}"
             ));
         }
         let s = &self.bounding_sphere;
@@ -831,7 +877,8 @@ pub fn manifest_for(
     layer_roots: Vec<Option<u32>>,
     nodes_per_level: Vec<u64>,
 ) -> AtlasManifest {
-    let dirs = directions::hemisphere_directions(params.directions);
+    let dirs = directions::sampling_directions(params.directions, params.below);
+    let (upper, lower) = directions::triangulate_sphere(&dirs);
     AtlasManifest {
         format: ATLAS_FORMAT.into(),
         version: ATLAS_VERSION,
@@ -839,7 +886,8 @@ pub fn manifest_for(
         lighting: params.lighting(),
         levels: params.levels(),
         bounding_sphere,
-        direction_triangles: directions::triangulate(&dirs),
+        direction_triangles: upper,
+        lower_triangles: lower,
         directions: dirs.into_iter().map(DirectionFrame::new).collect(),
         layer_roots,
         node_count: nodes_per_level.iter().sum(),

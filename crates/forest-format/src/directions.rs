@@ -1,13 +1,18 @@
-//! Sampling directions over the upper hemisphere, their triangulation, and view blending.
+//! Sampling directions over the sphere, their triangulation, and view blending.
 //!
-//! Directions lie on rings of constant elevation, the first ring on the horizon and the last
-//! point at the zenith, with points per ring proportional to the ring's circumference, so the
-//! set covers the whole hemisphere (views from below the horizon are clamped onto it). They
-//! are triangulated (Delaunay) in the octahedral projection `p = (x, z)/(|x| + max(y,0) + |z|)`
-//! (the zenith at the centre, the horizon on the diamond `|p.x| + |p.y| = 1`); the blend of a
-//! view direction is its barycentric coordinates in the triangle that contains its projection.
-//! The projection needs no trigonometry and is scale-invariant, so the GPU computes exactly the
-//! same weights as this CPU code from an unnormalised view vector.
+//! Upper directions lie on rings of constant elevation, the first ring on the horizon and the
+//! last point at the zenith, with points per ring proportional to the ring's circumference, so
+//! the set covers the whole upper hemisphere. Optional lower directions (rings below the
+//! horizon and the nadir) follow them, for trees seen from below. Each hemisphere is
+//! triangulated (Delaunay) in its own octahedral projection: above,
+//! `p = (x, z)/(|x| + max(y,0) + |z|)` (the zenith at the centre), below,
+//! `p = (x, z)/(|x| + max(−y,0) + |z|)` (the nadir at the centre); both put the horizon on the
+//! diamond `|p.x| + |p.y| = 1`, and both triangulations include the horizon ring, so blends
+//! agree across the horizon. The blend of a view direction is its barycentric coordinates in
+//! the triangle of its hemisphere that contains its projection. Without lower directions, views
+//! from below are clamped onto the horizon. The projections need no trigonometry and are
+//! scale-invariant, so the GPU computes exactly the same weights as this CPU code from an
+//! unnormalised view vector.
 
 use glam::{Vec2, Vec3};
 
@@ -73,6 +78,66 @@ pub fn hemisphere_directions(count: u32) -> Vec<Vec3> {
     dirs
 }
 
+/// The sampling directions: `upper` over the upper hemisphere ([`hemisphere_directions`]),
+/// then `below` under the horizon ([`lower_directions`]).
+pub fn sampling_directions(upper: u32, below: u32) -> Vec<Vec3> {
+    let mut d = hemisphere_directions(upper);
+    d.extend(lower_directions(below));
+    d
+}
+
+/// `count` directions strictly below the horizon, deterministic: the nadir last, and before it
+/// `R = max(1, round(√(count − 1) / 2))` rings at elevations `−90°·i/(R + 1)`, `i = 1..=R`,
+/// sharing `count − 1` points in proportion to `cos(elevation)` (at least one each while
+/// points last). At `count = 5`: four at −45° (azimuths 45°, 135°, …) and the nadir.
+pub fn lower_directions(count: u32) -> Vec<Vec3> {
+    if count == 0 {
+        return Vec::new();
+    }
+    let rest = count - 1;
+    let mut dirs = Vec::with_capacity(count as usize);
+    if rest > 0 {
+        let rings = ((f64::from(rest).sqrt() / 2.0).round() as u32).clamp(1, rest);
+        let elev: Vec<f64> = (1..=rings)
+            .map(|i| -std::f64::consts::FRAC_PI_2 * f64::from(i) / f64::from(rings + 1))
+            .collect();
+        let total: f64 = elev.iter().map(|e| e.cos()).sum();
+        let mut counts: Vec<u32> = elev
+            .iter()
+            .map(|e| ((f64::from(rest) * e.cos() / total).round() as u32).max(1))
+            .collect();
+        while counts.iter().sum::<u32>() > rest {
+            let i = counts.iter().rposition(|&c| c > 1).unwrap_or(0);
+            counts[i] -= 1;
+        }
+        while counts.iter().sum::<u32>() < rest {
+            counts[0] += 1;
+        }
+        for (i, (&e, &n)) in elev.iter().zip(&counts).enumerate() {
+            for j in 0..n {
+                let phi = 2.0 * std::f64::consts::PI * (f64::from(j) + 0.5 * ((i + 1) % 2) as f64)
+                    / f64::from(n);
+                dirs.push(
+                    Vec3::new(
+                        (e.cos() * phi.sin()) as f32,
+                        e.sin() as f32,
+                        (e.cos() * phi.cos()) as f32,
+                    )
+                    .normalize(),
+                );
+            }
+        }
+    }
+    dirs.push(Vec3::NEG_Y);
+    dirs
+}
+
+/// Octahedral projection of a direction for views from below (the nadir at the centre);
+/// above-horizon directions land on the horizon's diamond.
+pub fn disk_point_lower(dir: Vec3) -> Vec2 {
+    disk_point(Vec3::new(dir.x, -dir.y, dir.z))
+}
+
 /// Octahedral projection of a direction (any length); below-horizon directions are clamped
 /// onto the horizon, and straight down (or zero) maps to the zenith's point.
 pub fn disk_point(dir: Vec3) -> Vec2 {
@@ -104,6 +169,36 @@ pub fn triangulate(dirs: &[Vec3]) -> Vec<[u32; 3]> {
         .collect()
 }
 
+/// Triangulations for views from above and from below: `(upper, lower)`. The upper one covers
+/// the directions with `y ≥ 0` ([`triangulate`]); the lower one (empty without directions
+/// below the horizon) covers the horizon ring and the directions below it, in
+/// [`disk_point_lower`]. Indices refer to `dirs`.
+pub fn triangulate_sphere(dirs: &[Vec3]) -> (Vec<[u32; 3]>, Vec<[u32; 3]>) {
+    let subset = |keep: &dyn Fn(Vec3) -> bool, flip: bool| {
+        let idx: Vec<u32> = (0..dirs.len() as u32)
+            .filter(|&i| keep(dirs[i as usize]))
+            .collect();
+        let pts: Vec<Vec3> = idx
+            .iter()
+            .map(|&i| {
+                let d = dirs[i as usize];
+                if flip { Vec3::new(d.x, -d.y, d.z) } else { d }
+            })
+            .collect();
+        triangulate(&pts)
+            .into_iter()
+            .map(|t| t.map(|k| idx[k as usize]))
+            .collect::<Vec<_>>()
+    };
+    let upper = subset(&|d| d.y >= 0.0, false);
+    let lower = if dirs.iter().any(|d| d.y < 0.0) {
+        subset(&|d| d.y <= 0.0, true)
+    } else {
+        Vec::new()
+    };
+    (upper, lower)
+}
+
 /// The 1–3 directions blended for a view, with weights summing to 1 (unused slots weigh 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Blend {
@@ -113,15 +208,20 @@ pub struct Blend {
     pub weight: [f32; 3],
 }
 
-/// Blend of the sampling directions for a view direction `view` (unit, from the model towards
-/// the viewer, in the model's object space).
+/// Blend of the sampling directions for a view direction `view` (from the model towards the
+/// viewer, in the model's object space; any length).
 ///
-/// Inside the triangulation: the barycentric coordinates of the containing triangle. Outside
-/// its hull (between horizon points): the nearest hull edge, weighted by the projection onto
-/// it. Without triangles (fewer than 3 directions): the nearest direction alone.
-pub fn blend(dirs: &[Vec3], triangles: &[[u32; 3]], view: Vec3) -> Blend {
-    let p = disk_point(view);
-    let pts: Vec<Vec2> = dirs.iter().map(|&d| disk_point(d)).collect();
+/// Views from below (`view.y < 0`) use the `lower` triangles in [`disk_point_lower`] when
+/// there are any; every other view uses the `upper` triangles in [`disk_point`]. Inside the
+/// triangulation: the barycentric coordinates of the containing triangle. Outside its hull
+/// (between horizon points): the nearest hull edge, weighted by the projection onto it.
+/// Without triangles (fewer than 3 directions): the nearest direction alone.
+pub fn blend(dirs: &[Vec3], upper: &[[u32; 3]], lower: &[[u32; 3]], view: Vec3) -> Blend {
+    let below = view.y < 0.0 && !lower.is_empty();
+    let proj = if below { disk_point_lower } else { disk_point };
+    let triangles = if below { lower } else { upper };
+    let p = proj(view);
+    let pts: Vec<Vec2> = dirs.iter().map(|&d| proj(d)).collect();
     let mut best_edge: Option<(f32, Blend)> = None;
     for t in triangles {
         let [a, b, c] = t.map(|i| pts[i as usize]);
@@ -216,7 +316,7 @@ mod tests {
         let d = hemisphere_directions(15);
         let t = triangulate(&d);
         for (i, &v) in d.iter().enumerate() {
-            let b = blend(&d, &t, v);
+            let b = blend(&d, &t, &[], v);
             let w: f32 = (0..3)
                 .filter(|&k| b.index[k] == i as u32)
                 .map(|k| b.weight[k])
@@ -235,7 +335,7 @@ mod tests {
             Vec3::new(0.1, -0.5, -0.9), // below the horizon: clamped
             Vec3::new(0.0, 0.0, 1.0),
         ] {
-            let b = blend(&d, &t, view.normalize());
+            let b = blend(&d, &t, &[], view.normalize());
             let s: f32 = b.weight.iter().sum();
             assert!((s - 1.0).abs() < 1e-5);
             let p: Vec2 = (0..3)
@@ -251,8 +351,73 @@ mod tests {
     fn fewer_than_three_directions_pick_the_nearest() {
         let d = hemisphere_directions(2);
         assert!(triangulate(&d).is_empty());
-        let b = blend(&d, &[], Vec3::new(0.0, 0.9, 0.1).normalize());
+        let b = blend(&d, &[], &[], Vec3::new(0.0, 0.9, 0.1).normalize());
         assert_eq!(b.index[0], 1);
         assert_eq!(b.weight, [1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn lower_directions_are_below_and_end_at_the_nadir() {
+        let d = lower_directions(5);
+        assert_eq!(d.len(), 5);
+        assert_eq!(*d.last().unwrap(), Vec3::NEG_Y);
+        for v in &d[..4] {
+            assert!((v.y + std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-6, "{v}");
+        }
+        for n in 0..=40 {
+            let d = lower_directions(n);
+            assert_eq!(d.len(), n as usize, "count {n}");
+            assert!(
+                d.iter()
+                    .all(|v| v.y < 0.0 && (v.length() - 1.0).abs() < 1e-6)
+            );
+        }
+    }
+
+    #[test]
+    fn views_from_below_blend_lower_directions_and_agree_at_the_horizon() {
+        let d = sampling_directions(15, 5);
+        let (up, low) = triangulate_sphere(&d);
+        assert!(!low.is_empty());
+        // Every lower triangle uses the horizon ring or directions below it.
+        assert!(low.iter().flatten().all(|&i| d[i as usize].y <= 0.0));
+        // At each sampling direction, the blend is that direction alone.
+        for (i, &v) in d.iter().enumerate() {
+            let b = blend(&d, &up, &low, v);
+            let w: f32 = (0..3)
+                .filter(|&k| b.index[k] == i as u32)
+                .map(|k| b.weight[k])
+                .sum();
+            assert!((w - 1.0).abs() < 1e-5, "direction {i} ({v}): {b:?}");
+        }
+        // Straight down is the nadir alone.
+        let b = blend(&d, &up, &low, Vec3::new(0.0, -3.0, 0.0));
+        assert_eq!(b.index[0], 19);
+        // Just above and just below the horizon give the same weights on the same directions.
+        for az in [0.1f32, 0.7, 2.0, 4.0] {
+            let above = blend(&d, &up, &low, Vec3::new(az.sin(), 1e-4, az.cos()));
+            let under = blend(&d, &up, &low, Vec3::new(az.sin(), -1e-4, az.cos()));
+            let weights = |b: &Blend| {
+                let mut w = vec![0.0f32; d.len()];
+                for k in 0..3 {
+                    w[b.index[k] as usize] += b.weight[k];
+                }
+                w
+            };
+            let (a, u) = (weights(&above), weights(&under));
+            let diff: f32 = a.iter().zip(&u).map(|(x, y)| (x - y).abs()).sum();
+            assert!(diff < 1e-3, "azimuth {az}: {above:?} vs {under:?}");
+        }
+        // Without lower directions a view from below is clamped onto the horizon.
+        let d15 = sampling_directions(15, 0);
+        let (up15, low15) = triangulate_sphere(&d15);
+        assert!(low15.is_empty());
+        let b = blend(&d15, &up15, &low15, Vec3::new(0.0, -1.0, 1.0));
+        assert!(
+            b.index
+                .iter()
+                .zip(b.weight)
+                .all(|(&i, w)| w == 0.0 || d15[i as usize].y.abs() < 1e-6)
+        );
     }
 }

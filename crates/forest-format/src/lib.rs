@@ -22,6 +22,6 @@ pub mod nodes_codec;
 pub mod shading;
 pub mod slab;
 
-pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding};
+pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding, PlaneFit};
 pub use error::FormatError;
 pub use node::QuadNode;

@@ -13,21 +13,64 @@
 use bytemuck::{Pod, Zeroable};
 
 /// Bits of [`QuadNode::child`] holding the index of the first child.
-pub const FIRST_CHILD_BITS: u32 = 28;
-/// The largest number of nodes an atlas can hold (the first-child index must fit 28 bits).
+pub const FIRST_CHILD_BITS: u32 = 24;
+/// The largest number of nodes an atlas can hold (the first-child index must fit 24 bits).
 pub const MAX_NODES: u64 = 1 << FIRST_CHILD_BITS;
+/// Shift of the 4-bit depth-error code in [`QuadNode::child`].
+pub const ERROR_SHIFT: u32 = 24;
+/// Shift of the 4-bit child mask in [`QuadNode::child`].
+pub const MASK_SHIFT: u32 = 28;
+
+/// The depth error that code `k` stands for, slab-relative: 0 for `k = 0`, else
+/// `2^((k − 15)/2)` (from 2^−7 ≈ 2 quantisation steps up to 1, the whole slab). Codes step by
+/// √2; [`error_code`] rounds up, so the decoded error bounds the true one. Mirrored by
+/// `node_error` in `shaders/common.wgsl`.
+pub fn error_bound(code: u8) -> f32 {
+    ERROR_BOUNDS[usize::from(code.min(15))]
+}
+
+/// [`error_bound`] of every code, as decimal literals that WGSL parses to the same `f32`s.
+pub const ERROR_BOUNDS: [f32; 16] = [
+    0.0,
+    0.0078125,
+    0.011048543,
+    0.015625,
+    0.022097087,
+    0.03125,
+    0.044194173,
+    0.0625,
+    0.088388346,
+    0.125,
+    0.17677669,
+    0.25,
+    0.35355338,
+    0.5,
+    0.70710677,
+    1.0,
+];
+
+/// The smallest code whose [`error_bound`] is at least `err` (slab-relative): 0 when `err` is
+/// within a quantisation step (1/255) or not positive, 15 for anything from `2^−0.5` up.
+pub fn error_code(err: f32) -> u8 {
+    if err.is_nan() || err <= 1.0 / 255.0 {
+        return 0;
+    }
+    (1..15).find(|&k| error_bound(k) >= err).unwrap_or(15)
+}
 
 /// A quad-hierarchy node: 8 bytes, read by WGSL as one texel of an `Rg32Uint` texture.
 ///
-/// - `child`: bits 0..28 the index of the first existing child, bits 28..32 the child mask
-///   (bit `i` set when child `i` exists, i.e. is not blank). Zero for a leaf.
+/// - `child`: bits 0..24 the index of the first existing child (zero for a leaf), bits 24..28
+///   the depth-error code ([`error_code`]: how far the node's pixels lie from its drawn
+///   corners' bilinear surface, slab-relative), bits 28..32 the child mask (bit `i` set when
+///   child `i` exists, i.e. is not blank).
 /// - `depth`: the fitted plane's depth at the 4 corners, unorm8 relative to the node's slab:
 ///   0 at the slab's near clipping plane (towards the sampling camera), 255 at its far one.
 ///   WGSL reads it as one little-endian `u32`, corner 0 in the low byte.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Pod, Zeroable)]
 pub struct QuadNode {
-    /// First child index (28 bits) and child mask (high 4 bits).
+    /// First child index (24 bits), depth-error code (4 bits) and child mask (high 4 bits).
     pub child: u32,
     /// Corner depths, unorm8 within the slab, corners in the order TL, TR, BL, BR.
     pub depth: [u8; 4],
@@ -37,23 +80,36 @@ impl QuadNode {
     /// A node with the given child mask (4 bits), first child index and quantised corner depths.
     ///
     /// # Panics
-    /// If `first_child` does not fit 28 bits or `mask` has bits above the 4th (caller bugs).
+    /// If `first_child` does not fit 24 bits or `mask` has bits above the 4th (caller bugs).
     pub fn new(mask: u8, first_child: u32, depth: [u8; 4]) -> Self {
         assert!(mask < 16, "child mask has 4 bits");
         assert!(
             u64::from(first_child) < MAX_NODES,
-            "first child index fits 28 bits"
+            "first child index fits 24 bits"
         );
         let first_child = if mask == 0 { 0 } else { first_child };
         Self {
-            child: first_child | (u32::from(mask) << FIRST_CHILD_BITS),
+            child: first_child | (u32::from(mask) << MASK_SHIFT),
             depth,
+        }
+    }
+
+    /// The same node with depth-error code `code` (4 bits; larger values are clamped to 15).
+    pub fn with_error(self, code: u8) -> Self {
+        Self {
+            child: (self.child & !(15 << ERROR_SHIFT)) | (u32::from(code.min(15)) << ERROR_SHIFT),
+            depth: self.depth,
         }
     }
 
     /// The child mask: bit `i` is set when child `i` exists.
     pub fn mask(&self) -> u8 {
-        (self.child >> FIRST_CHILD_BITS) as u8
+        (self.child >> MASK_SHIFT) as u8
+    }
+
+    /// The depth-error code ([`error_bound`] decodes it).
+    pub fn error(&self) -> u8 {
+        ((self.child >> ERROR_SHIFT) & 15) as u8
     }
 
     /// Index of the first existing child (meaningless when [`Self::mask`] is 0).
@@ -109,6 +165,28 @@ mod tests {
         let bytes = bytemuck::bytes_of(&n);
         assert_eq!(&bytes[4..], &[1, 2, 3, 4]);
         assert_eq!(QuadNode::new(0, 99, [0; 4]).first_child(), 0);
+    }
+
+    #[test]
+    fn error_codes_bound_the_error_and_pack_beside_the_mask() {
+        assert_eq!(error_code(0.0), 0);
+        assert_eq!(error_code(1.0 / 255.0), 0);
+        assert_eq!(error_code(f32::NAN), 0);
+        assert_eq!(error_code(1.0), 15);
+        assert_eq!(error_code(7.0), 15);
+        for e in [0.005f32, 0.01, 0.05, 0.1, 0.3, 0.7, 0.99] {
+            let k = error_code(e);
+            assert!(error_bound(k) >= e, "{e}: code {k}");
+            assert!(error_bound(k - 1) < e, "{e}: code {k} is the smallest");
+        }
+        assert_eq!(error_bound(15), 1.0);
+        let n = QuadNode::new(0b1001, (1 << 24) - 1, [9, 8, 7, 6]).with_error(11);
+        assert_eq!(
+            (n.mask(), n.first_child(), n.error()),
+            (0b1001, (1 << 24) - 1, 11)
+        );
+        assert_eq!(n.with_error(3).error(), 3);
+        assert_eq!(n.with_error(3).mask(), 0b1001);
     }
 
     #[test]

@@ -4,14 +4,15 @@
 //! follows from the child masks of the nodes before it and need not be stored. Each corner
 //! depth is stored as its difference (mod 256) from the parent plane's value at that corner,
 //! integer-bilinearly interpolated from the parent's corners (128 for roots), which makes most
-//! residuals tiny. Layout: magic `FQN1`, node count and root count (u32 little-endian), then a
-//! DEFLATE stream of all masks (one byte each) followed by all residuals (4 bytes each).
+//! residuals tiny. Layout: magic `FQN2`, node count and root count (u32 little-endian), then a
+//! DEFLATE stream of one byte per node (child mask in the low nibble, depth-error code in the
+//! high one) followed by all residuals (4 bytes each).
 
 use std::io::{Read, Write};
 
 use crate::node::{MAX_NODES, QuadNode};
 
-const MAGIC: &[u8; 4] = b"FQN1";
+const MAGIC: &[u8; 4] = b"FQN2";
 
 /// Predicted corner depths of child `i` from its parent's corners (integer bilinear).
 pub fn predict_child(parent: [u8; 4], i: u32) -> [u8; 4] {
@@ -40,9 +41,7 @@ fn parents(masks: &[u8], roots: usize) -> Result<Vec<Option<(u32, u32)>>, String
     let mut parent = vec![None; n];
     let mut next = roots as u64;
     for (p, &m) in masks.iter().enumerate() {
-        if m >= 16 {
-            return Err(format!("node {p} has child mask {m} (above 15)"));
-        }
+        let m = m & 15;
         for i in 0..4u32 {
             if m & (1 << i) != 0 {
                 if next >= n as u64 {
@@ -66,7 +65,7 @@ fn parents(masks: &[u8], roots: usize) -> Result<Vec<Option<(u32, u32)>>, String
 
 /// Encode level-ordered nodes whose first `roots` entries are the roots.
 pub fn encode(nodes: &[QuadNode], roots: usize) -> Vec<u8> {
-    let masks: Vec<u8> = nodes.iter().map(QuadNode::mask).collect();
+    let masks: Vec<u8> = nodes.iter().map(|n| n.mask() | (n.error() << 4)).collect();
     let parent = parents(&masks, roots).expect("encode() is given a valid node forest");
     let mut payload = masks;
     payload.reserve(nodes.len() * 4);
@@ -91,7 +90,7 @@ pub fn encode(nodes: &[QuadNode], roots: usize) -> Vec<u8> {
 /// Decode `nodes.bin`; the error says what is wrong.
 pub fn decode(bytes: &[u8]) -> Result<(Vec<QuadNode>, usize), String> {
     if bytes.len() < 12 || &bytes[..4] != MAGIC {
-        return Err("not a node file (missing the FQN1 header)".into());
+        return Err("not a node file of this version (missing the FQN2 header)".into());
     }
     let n = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
     let roots = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
@@ -120,8 +119,9 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<QuadNode>, usize), String> {
             Some((p, i)) => predict_child(nodes[p as usize].depth, i),
         };
         let depth: [u8; 4] = std::array::from_fn(|c| residuals[4 * k + c].wrapping_add(pred[c]));
-        nodes.push(QuadNode::new(masks[k], next, depth));
-        next += masks[k].count_ones();
+        let mask = masks[k] & 15;
+        nodes.push(QuadNode::new(mask, next, depth).with_error(masks[k] >> 4));
+        next += mask.count_ones();
     }
     Ok((nodes, roots))
 }
@@ -133,8 +133,8 @@ mod tests {
     fn sample_forest() -> Vec<QuadNode> {
         // Two roots; root 0 has children 1 and 3, root 1 has child 0; one grandchild.
         vec![
-            QuadNode::new(0b1010, 2, [10, 20, 30, 40]),
-            QuadNode::new(0b0001, 4, [200, 200, 200, 200]),
+            QuadNode::new(0b1010, 2, [10, 20, 30, 40]).with_error(15),
+            QuadNode::new(0b0001, 4, [200, 200, 200, 200]).with_error(3),
             QuadNode::new(0b0100, 5, [15, 16, 17, 18]),
             QuadNode::new(0, 0, [25, 30, 35, 40]),
             QuadNode::new(0, 0, [199, 201, 198, 202]),

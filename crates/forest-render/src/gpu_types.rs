@@ -54,12 +54,17 @@ pub struct GpuSpecies {
     pub dir_base: u32,
     /// First entry in the direction-triangle table.
     pub tri_base: u32,
-    /// Direction triangles.
+    /// Direction triangles for views from above (at `tri_base`).
     pub tri_count: u32,
     /// First layer in the colour array and the root table.
     pub layer_base: u32,
     /// First node in the node texture.
     pub node_base: u32,
+    /// Direction triangles for views from below, right after the upper ones (0: views from
+    /// below are clamped onto the horizon).
+    pub lower_tri_count: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 3],
 }
 
 /// A sampling direction's frame (48 bytes; `w` unused).
@@ -84,9 +89,13 @@ pub struct Quad {
     pub node: u32,
     /// level | x << 4 | y << 16 | slab << 28.
     pub pos: u32,
-    /// direction | alpha (unorm16) << 16.
+    /// direction (8 bits) | lo << 8 | hi << 20: the aspect's share `[lo, hi)` of the tree's
+    /// blend, cumulative over its aspects in drawing order, in units of 1/[`WEIGHT_ONE`].
     pub dir_weight: u32,
 }
+
+/// The whole of a tree's blend in the units of [`Quad::dir_weight`]: 4095 (12 bits).
+pub const WEIGHT_ONE: u32 = 4095;
 
 impl Quad {
     /// Pack the position word.
@@ -109,13 +118,26 @@ impl Quad {
     pub fn slab(&self) -> u32 {
         self.pos >> 28
     }
+    /// Pack the direction word: direction `dir` (< 256) with share `[lo, hi)` (≤ 4095).
+    pub fn pack_dir(dir: u32, lo: u32, hi: u32) -> u32 {
+        dir | (lo << 8) | (hi << 20)
+    }
     /// Direction index within the species.
     pub fn dir(&self) -> u32 {
-        self.dir_weight & 0xffff
+        self.dir_weight & 255
     }
-    /// Blend alpha.
+    /// The aspect's share `[lo, hi)` of its tree's blend, in 1/[`WEIGHT_ONE`].
+    pub fn share(&self) -> (u32, u32) {
+        ((self.dir_weight >> 8) & 4095, self.dir_weight >> 20)
+    }
+    /// Alpha of the aspect when composited "over" the earlier ones: `(hi − lo) / hi`.
     pub fn weight(&self) -> f32 {
-        (self.dir_weight >> 16) as f32 / 65535.0
+        let (lo, hi) = self.share();
+        if hi == 0 {
+            0.0
+        } else {
+            (hi - lo) as f32 / hi as f32
+        }
     }
 }
 

@@ -4,7 +4,11 @@
 use forest_format::directions::blend;
 use glam::{Vec3, Vec4};
 
-use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad};
+use forest_format::QuadNode;
+use forest_format::node::ERROR_BOUNDS;
+
+use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE};
+use crate::renderer::{FLAG_DEPTH_ERROR, FLAG_NEAREST};
 use crate::scene::SceneTables;
 
 /// Result of the reference: the final stream and the frame's counters.
@@ -41,8 +45,34 @@ fn to_object_dir(inst: &GpuInstance, d: Vec3) -> Vec3 {
     )
 }
 
-fn unorm16(x: f32) -> u32 {
-    (x.clamp(0.0, 1.0) * 65535.0 + 0.5).floor() as u32
+fn unorm12(x: f32) -> u32 {
+    (x.clamp(0.0, 1.0) * 4095.0 + 0.5).floor() as u32
+}
+
+/// The camera's stream flags (`viewport.w`, see [`crate::renderer::StreamOptions::flags`]).
+fn flags(cam: &GpuCamera) -> u32 {
+    cam.viewport[3] as u32
+}
+
+/// Blend weights in units of 1/[`WEIGHT_ONE`], summing to exactly [`WEIGHT_ONE`]: each rounded,
+/// the rounding remainder given to the largest (first on ties); with [`FLAG_NEAREST`] the
+/// largest alone (see `aspect_weights` in `shaders/cull.wgsl`).
+pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
+    let mut w = weight.map(unorm12);
+    let mut big = 0;
+    for a in 1..3 {
+        if w[a] > w[big] {
+            big = a;
+        }
+    }
+    if flags & FLAG_NEAREST != 0 {
+        let mut one = [0; 3];
+        one[big] = WEIGHT_ONE;
+        return one;
+    }
+    let sum = w[0] + w[1] + w[2];
+    w[big] = w[big] + WEIGHT_ONE - sum;
+    w
 }
 
 fn xyz(v: [f32; 4]) -> Vec3 {
@@ -67,30 +97,35 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
         .iter()
         .map(|f| xyz(f.dir))
         .collect();
-    let tris: Vec<[u32; 3]> = t.tris[sp.tri_base as usize..(sp.tri_base + sp.tri_count) as usize]
-        .iter()
-        .map(|x| [x[0], x[1], x[2]])
-        .collect();
-    let bl = blend(&dirs, &tris, eye_obj);
-    let w16 = bl.weight.map(unorm16);
+    let tris = |from: u32, count: u32| -> Vec<[u32; 3]> {
+        t.tris[from as usize..(from + count) as usize]
+            .iter()
+            .map(|x| [x[0], x[1], x[2]])
+            .collect()
+    };
+    let upper = tris(sp.tri_base, sp.tri_count);
+    let lower = tris(sp.tri_base + sp.tri_count, sp.lower_tri_count);
+    let bl = blend(&dirs, &upper, &lower, eye_obj);
+    let w12 = aspect_weights(bl.weight, flags(cam));
     let mut out = Vec::new();
     for s in 0..sp.slabs {
         let slab = sp.slabs - 1 - s;
         let mut acc = 0u32;
-        for (a, &w) in w16.iter().enumerate() {
+        for (a, &w) in w12.iter().enumerate() {
             if w == 0 {
                 continue;
             }
+            let lo = acc;
+            acc += w;
             let root = t.roots[(sp.layer_base + bl.index[a] * sp.slabs + slab) as usize];
             if root == u32::MAX {
                 continue;
             }
-            acc += w;
             out.push(Quad {
                 instance: inst_id,
                 node: root,
                 pos: Quad::pack_pos(0, 0, 0, slab),
-                dir_weight: bl.index[a] | (unorm16(w as f32 / acc as f32) << 16),
+                dir_weight: Quad::pack_dir(bl.index[a], lo, acc),
             });
         }
     }
@@ -98,13 +133,18 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
 }
 
 fn clip_corner(t: &SceneTables, cam: &GpuCamera, q: &Quad, depth: [u8; 4], c: u32) -> Vec4 {
-    let inst = &t.instances[q.instance as usize];
-    let sp = &t.species[inst.species as usize];
-    let f = &t.frames[(sp.dir_base + q.dir()) as usize];
     let size = 1.0 / (1u32 << q.level()) as f32;
     let u = (q.x() as f32 + (c & 1) as f32) * size;
     let v = (q.y() as f32 + (c >> 1) as f32) * size;
     let tt = f32::from(depth[c as usize]) / 255.0;
+    clip_at(t, cam, q, u, v, tt)
+}
+
+/// Clip-space position of image point `(u, v)` at slab depth `tt` of a quad's layer.
+fn clip_at(t: &SceneTables, cam: &GpuCamera, q: &Quad, u: f32, v: f32, tt: f32) -> Vec4 {
+    let inst = &t.instances[q.instance as usize];
+    let sp = &t.species[inst.species as usize];
+    let f = &t.frames[(sp.dir_base + q.dir()) as usize];
     let r = sp.sphere[3];
     let d = (q.slab() as f32 + tt) / sp.slabs as f32;
     let p = xyz(sp.sphere)
@@ -139,12 +179,36 @@ fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
     if behind == 4 {
         return 0;
     }
-    let long = behind > 0
+    let mut long = behind > 0
         || edge_long(cam, clip[0], clip[1])
         || edge_long(cam, clip[1], clip[3])
         || edge_long(cam, clip[3], clip[2])
         || edge_long(cam, clip[2], clip[0]);
+    if !long && flags(cam) & FLAG_DEPTH_ERROR != 0 {
+        long = error_long(t, cam, q, node);
+    }
     if long { mask.count_ones() } else { 0 }
+}
+
+/// Whether the node's depth error, as a displacement along its sampling direction at the
+/// quad's centre and mean depth, projects longer than ε pixels (see `error_long` in
+/// `shaders/common.wgsl`); a displacement reaching behind the eye counts as long.
+pub fn error_long(t: &SceneTables, cam: &GpuCamera, q: &Quad, node: QuadNode) -> bool {
+    let e = ERROR_BOUNDS[usize::from(node.error())];
+    if e <= 0.0 {
+        return false;
+    }
+    let sum: u32 = node.depth.iter().map(|&d| u32::from(d)).sum();
+    let tc = sum as f32 / 1020.0;
+    let size = 1.0 / (1u32 << q.level()) as f32;
+    let u = (q.x() as f32 + 0.5) * size;
+    let v = (q.y() as f32 + 0.5) * size;
+    let a = clip_at(t, cam, q, u, v, tc);
+    let b = clip_at(t, cam, q, u, v, tc + e);
+    if a.w <= 0.0 || b.w <= 0.0 {
+        return true;
+    }
+    edge_long(cam, a, b)
 }
 
 /// Exclusive prefix sums and total.

@@ -140,6 +140,79 @@ impl DebugView {
     }
 }
 
+/// How the 1–3 aspects (sampling directions) of a tree are combined where they overlap.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AspectBlend {
+    /// Every pixel shows exactly one aspect, chosen by an ordered dither with probability equal
+    /// to its weight (per tree and slab), so the blended coverage is the weighted mean of the
+    /// aspects' coverages.
+    #[default]
+    Dither,
+    /// Alpha-composited "over" each other with alpha `w_a / Σ_{b ≤ a} w_b`: the weighted mean
+    /// where every aspect is opaque, the union of their silhouettes elsewhere (the paper's
+    /// blending).
+    Over,
+    /// The aspect of largest weight alone (pops where the view crosses a direction).
+    Nearest,
+}
+
+impl AspectBlend {
+    /// Short name for the CLI and the benchmark tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            AspectBlend::Dither => "dither",
+            AspectBlend::Over => "over",
+            AspectBlend::Nearest => "nearest",
+        }
+    }
+}
+
+/// Run-time choices of the quad stream. They travel in the camera uniform's `viewport.w` as
+/// bit flags ([`StreamOptions::flags`]), so the camera stays the only per-frame upload.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StreamOptions {
+    /// How overlapping aspects combine.
+    pub blend: AspectBlend,
+    /// Refine a quad also when its depth error (the largest distance between its fitted plane
+    /// and its pixels, projected to the screen from the current view) exceeds ε, and draw a
+    /// finest-level quad whose depth error exceeds ε flat at its mean depth. Off: the paper's
+    /// metric alone (projected edge length).
+    pub depth_error: bool,
+}
+
+impl Default for StreamOptions {
+    fn default() -> Self {
+        Self {
+            blend: AspectBlend::Dither,
+            depth_error: true,
+        }
+    }
+}
+
+/// Flag bits of [`StreamOptions`] in `viewport.w`; mirrored in `shaders/common.wgsl`.
+pub const FLAG_DITHER: u32 = 1;
+/// See [`FLAG_DITHER`].
+pub const FLAG_NEAREST: u32 = 2;
+/// See [`FLAG_DITHER`].
+pub const FLAG_DEPTH_ERROR: u32 = 4;
+
+impl StreamOptions {
+    /// The flag bits written to the camera uniform's `viewport.w`.
+    pub fn flags(self) -> u32 {
+        let blend = match self.blend {
+            AspectBlend::Dither => FLAG_DITHER,
+            AspectBlend::Over => 0,
+            AspectBlend::Nearest => FLAG_NEAREST,
+        };
+        blend
+            | if self.depth_error {
+                FLAG_DEPTH_ERROR
+            } else {
+                0
+            }
+    }
+}
+
 /// Colours of levels 0, 1, … in the [`DebugView::Levels`] view (linear RGB; level `l` uses
 /// entry `l % 8`). Mirrored by `level_colour` in `shaders/draw.wgsl`.
 pub const LEVEL_COLOURS: [[f32; 3]; 8] = [
@@ -212,6 +285,7 @@ pub struct QuadStream {
     writes: Cell<(u64, u64)>,
     camera_set: Cell<bool>,
     debug: Cell<DebugView>,
+    options: Cell<StreamOptions>,
     background: Background,
     owned: Vec<(&'static str, wgpu::Buffer)>,
 }
@@ -435,6 +509,7 @@ impl QuadStream {
             writes: Cell::new((0, 0)),
             camera_set: Cell::new(false),
             debug: Cell::new(DebugView::Off),
+            options: Cell::new(StreamOptions::default()),
             background: opts.background,
             owned,
         })
@@ -453,6 +528,16 @@ impl QuadStream {
     /// The debug view in use.
     pub fn debug_view(&self) -> DebugView {
         self.debug.get()
+    }
+
+    /// Choose the stream's run-time options from the next camera write on.
+    pub fn set_options(&self, options: StreamOptions) {
+        self.options.set(options);
+    }
+
+    /// The run-time options in use.
+    pub fn options(&self) -> StreamOptions {
+        self.options.get()
     }
 
     /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
@@ -493,6 +578,7 @@ impl QuadStream {
         camera.validate()?;
         let mut g = camera.to_gpu();
         g.viewport[2] = self.debug.get() as u32 as f32;
+        g.viewport[3] = self.options.get().flags() as f32;
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
         let (n, bytes) = self.writes.get();

@@ -86,7 +86,7 @@ impl SceneTables {
                     .center
                     .extend(m.bounding_sphere.radius)
                     .to_array(),
-                directions: m.params.directions,
+                directions: m.params.total_directions(),
                 slabs: m.params.slabs,
                 levels: m.levels,
                 dir_base: t.frames.len() as u32,
@@ -94,14 +94,20 @@ impl SceneTables {
                 tri_count: m.direction_triangles.len() as u32,
                 layer_base: t.layers,
                 node_base,
+                lower_tri_count: m.lower_triangles.len() as u32,
+                pad: [0; 3],
             });
             t.frames.extend(m.directions.iter().map(|f| GpuFrame {
                 dir: f.dir.extend(0.0).to_array(),
                 right: f.right.extend(0.0).to_array(),
                 up: f.up.extend(0.0).to_array(),
             }));
-            t.tris
-                .extend(m.direction_triangles.iter().map(|x| [x[0], x[1], x[2], 0]));
+            t.tris.extend(
+                m.direction_triangles
+                    .iter()
+                    .chain(&m.lower_triangles)
+                    .map(|x| [x[0], x[1], x[2], 0]),
+            );
             t.roots.extend(
                 m.layer_roots
                     .iter()

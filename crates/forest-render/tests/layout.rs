@@ -84,6 +84,7 @@ fn shared() -> Vec<Expect> {
                 ("tri_count", offset_of!(GpuSpecies, tri_count)),
                 ("layer_base", offset_of!(GpuSpecies, layer_base)),
                 ("node_base", offset_of!(GpuSpecies, node_base)),
+                ("lower_tri_count", offset_of!(GpuSpecies, lower_tri_count)),
             ],
         ),
         (

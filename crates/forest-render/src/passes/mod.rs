@@ -10,17 +10,19 @@ pub mod refine;
 pub mod scan;
 
 /// WGSL of the compute passes.
-pub const COMPUTE_WGSL: [&str; 5] = [
+pub const COMPUTE_WGSL: [&str; 6] = [
     include_str!("../../../../shaders/common.wgsl"),
     include_str!("../../../../shaders/bindings.wgsl"),
+    include_str!("../../../../shaders/quad_geometry.wgsl"),
     include_str!("../../../../shaders/scan.wgsl"),
     include_str!("../../../../shaders/cull.wgsl"),
     include_str!("../../../../shaders/refine.wgsl"),
 ];
 
 /// WGSL of the draw pass.
-pub const DRAW_WGSL: [&str; 3] = [
+pub const DRAW_WGSL: [&str; 4] = [
     include_str!("../../../../shaders/common.wgsl"),
+    include_str!("../../../../shaders/quad_geometry.wgsl"),
     include_str!("../../../../shaders/draw.wgsl"),
     include_str!("../../../../shaders/ground.wgsl"),
 ];

@@ -1,0 +1,45 @@
+// Where a quad lies on screen, shared by the refine and draw passes (both bind camera,
+// instances, species and frames). Mirrored by clip_at, edge_long and error_long in
+// crates/forest-render/src/reference.rs, operation for operation.
+
+// Clip-space position of image point (u, v) at slab-relative depth t of a quad's layer.
+fn quad_clip_at(q: Quad, u: f32, v: f32, t: f32) -> vec4<f32> {
+    let inst = instances[q.instance];
+    let sp = species[inst.species];
+    let f = frames[sp.dir_base + quad_dir(q)];
+    let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
+    let m = camera.view_proj;
+    return m[0] * w.x + m[1] * w.y + m[2] * w.z + m[3];
+}
+
+// Whether the projected segment a-b is longer than ε pixels; both ends in front of the eye.
+fn edge_long(a: vec4<f32>, b: vec4<f32>) -> bool {
+    let sx = camera.viewport.x * 0.5;
+    let sy = camera.viewport.y * 0.5;
+    let dx = (a.x * b.w - b.x * a.w) * sx;
+    let dy = (a.y * b.w - b.y * a.w) * sy;
+    let lim = camera.eye.w * a.w * b.w;
+    return dx * dx + dy * dy > lim * lim;
+}
+
+// Mean of a node's 4 corner depths, slab-relative.
+fn node_mean_depth(node: vec2<u32>) -> f32 {
+    let d = node.y;
+    let sum = (d & 255u) + ((d >> 8u) & 255u) + ((d >> 16u) & 255u) + (d >> 24u);
+    return f32(sum) / 1020.0;
+}
+
+// Whether the node's depth error, as a displacement along its sampling direction at the quad's
+// centre and mean depth, projects longer than ε pixels; reaching behind the eye counts as long.
+fn error_long(q: Quad, node: vec2<u32>) -> bool {
+    let e = node_error(node);
+    if (e <= 0.0) { return false; }
+    let tc = node_mean_depth(node);
+    let size = 1.0 / f32(1u << quad_level(q));
+    let u = (f32(quad_x(q)) + 0.5) * size;
+    let v = (f32(quad_y(q)) + 0.5) * size;
+    let a = quad_clip_at(q, u, v, tc);
+    let b = quad_clip_at(q, u, v, tc + e);
+    if (a.w <= 0.0 || b.w <= 0.0) { return true; }
+    return edge_long(a, b);
+}
