@@ -7,8 +7,10 @@
 // coverage is the weighted mean of the aspects' coverages) or, without FLAG_DITHER, "over"
 // each other with alpha (hi − lo) / hi.
 //
-// A finest-level quad whose depth error still projects longer than ε (with
-// FLAG_DEPTH_ERROR) is drawn flat at its mean depth rather than stretched along its plane.
+// A finest-level quad is drawn on its plane even where its depth error projects longer than ε:
+// the bake keeps every node's corners within one depth cluster of its pixels, so no quad is
+// stretched across a gap, and flattening such quads to their mean depth was measured to lose
+// accuracy (close-up FLIP 0.190 against 0.185 on its plane).
 //
 // Depth: the quads are drawn strictly back to front (presorted trees, back slab first), so
 // ordering comes from the stream and blending needs no depth writes; writing depth would make
@@ -47,11 +49,8 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let size = 1.0 / f32(1u << quad_level(q));
     let u = (f32(quad_x(q)) + f32(vi & 1u)) * size;
     let v = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
-    var t = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    let t = f32((node.y >> (8u * vi)) & 255u) / 255.0;
     let flags = stream_flags(camera);
-    if ((flags & FLAG_DEPTH_ERROR) != 0u && (node.x >> 28u) == 0u && error_long(q, node)) {
-        t = node_mean_depth(node);
-    }
     let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
     var out: VsOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);

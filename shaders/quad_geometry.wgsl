@@ -1,5 +1,4 @@
-// Where a quad lies on screen, shared by the refine and draw passes (both bind camera,
-// instances, species and frames). Mirrored by clip_at, edge_long and error_long in
+// Where a quad lies on screen, for the refine pass. Mirrored by clip_at, edge_long and error_long in
 // crates/forest-render/src/reference.rs, operation for operation.
 
 // Clip-space position of image point (u, v) at slab-relative depth t of a quad's layer.

@@ -46,13 +46,31 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
     assert!(header("accuracy.csv").starts_with("method,param,view,frame_ms,flip_mean,ssim,psnr"));
     assert!(header("stability.csv").starts_with("case,method,flip_mean,flicker,pops"));
     assert!(header("storage.csv").starts_with("method,species,disk_bytes,gpu_bytes"));
+    assert_eq!(
+        header("fidelity.csv"),
+        "variant,species,camera,distance_radii,elevation_deg,azimuth_deg,between_directions,\
+         epsilon,quads,flip_mean,iou,frame_ms"
+    );
     for f in [
         "path.csv",
         "budget.csv",
         "storage_forest.csv",
         "storage_stream.csv",
+        "fidelity_summary.csv",
     ] {
         assert!(!header(f).is_empty(), "{f}");
+    }
+    // Quick mode's fidelity variants: the baseline, one run-time swap and the paper's method.
+    let fidelity = std::fs::read_to_string(results.join("fidelity.csv")).unwrap();
+    for v in ["baseline", "blend=dither", "paper"] {
+        assert!(
+            fidelity.lines().any(|l| l.starts_with(&format!("{v},"))),
+            "{v}"
+        );
+    }
+    for c in ["fidelity-distance", "fidelity-elevation"] {
+        assert!(results.join(format!("{c}.png")).is_file(), "{c}.png");
+        assert!(results.join(format!("{c}.svg")).is_file(), "{c}.svg");
     }
     // Every method appears in the accuracy and stability tables.
     let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
@@ -71,9 +89,11 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
         assert!(results.join(png.replace(".png", ".svg")).is_file());
         charts += 1;
     }
-    assert!(charts >= 8, "{charts} charts in the report");
-    assert!(
-        !results.join(".budget-atlases").exists(),
-        "scratch bakes removed"
-    );
+    assert!(charts >= 10, "{charts} charts in the report");
+    for scratch in [".budget-atlases", ".fidelity-atlases"] {
+        assert!(
+            !results.join(scratch).exists(),
+            "scratch bakes removed: {scratch}"
+        );
+    }
 }

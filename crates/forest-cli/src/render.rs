@@ -88,16 +88,15 @@ pub struct MethodArgs {
     /// LODs: distances (m, per unit tree scale) where LOD 1, LOD 2 and billboards start.
     #[arg(long, value_delimiter = ',', default_values_t = Lods::default().distances)]
     pub lod_distances: Vec<f32>,
-    /// Quad stream: how a tree's 1–3 aspects combine: dither (each pixel shows one aspect,
-    /// chosen by weight: coverage is the weighted mean), over (alpha-blended over each other,
-    /// the paper's blend: coverage is their union), nearest (the largest weight alone).
-    #[arg(long, default_value = "dither", value_parser = ["dither", "over", "nearest"])]
+    /// Quad stream: how a tree's 1–3 aspects combine: over (alpha-blended over each other,
+    /// the paper's blend: coverage is their union), dither (each pixel shows one aspect,
+    /// chosen by weight: coverage is the weighted mean), nearest (the largest weight alone).
+    #[arg(long, default_value = "over", value_parser = ["over", "dither", "nearest"])]
     pub blend: String,
-    /// Quad stream: refine by projected edge length alone (the paper's metric), not also by
-    /// each quad's projected depth error, and draw finest quads on their planes however far
-    /// their pixels lie from them.
+    /// Quad stream: refine also by each quad's projected depth error, not only by its
+    /// projected edge length (the paper's metric).
     #[arg(long)]
-    pub no_depth_error: bool,
+    pub depth_error: bool,
 }
 
 impl MethodArgs {
@@ -105,11 +104,11 @@ impl MethodArgs {
     pub fn stream_options(&self) -> StreamOptions {
         StreamOptions {
             blend: match self.blend.as_str() {
-                "over" => AspectBlend::Over,
+                "dither" => AspectBlend::Dither,
                 "nearest" => AspectBlend::Nearest,
-                _ => AspectBlend::Dither,
+                _ => AspectBlend::Over,
             },
-            depth_error: !self.no_depth_error,
+            depth_error: self.depth_error,
         }
     }
 

@@ -141,17 +141,23 @@ impl DebugView {
 }
 
 /// How the 1–3 aspects (sampling directions) of a tree are combined where they overlap.
+///
+/// The default is [`AspectBlend::Over`], chosen by measurement (`forest bench fidelity`): with
+/// the gap-aware bake its union of silhouettes covers about as many pixels as the reference
+/// (1.02× at 14 m from a bundled oak), while each single aspect misses what its two slabs
+/// could not see from its own direction, so the dither's weighted mean of coverages falls
+/// short (0.95×) and its FLIP is no better anywhere we looked.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AspectBlend {
-    /// Every pixel shows exactly one aspect, chosen by an ordered dither with probability equal
-    /// to its weight (per tree and slab), so the blended coverage is the weighted mean of the
-    /// aspects' coverages.
-    #[default]
-    Dither,
     /// Alpha-composited "over" each other with alpha `w_a / Σ_{b ≤ a} w_b`: the weighted mean
     /// where every aspect is opaque, the union of their silhouettes elsewhere (the paper's
     /// blending).
+    #[default]
     Over,
+    /// Every pixel shows exactly one aspect, chosen by an ordered dither with probability equal
+    /// to its weight (per tree), so the blended coverage is the weighted mean of the aspects'
+    /// coverages.
+    Dither,
     /// The aspect of largest weight alone (pops where the view crosses a direction).
     Nearest,
 }
@@ -173,18 +179,20 @@ impl AspectBlend {
 pub struct StreamOptions {
     /// How overlapping aspects combine.
     pub blend: AspectBlend,
-    /// Refine a quad also when its depth error (the largest distance between its fitted plane
-    /// and its pixels, projected to the screen from the current view) exceeds ε, and draw a
-    /// finest-level quad whose depth error exceeds ε flat at its mean depth. Off: the paper's
-    /// metric alone (projected edge length).
+    /// Refine a quad also when its depth error (the largest distance between its drawn
+    /// surface and its pixels, as a displacement along its sampling direction projected to
+    /// the screen from the current view) exceeds ε. Off (the default): the paper's metric
+    /// alone (projected edge length). Measured on a bundled oak at 14–30 m, the error metric
+    /// buys 1–3 % lower FLIP for 2–6× the quads, where a smaller ε buys as much for fewer
+    /// quads, so it is off unless asked for.
     pub depth_error: bool,
 }
 
 impl Default for StreamOptions {
     fn default() -> Self {
         Self {
-            blend: AspectBlend::Dither,
-            depth_error: true,
+            blend: AspectBlend::Over,
+            depth_error: false,
         }
     }
 }

@@ -67,7 +67,7 @@ const SIZE: (u32, u32) = (900, 600);
 
 /// Series colours, in series order (methods are always added in the same order, so a method
 /// keeps its colour across charts).
-const PALETTE: [(u8, u8, u8); 8] = [
+const PALETTE: [(u8, u8, u8); 12] = [
     (214, 39, 40),
     (255, 127, 14),
     (40, 40, 40),
@@ -76,6 +76,10 @@ const PALETTE: [(u8, u8, u8); 8] = [
     (148, 103, 189),
     (140, 86, 75),
     (23, 190, 207),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+    (0, 0, 128),
 ];
 
 /// A method keeps one colour on every chart (series named after it, or after it and a colon);

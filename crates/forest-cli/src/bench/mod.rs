@@ -5,6 +5,7 @@
 mod accuracy;
 mod budget;
 pub mod chart;
+mod fidelity;
 mod path;
 mod report;
 mod stability;
@@ -27,21 +28,24 @@ use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
 /// The suites, in the order `all` runs them.
-pub const SUITES: [&str; 6] = [
+pub const SUITES: [&str; 7] = [
     "storage",
     "table1",
     "path",
     "accuracy",
     "stability",
     "budget",
+    "fidelity",
 ];
 
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Suite: storage, table1, path, accuracy, stability, budget, or all. Every run updates
-    /// REPORT.md with the sections of all suites run into the results folder so far.
-    #[arg(value_parser = ["storage", "table1", "path", "accuracy", "stability", "budget", "all"])]
+    /// Suite: storage, table1, path, accuracy, stability, budget, fidelity, or all. Every run
+    /// updates REPORT.md with the sections of all suites run into the results folder so far.
+    #[arg(value_parser = [
+        "storage", "table1", "path", "accuracy", "stability", "budget", "fidelity", "all",
+    ])]
     pub suite: String,
     /// Species atlases (comma-separated).
     #[arg(long, value_delimiter = ',', required = true)]
@@ -387,6 +391,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "accuracy" => accuracy::run(&b)?,
             "stability" => stability::run(&b)?,
             "budget" => budget::run(&b)?,
+            "fidelity" => fidelity::run(&b)?,
             _ => unreachable!("clap checks the suite"),
         };
         report::write(&b, s, &section)?;

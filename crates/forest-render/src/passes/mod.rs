@@ -20,9 +20,8 @@ pub const COMPUTE_WGSL: [&str; 6] = [
 ];
 
 /// WGSL of the draw pass.
-pub const DRAW_WGSL: [&str; 4] = [
+pub const DRAW_WGSL: [&str; 3] = [
     include_str!("../../../../shaders/common.wgsl"),
-    include_str!("../../../../shaders/quad_geometry.wgsl"),
     include_str!("../../../../shaders/draw.wgsl"),
     include_str!("../../../../shaders/ground.wgsl"),
 ];

@@ -1,0 +1,637 @@
+//! Fidelity: the quad stream's accuracy around single trees where people look — close up,
+//! under the crown, between sampling directions, far away — and the error split by swapping
+//! one factor of the bake or the runtime at a time (and the paper's method in one row).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use forest_format::forest::{DEFAULT_PRESORT_DIRECTIONS, Forest, Instance};
+use forest_format::generate::SplitMix64;
+use forest_format::{BakeParams, ColourEncoding, PlaneFit};
+use forest_render::methods::{ForestRenderer, Method};
+use forest_render::renderer::{AspectBlend, Background, StreamOptions};
+use forest_render::scene::SpeciesData;
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::{Camera, GpuScene, QuadStream, RendererOptions};
+use glam::Vec3;
+
+use super::accuracy::reference;
+use super::chart::{Chart, Series};
+use super::report::Section;
+use super::{Bench, Table, ms};
+
+/// Seed of the camera draw.
+pub const SEED: u64 = 0x5eed;
+/// ε (pixels) of every variant but `min-quad=1`.
+pub const EPS: f32 = 2.0;
+/// ε of the `min-quad=1` variant (exact per-pixel depth).
+pub const EPS_EXACT: f32 = 1.0;
+/// Lowest eye height (metres): eyes drawn below it slide along their ray towards the crown.
+pub const MIN_EYE_HEIGHT: f32 = 0.3;
+/// Highest elevation drawn (degrees): straight down has no up vector.
+const MAX_ELEVATION: f32 = 89.5;
+/// Largest scratch-bake resolution in quick mode.
+const QUICK_RESOLUTION: u32 = 128;
+/// Scratch folder of the re-baked atlases, inside the results folder (removed afterwards).
+pub const SCRATCH: &str = ".fidelity-atlases";
+
+/// A bake change: the parameters of a re-bake from the given atlas's ones.
+type BakeChange = fn(BakeParams) -> BakeParams;
+
+/// One row of the comparison: a bake change (none: the atlas given) and run-time options.
+struct Variant {
+    name: &'static str,
+    bake: Option<BakeChange>,
+    options: StreamOptions,
+    epsilon: f32,
+}
+
+fn variants(quick: bool) -> Vec<Variant> {
+    let default = StreamOptions::default();
+    let runtime = |name, options| Variant {
+        name,
+        bake: None,
+        options,
+        epsilon: EPS,
+    };
+    let baked = |name, bake: BakeChange| Variant {
+        name,
+        bake: Some(bake),
+        options: default,
+        epsilon: EPS,
+    };
+    let paper = Variant {
+        name: "paper",
+        bake: Some(|p| BakeParams {
+            below: 0,
+            plane_fit: PlaneFit::LeastSquares,
+            ..p
+        }),
+        options: StreamOptions {
+            blend: AspectBlend::Over,
+            depth_error: false,
+        },
+        epsilon: EPS,
+    };
+    let dither = runtime(
+        "blend=dither",
+        StreamOptions {
+            blend: AspectBlend::Dither,
+            ..default
+        },
+    );
+    if quick {
+        return vec![runtime("baseline", default), dither, paper];
+    }
+    vec![
+        runtime("baseline", default),
+        dither,
+        runtime(
+            "blend=nearest",
+            StreamOptions {
+                blend: AspectBlend::Nearest,
+                ..default
+            },
+        ),
+        runtime(
+            "depth-error refine",
+            StreamOptions {
+                depth_error: true,
+                ..default
+            },
+        ),
+        baked("directions=31", |p| BakeParams {
+            directions: 31,
+            ..p
+        }),
+        baked("slabs=4", |p| BakeParams { slabs: 4, ..p }),
+        baked("lossless", |p| BakeParams {
+            colour: ColourEncoding::Png,
+            ..p
+        }),
+        Variant {
+            epsilon: EPS_EXACT,
+            ..baked("min-quad=1", |p| BakeParams { min_quad: 1, ..p })
+        },
+        baked("below=0", |p| BakeParams { below: 0, ..p }),
+        baked("fit=least-squares", |p| BakeParams {
+            plane_fit: PlaneFit::LeastSquares,
+            ..p
+        }),
+        paper,
+    ]
+}
+
+/// A drawn camera and what the table records of it.
+struct View {
+    cam: Camera,
+    /// Distance from the crown centre in crown radii (after any move above the ground).
+    distance_radii: f32,
+    elevation_deg: f32,
+    azimuth_deg: f32,
+    /// Azimuth halfway between two adjacent horizon sampling directions (else on one).
+    between: bool,
+}
+
+/// `n` cameras around a tree at the origin (scale 1, rotation 0) of `data`, drawn from `seed`:
+/// distance 1–100 crown radii (log-uniform) from the crown centre, elevation −60°..90°,
+/// azimuth on a horizon sampling direction (even indices) or halfway between two (odd).
+fn views(data: &SpeciesData, n: usize, viewport: (u32, u32), seed: u64) -> Vec<View> {
+    let m = &data.atlas.manifest;
+    let (c, r) = (m.bounding_sphere.center, m.bounding_sphere.radius);
+    let tau = std::f32::consts::TAU;
+    let mut horizon: Vec<f32> = m
+        .directions
+        .iter()
+        .filter(|f| f.dir.y.abs() < 1e-3)
+        .map(|f| f.dir.x.atan2(f.dir.z).rem_euclid(tau))
+        .collect();
+    horizon.sort_by(f32::total_cmp);
+    let mut rng = SplitMix64(seed);
+    (0..n)
+        .map(|i| {
+            // Always the same four draws per camera, whatever the branch.
+            let u = rng.next_f32();
+            let e = rng.next_f32();
+            let pick = rng.next_u64();
+            let free = rng.next_f32() * tau;
+            let (az, between) = if horizon.is_empty() {
+                (free, false)
+            } else {
+                let k = (pick % horizon.len() as u64) as usize;
+                if i % 2 == 0 {
+                    (horizon[k], false)
+                } else {
+                    let next = horizon.get(k + 1).copied().unwrap_or(horizon[0] + tau);
+                    (((horizon[k] + next) / 2.0).rem_euclid(tau), true)
+                }
+            };
+            let el = (-60.0 + 150.0 * e).min(MAX_ELEVATION).to_radians();
+            let dir = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+            let mut d = r * 10f32.powf(2.0 * u);
+            if (c + dir * d).y < MIN_EYE_HEIGHT {
+                // Below ground: slide towards the crown centre (under the crown).
+                d = ((MIN_EYE_HEIGHT - c.y) / dir.y).clamp(0.05, d);
+            }
+            View {
+                cam: Camera {
+                    eye: c + dir * d,
+                    target: c,
+                    fov_y_deg: 60.0,
+                    near: 0.05,
+                    far: d + 4.0 * r + 10.0,
+                    viewport,
+                    epsilon: EPS,
+                },
+                distance_radii: d / r,
+                elevation_deg: el.to_degrees(),
+                azimuth_deg: az.to_degrees(),
+                between,
+            }
+        })
+        .collect()
+}
+
+/// One measured (variant, species, camera).
+struct Row {
+    variant: usize,
+    distance_radii: f32,
+    elevation_deg: f32,
+    flip: f32,
+    iou: Option<f64>,
+    frame_ms: f64,
+}
+
+/// The single-tree forest of species `k` among `species` names.
+fn one_tree(species: Vec<String>, k: u32) -> Forest {
+    Forest::new(
+        species,
+        vec![Instance {
+            position: [0.0; 3],
+            rotation: 0.0,
+            scale: 1.0,
+            species: k,
+        }],
+        DEFAULT_PRESORT_DIRECTIONS,
+    )
+}
+
+/// The quad stream alone of one scratch atlas at `path` (a single-species forest).
+fn scratch_renderer(
+    b: &Bench,
+    path: &Path,
+    viewport: (u32, u32),
+    min_epsilon: f32,
+) -> Result<(ForestRenderer, u64)> {
+    let species = vec![SpeciesData::load(path)?];
+    let gpu = species[0].atlas.manifest.gpu_bytes();
+    let forest = one_tree(vec![path.display().to_string()], 0);
+    let scene = GpuScene::new(&b.ctx, &species, &forest)?;
+    let opts = RendererOptions {
+        format: TARGET_FORMAT,
+        viewport,
+        min_epsilon,
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let stream = QuadStream::new(&b.ctx, scene, &opts)?;
+    Ok((ForestRenderer::new(stream, None), gpu))
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> Option<f64> {
+    let (s, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    (n > 0).then(|| s / n as f64)
+}
+
+fn cell(v: Option<f64>, digits: usize) -> String {
+    v.map_or_else(|| "-".into(), |x| format!("{x:.digits$}"))
+}
+
+/// Run the suite.
+pub fn run(b: &Bench) -> Result<Section> {
+    // The reference needs the models: fail before any work without them.
+    b.prepared()?;
+    let quick = b.quick;
+    let viewport = if quick { (160, 120) } else { (400, 300) };
+    let n = if quick { 4 } else { 24 };
+    let count = if quick { 1 } else { b.species.len() };
+    let variants = variants(quick);
+    let scratch = b.out.join(SCRATCH);
+    std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
+    let names: Vec<String> = b
+        .species_paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let target = Target::new(&b.ctx, viewport.0, viewport.1);
+    let mut table = Table::new(&[
+        "variant",
+        "species",
+        "camera",
+        "distance_radii",
+        "elevation_deg",
+        "azimuth_deg",
+        "between_directions",
+        "epsilon",
+        "quads",
+        "flip_mean",
+        "iou",
+        "frame_ms",
+    ]);
+    let mut rows: Vec<Row> = Vec::new();
+    // Atlas GPU bytes per variant (all species measured), and variants that could not run.
+    let mut gpu_bytes = vec![0u64; variants.len()];
+    let mut failed: Vec<String> = Vec::new();
+    let mut bake_resolutions: Vec<u32> = Vec::new();
+    let result = (|| -> Result<()> {
+        for k in 0..count {
+            let data = &b.species[k];
+            let species = b.species_paths[k]
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| format!("species{k}"));
+            let views = views(data, n, viewport, SEED.wrapping_add(k as u64));
+            let forest = one_tree(names.clone(), k as u32);
+            let r0 = b.renderer(&forest, viewport, EPS, true, Background::Transparent)?;
+            eprintln!("fidelity: {species}: {n} references (4x4 supersampled full geometry)");
+            let refs = views
+                .iter()
+                .map(|v| reference(b, &r0, &v.cam))
+                .collect::<Result<Vec<_>>>()?;
+            let mut base = data.atlas.manifest.params;
+            if quick {
+                base.resolution = base.resolution.min(QUICK_RESOLUTION);
+                base.min_quad = base.min_quad.min(base.resolution / 2).max(1);
+            }
+            for (vi, v) in variants.iter().enumerate() {
+                let start = std::time::Instant::now();
+                // The renderer of this variant: the one given, or a scratch re-bake.
+                let scratch_r;
+                let r = match v.bake {
+                    None => {
+                        gpu_bytes[vi] += data.atlas.manifest.gpu_bytes();
+                        &r0
+                    }
+                    Some(change) => {
+                        let params = change(base);
+                        eprintln!(
+                            "fidelity: {species} {}: baking ({} px, {} + {} directions, {} \
+                             slabs, min quad {}, {} fit)",
+                            v.name,
+                            params.resolution,
+                            params.directions,
+                            params.below,
+                            params.slabs,
+                            params.min_quad,
+                            params.plane_fit.name()
+                        );
+                        let path = scratch.join(format!("{k}-{vi}.atlas"));
+                        let baked = forest_bake::bake_file(&b.models[k], &params, &|_, _| {})
+                            .map_err(anyhow::Error::from)
+                            .and_then(|out| {
+                                out.atlas.save(&path)?;
+                                scratch_renderer(b, &path, viewport, v.epsilon)
+                            });
+                        match baked {
+                            Ok((r, gpu)) => {
+                                bake_resolutions.push(params.resolution);
+                                gpu_bytes[vi] += gpu;
+                                scratch_r = r;
+                                &scratch_r
+                            }
+                            Err(e) => {
+                                eprintln!("fidelity: {species} {}: FAILED: {e:#}", v.name);
+                                failed.push(format!("{} ({species}): {e:#}", v.name));
+                                let _ = std::fs::remove_dir_all(&path);
+                                continue;
+                            }
+                        }
+                    }
+                };
+                r.stream.set_options(v.options);
+                let mut flips = Vec::new();
+                for (ci, (view, rf)) in views.iter().zip(&refs).enumerate() {
+                    let mut cam = view.cam;
+                    cam.epsilon = v.epsilon;
+                    let (s, frame_ms) = b.measure(r, Method::Quads, &cam, &target, b.frames)?;
+                    if s.overflow > 0 {
+                        eprintln!(
+                            "fidelity: {species} {} camera {ci}: {} quads overflowed",
+                            v.name, s.overflow
+                        );
+                    }
+                    let m = forest_metrics::compare(rf, &target.read(&b.ctx))?;
+                    flips.push(f64::from(m.flip_mean));
+                    table.push(vec![
+                        v.name.into(),
+                        species.clone(),
+                        ci.to_string(),
+                        format!("{:.3}", view.distance_radii),
+                        format!("{:.2}", view.elevation_deg),
+                        format!("{:.2}", view.azimuth_deg),
+                        view.between.to_string(),
+                        v.epsilon.to_string(),
+                        s.primitives.to_string(),
+                        format!("{:.5}", m.flip_mean),
+                        cell(m.coverage_iou, 4),
+                        ms(frame_ms),
+                    ]);
+                    rows.push(Row {
+                        variant: vi,
+                        distance_radii: view.distance_radii,
+                        elevation_deg: view.elevation_deg,
+                        flip: m.flip_mean,
+                        iou: m.coverage_iou,
+                        frame_ms,
+                    });
+                }
+                r.stream.set_options(StreamOptions::default());
+                eprintln!(
+                    "fidelity: {species} {}: mean FLIP {:.4} ({:.1} s)",
+                    v.name,
+                    mean(flips.into_iter()).unwrap_or(f64::NAN),
+                    start.elapsed().as_secs_f64()
+                );
+                if v.bake.is_some() {
+                    let _ = std::fs::remove_dir_all(scratch.join(format!("{k}-{vi}.atlas")));
+                }
+            }
+        }
+        Ok(())
+    })();
+    let _ = std::fs::remove_dir_all(&scratch);
+    result?;
+    b.write("fidelity.csv", &table.csv())?;
+
+    // Summary per variant.
+    let stats = |vi: usize, f: &dyn Fn(&Row) -> bool| {
+        mean(
+            rows.iter()
+                .filter(|r| r.variant == vi && f(r))
+                .map(|r| f64::from(r.flip)),
+        )
+    };
+    let all = |_: &Row| true;
+    let base_flip = stats(0, &all);
+    let mut summary = Table::new(&[
+        "variant",
+        "rows",
+        "flip_mean",
+        "iou_mean",
+        "flip_under_2r",
+        "flip_2r_to_10r",
+        "flip_over_10r",
+        "flip_from_below",
+        "flip_ratio_to_baseline",
+        "frame_ms_mean",
+        "atlas_gpu_mib",
+    ]);
+    let mut ratios: Vec<(&str, f64, f64)> = Vec::new();
+    for (vi, v) in variants.iter().enumerate() {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.variant == vi).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let flip = stats(vi, &all);
+        let ratio = flip.zip(base_flip).map(|(f, b)| f / b);
+        if let (Some(f), Some(q)) = (flip, ratio) {
+            ratios.push((v.name, f, q));
+        }
+        summary.push(vec![
+            v.name.into(),
+            mine.len().to_string(),
+            cell(flip, 5),
+            cell(mean(mine.iter().filter_map(|r| r.iou)), 4),
+            cell(stats(vi, &|r| r.distance_radii < 2.0), 5),
+            cell(stats(vi, &|r| (2.0..=10.0).contains(&r.distance_radii)), 5),
+            cell(stats(vi, &|r| r.distance_radii > 10.0), 5),
+            cell(stats(vi, &|r| r.elevation_deg < 0.0), 5),
+            cell(ratio, 3),
+            cell(mean(mine.iter().map(|r| r.frame_ms)), 3),
+            format!("{:.2}", gpu_bytes[vi] as f64 / 1048576.0),
+        ]);
+    }
+    b.write("fidelity_summary.csv", &summary.csv())?;
+    println!("{}", summary.markdown());
+
+    // Charts: FLIP against distance and elevation, one series per variant.
+    let series = |x: &dyn Fn(&Row) -> f64| -> Vec<Series> {
+        variants
+            .iter()
+            .enumerate()
+            .filter(|(vi, _)| rows.iter().any(|r| r.variant == *vi))
+            .map(|(vi, v)| Series {
+                name: v.name.into(),
+                points: rows
+                    .iter()
+                    .filter(|r| r.variant == vi)
+                    .map(|r| (x(r), f64::from(r.flip)))
+                    .collect(),
+                ..Default::default()
+            })
+            .collect()
+    };
+    let what = format!(
+        "{} species, {n} cameras each, {}x{}",
+        count, viewport.0, viewport.1
+    );
+    b.chart(
+        "fidelity-distance",
+        &Chart {
+            title: format!("Single-tree fidelity against distance ({what})"),
+            x_label: "distance from the crown centre (crown radii)".into(),
+            y_label: "mean FLIP against the reference".into(),
+            log_x: true,
+            series: series(&|r| f64::from(r.distance_radii)),
+            ..Default::default()
+        },
+    )?;
+    b.chart(
+        "fidelity-elevation",
+        &Chart {
+            title: format!("Single-tree fidelity against elevation ({what})"),
+            x_label: "camera elevation seen from the crown centre (degrees)".into(),
+            y_label: "mean FLIP against the reference".into(),
+            series: series(&|r| f64::from(r.elevation_deg)),
+            ..Default::default()
+        },
+    )?;
+
+    let text = paragraph(
+        b,
+        &variants,
+        &ratios,
+        &summary,
+        &failed,
+        &bake_resolutions,
+        &what,
+    );
+    Ok(Section {
+        title: "Fidelity around single trees".into(),
+        text,
+        table: summary,
+        charts: vec!["fidelity-distance".into(), "fidelity-elevation".into()],
+    })
+}
+
+/// The report's reading, from the measured figures.
+fn paragraph(
+    b: &Bench,
+    variants: &[Variant],
+    ratios: &[(&str, f64, f64)],
+    summary: &Table,
+    failed: &[String],
+    bake_resolutions: &[u32],
+    what: &str,
+) -> String {
+    let mut s = format!(
+        "One tree at the origin per species ({what}; transparent background, so coverage IoU \
+         is the silhouette's overlap), seen from seeded random cameras (seed {SEED:#x}): \
+         distance 1–100 crown radii from the crown centre (log-uniform), elevation −60° to \
+         90°, azimuth exactly on a horizon sampling direction (even cameras) or halfway \
+         between two (odd); eyes drawn below {MIN_EYE_HEIGHT} m slide along their ray towards \
+         the crown centre and stand under the crown; cameras inside a crown are kept. Every \
+         image is compared with the 4×4 supersampled full-geometry reference (mean FLIP, lower \
+         is better). The baseline is the atlases given with the default run-time options \
+         (\"over\" aspect blend, refinement by projected edge length) on the default bake \
+         (gap-aware planes, 5 directions below the horizon) at ε = {EPS}; every other row swaps \
+         one factor: a run-time option, or a re-bake of the model with the given atlas's \
+         parameters but that one changed (`min-quad=1` at ε = {EPS_EXACT}); `paper` is the \
+         original method in one row (no directions below the horizon, least-squares plane \
+         fit, \"over\" blending, projected edge length alone).\n\n"
+    );
+    if let Some(res) = bake_resolutions.iter().max() {
+        let given: Vec<u32> = b
+            .species
+            .iter()
+            .map(|d| d.atlas.manifest.params.resolution)
+            .collect();
+        if given.iter().any(|g| g != res) {
+            let _ = write!(
+                s,
+                "Re-bakes here are at {res} px while the atlases given are at {} px, so the \
+                 bake rows also differ by resolution. ",
+                given
+                    .iter()
+                    .map(u32::to_string)
+                    .collect::<Vec<_>>()
+                    .join("/")
+            );
+        }
+    }
+    let base = ratios.iter().find(|r| r.0 == "baseline");
+    match base {
+        Some(&(_, flip, _)) => {
+            let _ = write!(s, "Baseline mean FLIP {flip:.4}. ");
+            let mut others: Vec<&(&str, f64, f64)> =
+                ratios.iter().filter(|r| r.0 != "baseline").collect();
+            others.sort_by(|a, b| b.2.total_cmp(&a.2));
+            let factors: Vec<String> = others
+                .iter()
+                .filter(|r| r.0 != "paper")
+                .map(|&&(name, f, q)| {
+                    let verdict = if q > 1.0 {
+                        format!("{:.0} % more error than the baseline", (q - 1.0) * 100.0)
+                    } else {
+                        format!("{:.0} % less error than the baseline", (1.0 - q) * 100.0)
+                    };
+                    format!("`{name}` {f:.4} ({q:.2}×, {verdict})")
+                })
+                .collect();
+            if !factors.is_empty() {
+                let _ = write!(
+                    s,
+                    "Swapping one factor, from the most error to the least: {}. ",
+                    factors.join("; ")
+                );
+            }
+            if let Some(&&(_, f, q)) = others.iter().find(|r| r.0 == "paper") {
+                let _ = write!(
+                    s,
+                    "The paper's method together: mean FLIP {f:.4}, {q:.2}× the baseline's \
+                     (the baseline has {:.0} % {} error)",
+                    (1.0 - 1.0 / q).abs() * 100.0,
+                    if q >= 1.0 { "less" } else { "more" }
+                );
+                // Where the two differ most: the buckets' ratios.
+                let row = |name: &str| summary.rows.iter().find(|r| r[0] == name);
+                if let (Some(p), Some(bl)) = (row("paper"), row("baseline")) {
+                    let buckets = [
+                        (4, "under 2 radii"),
+                        (5, "2–10 radii"),
+                        (6, "beyond 10 radii"),
+                        (7, "from below"),
+                    ];
+                    let parts: Vec<String> = buckets
+                        .iter()
+                        .filter_map(|&(c, label)| {
+                            let (x, y) = (p[c].parse::<f64>().ok()?, bl[c].parse::<f64>().ok()?);
+                            (y > 0.0).then(|| format!("{label} {x:.4} against {y:.4}"))
+                        })
+                        .collect();
+                    if !parts.is_empty() {
+                        let _ = write!(s, ": {}", parts.join(", "));
+                    }
+                }
+                s += ". ";
+            }
+        }
+        None => s += "The baseline was not measured. ",
+    }
+    let _ = write!(
+        s,
+        "The distance buckets and the from-below column are the mean FLIP of the cameras \
+         in them; `atlas_gpu_mib` is the atlas memory each row needs (the cost of the \
+         larger bakes). Variants measured: {}.",
+        variants
+            .iter()
+            .map(|v| format!("`{}`", v.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if !failed.is_empty() {
+        let _ = write!(s, "\n\nNot measured (failed): {}.", failed.join("; "));
+    }
+    s
+}
