@@ -90,8 +90,8 @@ fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
     assert_eq!(v["levels"], 5);
     assert_eq!(v["nodes_per_level"].as_array().unwrap().len(), 5);
     assert_eq!(
-        v["nodes_per_level"][0], 8,
-        "every one of the 8 layers has a root"
+        v["nodes_per_level"][0], 18,
+        "every one of the 18 layers ((4 + 5 below) directions x 2 slabs) has a root"
     );
     let on_disk: u64 = std::fs::read_dir(&atlas)
         .unwrap()

@@ -376,9 +376,12 @@ pub fn build_layer(
                     let cl = front_cluster(alpha, depth, r, rect, gap_bins)
                         .expect("only non-blank nodes are visited");
                     let plane = cl.moments.plane().expect("a cluster has weight");
+                    // Corners lie half a pixel beyond the outermost pixel centres: the range
+                    // extends by the plane's rise over that half pixel.
+                    let margin = 0.5 * (plane.gx.abs() + plane.gy.abs());
                     plane
                         .corners(x0, y0, size)
-                        .map(|d| d.clamp(cl.t_min, cl.t_max))
+                        .map(|d| d.clamp(cl.t_min - margin, cl.t_max + margin))
                 }
             };
             let quantised = c.map(|d| quantize_depth(d as f32));

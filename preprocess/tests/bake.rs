@@ -265,7 +265,7 @@ fn the_loader_says_what_is_wrong() {
     reset();
     let manifest = path.join("manifest.json");
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("\"version\": 1", "\"version\": 99")).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 2", "\"version\": 99")).unwrap();
     assert!(err(&path).contains("atlas version 99"), "{}", err(&path));
 
     reset();

@@ -85,6 +85,9 @@ fn shared() -> Vec<Expect> {
                 ("layer_base", offset_of!(GpuSpecies, layer_base)),
                 ("node_base", offset_of!(GpuSpecies, node_base)),
                 ("lower_tri_count", offset_of!(GpuSpecies, lower_tri_count)),
+                ("pad0", offset_of!(GpuSpecies, pad)),
+                ("pad1", offset_of!(GpuSpecies, pad) + 4),
+                ("pad2", offset_of!(GpuSpecies, pad) + 8),
             ],
         ),
         (

@@ -30,14 +30,19 @@ pub fn run(b: &Bench) -> Result<Section> {
         .next_power_of_two()
         .clamp(32, 1024);
     let defaults = b.species[0].atlas.manifest.params;
-    let resolutions: Vec<u32> = if b.quick {
-        vec![32, 64]
+    // (resolution, directions below the horizon): every resolution with the atlases' own
+    // directions below, and the default resolution without any (what they cost).
+    let mut resolutions: Vec<(u32, u32)> = if b.quick {
+        vec![(32, defaults.below), (64, defaults.below)]
     } else {
         let mut r = vec![needed / 2, needed, defaults.resolution];
         r.sort_unstable();
         r.dedup();
-        r
+        r.into_iter().map(|r| (r, defaults.below)).collect()
     };
+    if !b.quick && defaults.below > 0 {
+        resolutions.push((defaults.resolution, 0));
+    }
     // The nearest tree is `near` metres away: a tree whose viewpoint has no other tree closer
     // (the one nearest the centre that qualifies).
     let offset = Vec3::new(near * 0.6, 1.7, near * 0.8);
@@ -83,16 +88,17 @@ pub fn run(b: &Bench) -> Result<Section> {
     let mut points = Vec::new();
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let dir = tempfile_dir(&b.out)?;
-    for &res in &resolutions {
+    for &(res, below) in &resolutions {
         let params = forest_format::BakeParams {
             resolution: res,
+            below,
             ..defaults
         };
         let mut species = Vec::new();
         let (mut disk, mut gpu) = (0u64, 0u64);
         for (k, obj) in b.models.iter().enumerate() {
             let out = forest_bake::bake_file(obj, &params, &|_, _| {})?;
-            let path = dir.join(format!("{k}-{res}.atlas"));
+            let path = dir.join(format!("{k}-{res}-{below}.atlas"));
             out.atlas.save(&path)?;
             disk += std::fs::read_dir(&path)?
                 .filter_map(|e| e.ok()?.metadata().ok())
@@ -135,11 +141,16 @@ pub fn run(b: &Bench) -> Result<Section> {
             });
         let levels = species[0].atlas.manifest.nodes_per_level.len();
         println!(
-            "budget: {res} px, {levels} levels: {disk} B disk, {gpu} B GPU, FLIP {:.4}",
+            "budget: {res} px, {levels} levels, {below} directions below: {disk} B disk, \
+             {gpu} B GPU, FLIP {:.4}",
             m.flip_mean
         );
-        points.push((gpu as f64 / 1048576.0, f64::from(m.flip_mean)));
-        let choice = if res == needed {
+        if below == defaults.below {
+            points.push((gpu as f64 / 1048576.0, f64::from(m.flip_mean)));
+        }
+        let choice = if below != defaults.below {
+            "no directions below"
+        } else if res == needed {
             "needed"
         } else if res == defaults.resolution {
             "default"
@@ -188,11 +199,15 @@ pub fn run(b: &Bench) -> Result<Section> {
          capacity the formula allocates (a quarter more than measured is suggested: \
          `RendererOptions::max_quads`), and mean FLIP against the reference at the nearest view. \
          Choosing the needed resolution instead of a larger default saves the difference in \
-         the gpu_bytes column at the FLIP cost the table shows.",
+         the gpu_bytes column at the FLIP cost the table shows. The row \"no directions below\" \
+         bakes the default resolution without the {} sampling directions below the horizon: \
+         its storage columns are what those directions cost (views from under a crown: see \
+         the fidelity suite).",
         viewport.0,
         viewport.1,
         2.0 * radius * focal / near,
         defaults.resolution,
+        defaults.below,
     );
     Ok(Section {
         title: "Budget: model no more than a scene needs".into(),
