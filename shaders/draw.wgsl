@@ -7,6 +7,9 @@
 // coverage is the weighted mean of the aspects' coverages) or, without FLAG_DITHER, "over"
 // each other with alpha (hi − lo) / hi.
 //
+// Finest-level quads magnified past CRACK_PIXELS reach a little past their rectangles (see
+// crack_margin), so that neighbours at different depths overlap rather than crack apart.
+//
 // A finest-level quad is drawn on its plane even where its depth error projects longer than ε:
 // the bake keeps every node's corners within one depth cluster of its pixels, so no quad is
 // stretched across a gap, and flattening such quads to their mean depth was measured to lose
@@ -38,6 +41,23 @@ struct VsOut {
     @location(5) @interpolate(flat) share: vec3<u32>,
 }
 
+// How far (in finest-quad widths) a finest-level quad reaches past its rectangle, so that
+// neighbouring quads at different depths overlap instead of leaving cracks once the view
+// magnifies their texels: 0 while a finest quad covers at most CRACK_PIXELS pixels at `p`,
+// rising to CRACK_MARGIN at twice that.
+const CRACK_PIXELS: f32 = 4.0;
+const CRACK_MARGIN: f32 = 0.25;
+fn crack_margin(sp: Species, inst: Instance, level: u32, p: vec3<f32>) -> f32 {
+    if (level + 1u != sp.levels) { return 0.0; }
+    let m = camera.view_proj;
+    let w = m[0].w * p.x + m[1].w * p.y + m[2].w * p.z + m[3].w;
+    if (w <= 0.0) { return CRACK_MARGIN; }
+    // |row 1 of the view-projection's 3×3| is the projection's y scale (the view is a rotation).
+    let focal = length(vec3<f32>(m[0].y, m[1].y, m[2].y)) * camera.viewport.y * 0.5;
+    let quad_px = 2.0 * sp.sphere.w * inst.scale / f32(1u << (sp.levels - 1u)) * focal / w;
+    return CRACK_MARGIN * clamp(quad_px / CRACK_PIXELS - 1.0, 0.0, 1.0);
+}
+
 @vertex
 fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
     let q = quads[qi];
@@ -47,9 +67,15 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let f = frames[sp.dir_base + dir];
     let node = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).xy;
     let size = 1.0 / f32(1u << quad_level(q));
-    let u = (f32(quad_x(q)) + f32(vi & 1u)) * size;
-    let v = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
-    let t = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    let finest = 1.0 / f32(1u << (sp.levels - 1u));
+    let u0 = (f32(quad_x(q)) + f32(vi & 1u)) * size;
+    let v0 = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
+    let t0 = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    let corner = to_world(inst, slab_point(sp, f, quad_slab(q), u0, v0, t0));
+    let margin = crack_margin(sp, inst, quad_level(q), corner);
+    let u = u0 + (f32(vi & 1u) * 2.0 - 1.0) * margin * finest;
+    let v = v0 + (f32(vi >> 1u) * 2.0 - 1.0) * margin * finest;
+    let t = t0;
     let flags = stream_flags(camera);
     let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
     var out: VsOut;
