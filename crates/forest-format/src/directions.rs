@@ -60,22 +60,28 @@ pub fn hemisphere_directions(count: u32) -> Vec<Vec3> {
             counts[i] -= 1;
         }
         for (i, (&e, &n)) in elev.iter().zip(&counts).enumerate() {
-            for j in 0..n {
-                let phi = 2.0 * std::f64::consts::PI * (f64::from(j) + 0.5 * (i % 2) as f64)
-                    / f64::from(n);
-                dirs.push(
-                    Vec3::new(
-                        (e.cos() * phi.sin()) as f32,
-                        e.sin() as f32,
-                        (e.cos() * phi.cos()) as f32,
-                    )
-                    .normalize(),
-                );
-            }
+            push_ring(&mut dirs, e, n, i % 2 == 1);
         }
     }
     dirs.push(Vec3::Y);
     dirs
+}
+
+/// Push `n` unit directions at elevation `e` (radians), evenly spaced in azimuth from +Z
+/// towards +X, rotated by half a step when `half_step`.
+fn push_ring(dirs: &mut Vec<Vec3>, e: f64, n: u32, half_step: bool) {
+    let offset = if half_step { 0.5 } else { 0.0 };
+    for j in 0..n {
+        let phi = 2.0 * std::f64::consts::PI * (f64::from(j) + offset) / f64::from(n);
+        dirs.push(
+            Vec3::new(
+                (e.cos() * phi.sin()) as f32,
+                e.sin() as f32,
+                (e.cos() * phi.cos()) as f32,
+            )
+            .normalize(),
+        );
+    }
 }
 
 /// The sampling directions: `upper` over the upper hemisphere ([`hemisphere_directions`]),
@@ -114,18 +120,7 @@ pub fn lower_directions(count: u32) -> Vec<Vec3> {
             counts[0] += 1;
         }
         for (i, (&e, &n)) in elev.iter().zip(&counts).enumerate() {
-            for j in 0..n {
-                let phi = 2.0 * std::f64::consts::PI * (f64::from(j) + 0.5 * ((i + 1) % 2) as f64)
-                    / f64::from(n);
-                dirs.push(
-                    Vec3::new(
-                        (e.cos() * phi.sin()) as f32,
-                        e.sin() as f32,
-                        (e.cos() * phi.cos()) as f32,
-                    )
-                    .normalize(),
-                );
-            }
+            push_ring(&mut dirs, e, n, i % 2 == 0);
         }
     }
     dirs.push(Vec3::NEG_Y);
