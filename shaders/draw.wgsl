@@ -71,13 +71,14 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let u0 = (f32(quad_x(q)) + f32(vi & 1u)) * size;
     let v0 = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
     let t0 = f32((node.y >> (8u * vi)) & 255u) / 255.0;
-    let corner = to_world(inst, slab_point(sp, f, quad_slab(q), u0, v0, t0));
-    let margin = crack_margin(sp, inst, quad_level(q), corner);
+    var w = to_world(inst, slab_point(sp, f, quad_slab(q), u0, v0, t0));
+    let margin = crack_margin(sp, inst, quad_level(q), w);
     let u = u0 + (f32(vi & 1u) * 2.0 - 1.0) * margin * finest;
     let v = v0 + (f32(vi >> 1u) * 2.0 - 1.0) * margin * finest;
-    let t = t0;
+    if (margin > 0.0) {
+        w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t0));
+    }
     let flags = stream_flags(camera);
-    let w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t));
     var out: VsOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.uv = vec2<f32>(u, v);

@@ -91,7 +91,7 @@ pub struct MethodArgs {
     /// Quad stream: how a tree's 1–3 aspects combine: over (alpha-blended over each other,
     /// the paper's blend: coverage is their union), dither (each pixel shows one aspect,
     /// chosen by weight: coverage is the weighted mean), nearest (the largest weight alone).
-    #[arg(long, default_value = "over", value_parser = ["over", "dither", "nearest"])]
+    #[arg(long, default_value = "over", value_parser = clap::builder::PossibleValuesParser::new(AspectBlend::ALL.map(AspectBlend::name)))]
     pub blend: String,
     /// Quad stream: refine also by each quad's projected depth error, not only by its
     /// projected edge length (the paper's metric).
@@ -103,11 +103,7 @@ impl MethodArgs {
     /// The quad stream's run-time options.
     pub fn stream_options(&self) -> StreamOptions {
         StreamOptions {
-            blend: match self.blend.as_str() {
-                "dither" => AspectBlend::Dither,
-                "nearest" => AspectBlend::Nearest,
-                _ => AspectBlend::Over,
-            },
+            blend: AspectBlend::from_name(&self.blend).unwrap_or_default(),
             depth_error: self.depth_error,
         }
     }

@@ -192,7 +192,7 @@ fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
 
 /// Whether the node's depth error, as a displacement along its sampling direction at the
 /// quad's centre and mean depth, projects longer than ε pixels (see `error_long` in
-/// `shaders/common.wgsl`); a displacement reaching behind the eye counts as long.
+/// `shaders/quad_geometry.wgsl`); a displacement reaching behind the eye counts as long.
 pub fn error_long(t: &SceneTables, cam: &GpuCamera, q: &Quad, node: QuadNode) -> bool {
     let e = ERROR_BOUNDS[usize::from(node.error())];
     if e <= 0.0 {

@@ -163,6 +163,15 @@ pub enum AspectBlend {
 }
 
 impl AspectBlend {
+    /// Every blend, the default first.
+    pub const ALL: [AspectBlend; 3] =
+        [AspectBlend::Over, AspectBlend::Dither, AspectBlend::Nearest];
+
+    /// The blend named `name` ([`AspectBlend::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|b| b.name() == name)
+    }
+
     /// Short name for the CLI and the benchmark tables.
     pub fn name(self) -> &'static str {
         match self {
