@@ -13,6 +13,11 @@ struct Camera {
     viewport: vec4<f32>,
     // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
     planes: array<vec4<f32>, 6>,
+    // Which form draws each tree (the hybrid method, see quad_share): x metres + y crown
+    // radii = the switch distance; z: the transition band's width as a fraction of it;
+    // w: the per-instance jitter of the band's start, a fraction of the switch distance.
+    // (0, 0, ·, ·): every tree is drawn as quads; x ≥ 3e38: every tree as geometry.
+    forms: vec4<f32>,
 }
 
 struct Instance {
@@ -114,6 +119,53 @@ fn node_error(node: vec2<u32>) -> f32 {
         0.70710677, 1.0);
     return b[(node.x >> 24u) & 15u];
 }
+fn unorm12(x: f32) -> u32 {
+    return u32(floor(clamp(x, 0.0, 1.0) * 4095.0 + 0.5));
+}
+
+// A per-instance number in [0, 1) (a PCG hash; exact in f32: 24 bits over 2^24).
+fn instance_hash(instance: u32) -> f32 {
+    var h = instance * 747796405u + 2891336453u;
+    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+    return f32(h >> 8u) / 16777216.0;
+}
+
+// The quad stream's share of a tree in units of 1/WEIGHT_ONE (hybrid::quad_share mirrors it):
+// 0 while the tree is nearer than its switch distance s (drawn as geometry only), WEIGHT_ONE
+// from the end of its transition band on (quads only), and in between the fraction of its
+// pixels the quads draw. The band starts at s·(1 + jitter·h) with h the instance's hash, so
+// a ring of trees at one distance does not change form in the same frame, and is
+// band·start wide. `d`: eye to bounding-sphere centre, `radius`: the crown's radius (metres).
+fn quad_share(forms: vec4<f32>, d: f32, radius: f32, instance: u32) -> u32 {
+    let s = forms.x + forms.y * radius;
+    if (s <= 0.0) { return WEIGHT_ONE; }
+    if (s >= 3.0e38) { return 0u; }
+    let start = s * (1.0 + forms.w * instance_hash(instance));
+    let width = start * forms.z;
+    if (width <= 0.0) { return select(0u, WEIGHT_ONE, d >= start); }
+    return unorm12((d - start) / width);
+}
+
+// Ordered-dither threshold of a pixel for a tree, in [0, WEIGHT_ONE): an 8×8 Bayer matrix,
+// shifted per instance so that neighbouring trees do not share a pattern.
+fn dither_threshold(pixel: vec2<f32>, instance: u32) -> u32 {
+    let x = u32(pixel.x) & 7u;
+    let y = u32(pixel.y) & 7u;
+    let xy = x ^ y;
+    let b = ((xy & 1u) << 5u) | ((y & 1u) << 4u) | ((xy & 2u) << 2u) | ((y & 2u) << 1u)
+        | ((xy & 4u) >> 1u) | ((y & 4u) >> 2u);
+    let u = fract((f32(b) + 0.5) / 64.0 + instance_hash(instance));
+    return min(u32(u * f32(WEIGHT_ONE)), WEIGHT_ONE - 1u);
+}
+
+// The screen-door threshold that splits a tree in its transition band between the forms: the
+// quads keep the pixels whose threshold is below the tree's quad share, the geometry the
+// others, so every pixel is drawn by exactly one form. The matrix is transposed and the
+// instance salted, so it does not follow the aspects' dither.
+fn form_threshold(pixel: vec2<f32>, instance: u32) -> u32 {
+    return dither_threshold(pixel.yx, instance ^ 0x5bd1e995u);
+}
+
 fn pack_pos(level: u32, x: u32, y: u32, slab: u32) -> u32 {
     return level | (x << 4u) | (y << 16u) | (slab << 28u);
 }

@@ -91,10 +91,6 @@ fn visible(inst: Instance, sp: Species) -> bool {
     return true;
 }
 
-fn unorm12(x: f32) -> u32 {
-    return u32(floor(clamp(x, 0.0, 1.0) * 4095.0 + 0.5));
-}
-
 // Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, the
 // remainder given to the largest (first on ties); with FLAG_NEAREST the largest alone.
 // Quantising first puts every later decision on integers, so a weight a rounding error away
@@ -122,7 +118,13 @@ fn aspect_weights(w: vec3<f32>) -> vec3<u32> {
 fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
     let inst = instances[inst_id];
     let sp = species[inst.species];
-    let eye_obj = to_object_dir(inst, camera.eye.xyz - to_world(inst, sp.sphere.xyz));
+    let centre = to_world(inst, sp.sphere.xyz);
+    // Trees drawn as geometry alone (the hybrid method) have no quads.
+    if (quad_share(camera.forms, distance(camera.eye.xyz, centre), sp.sphere.w * inst.scale,
+                   inst_id) == 0u) {
+        return 0u;
+    }
+    let eye_obj = to_object_dir(inst, camera.eye.xyz - centre);
     let bl = blend(sp, eye_obj);
     let w12 = aspect_weights(bl.w);
     var n = 0u;

@@ -37,8 +37,9 @@ struct VsOut {
     @location(2) @interpolate(flat) alpha: f32,
     @location(3) @interpolate(flat) level: u32,
     @location(4) @interpolate(flat) dir: u32,
-    // Share [lo, hi) of the blend (x, y) and the instance (z).
-    @location(5) @interpolate(flat) share: vec3<u32>,
+    // Share [lo, hi) of the blend (x, y), the instance (z) and the tree's quad share (w, see
+    // quad_share: below WEIGHT_ONE in the hybrid's transition band).
+    @location(5) @interpolate(flat) share: vec4<u32>,
 }
 
 // How far (in finest-quad widths) a finest-level quad reaches past its rectangle, so that
@@ -87,7 +88,9 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let hi = quad_hi(q);
     out.alpha = select(0.0, f32(hi - lo) / f32(hi), hi > 0u);
     if ((flags & FLAG_DITHER) != 0u) { out.alpha = 1.0; }
-    out.share = vec3<u32>(lo, hi, q.instance);
+    let form = quad_share(camera.forms, distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz)),
+                          sp.sphere.w * inst.scale, q.instance);
+    out.share = vec4<u32>(lo, hi, q.instance, form);
     out.level = quad_level(q);
     out.dir = dir;
     return out;
@@ -116,20 +119,6 @@ fn direction_colour(dir: u32) -> vec3<f32> {
     return 0.15 + 0.8 * rgb;
 }
 
-// Ordered-dither threshold of a pixel for a tree, in [0, WEIGHT_ONE): an 8×8 Bayer matrix,
-// shifted per instance so that neighbouring trees do not share a pattern.
-fn dither_threshold(pixel: vec2<f32>, instance: u32) -> u32 {
-    let x = u32(pixel.x) & 7u;
-    let y = u32(pixel.y) & 7u;
-    let xy = x ^ y;
-    let b = ((xy & 1u) << 5u) | ((y & 1u) << 4u) | ((xy & 2u) << 2u) | ((y & 2u) << 1u)
-        | ((xy & 4u) >> 1u) | ((y & 4u) >> 2u);
-    var h = instance * 747796405u + 2891336453u;
-    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
-    let u = fract((f32(b) + 0.5) / 64.0 + f32(h >> 8u) / 16777216.0);
-    return min(u32(u * f32(WEIGHT_ONE)), WEIGHT_ONE - 1u);
-}
-
 @fragment
 fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
     let c = textureSample(colour, colour_sampler, in.uv, in.layer);
@@ -137,6 +126,9 @@ fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
     let g = in.uv * f32(1u << in.level);
     let px = max(fwidth(g), vec2<f32>(1e-6));
     let mode = u32(camera.viewport.z);
+    if (in.share.w < WEIGHT_ONE && form_threshold(in.clip.xy, in.share.z) >= in.share.w) {
+        discard;
+    }
     if ((stream_flags(camera) & FLAG_DITHER) != 0u) {
         let u = dither_threshold(in.clip.xy, in.share.z);
         if (u < in.share.x || u >= in.share.y) { discard; }

@@ -1,7 +1,8 @@
 // Culling of the geometry-based methods: every instance is frustum-tested and given a draw
 // segment (distance band × species, see method_band); a count, one serial pass of offsets and
 // indirect arguments, and a scatter build the visible list segment by segment, nearest band
-// first. Appended after common.wgsl and geometry_types.wgsl.
+// first. In the hybrid method (camera.forms) trees drawn as quads alone get no segment.
+// Appended after common.wgsl and geometry_types.wgsl.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -34,6 +35,11 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
             keys[i] = NONE;
             return;
         }
+    }
+    // Trees drawn as quads alone (the hybrid method) are not drawn here.
+    if (quad_share(camera.forms, distance(camera.eye.xyz, c), r, i) == WEIGHT_ONE) {
+        keys[i] = NONE;
+        return;
     }
     let d = distance(camera.eye.xyz, c) / inst.scale;
     let key = method_band(method, d) * geo_consts.y + inst.species;

@@ -30,11 +30,27 @@ struct GeoOut {
     @location(4) @interpolate(flat) material: u32,
     // rgb: mean leaf colour; a: contrast weight α = √λ (1: untouched).
     @location(5) @interpolate(flat) contrast: vec4<f32>,
+    // The instance and its quad share (see quad_share): in the hybrid's transition band the
+    // geometry keeps the pixels the quads leave.
+    @location(6) @interpolate(flat) form: vec2<u32>,
+}
+
+// The instance and its quad share (0 outside the hybrid's transition band).
+fn geo_form(id: u32, inst: Instance) -> vec2<u32> {
+    let sp = geo_species[inst.species];
+    let d = distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz));
+    return vec2<u32>(id, quad_share(camera.forms, d, sp.sphere.w * inst.scale, id));
+}
+
+// Whether a pixel of a tree in the transition band belongs to the quads.
+fn quads_own(pixel: vec2<f32>, form: vec2<u32>) -> bool {
+    return form.y > 0u && form_threshold(pixel, form.x) < form.y;
 }
 
 @vertex
 fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> GeoOut {
-    let inst = instances[visible_list[ii]];
+    let id = visible_list[ii];
+    let inst = instances[id];
     let v = vertices[vi];
     var p = v.pos;
     var contrast = vec4<f32>(0.0, 0.0, 0.0, 1.0);
@@ -60,11 +76,13 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     out.sun_visibility = v.sun_visibility;
     out.material = v.material;
     out.contrast = contrast;
+    out.form = geo_form(id, inst);
     return out;
 }
 
 @fragment
 fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
+    if (quads_own(in.clip.xy, in.form)) { discard; }
     let m = materials[in.material];
     var albedo = m.kd.rgb;
     if (m.layer != NONE) {
@@ -88,6 +106,7 @@ struct BillboardOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
     @location(1) @interpolate(flat) layer: u32,
+    @location(2) @interpolate(flat) form: vec2<u32>,
 }
 
 // A camera-facing quad over the tree's bounding sphere showing the billboard image whose
@@ -95,7 +114,8 @@ struct BillboardOut {
 @vertex
 fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32)
     -> BillboardOut {
-    let inst = instances[visible_list[ii]];
+    let id = visible_list[ii];
+    let inst = instances[id];
     let sp = geo_species[inst.species];
     let c = to_world(inst, sp.sphere.xyz);
     let r = sp.sphere.w * inst.scale;
@@ -115,11 +135,13 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.clip = camera.view_proj * vec4<f32>(c + (right * x + up * y) * r, 1.0);
     out.uv = vec2<f32>(0.5 + 0.5 * x, 0.5 - 0.5 * y);
     out.layer = sp.lod_first.w + e;
+    out.form = geo_form(id, inst);
     return out;
 }
 
 @fragment
 fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
+    if (quads_own(in.clip.xy, in.form)) { discard; }
     let t = textureSample(billboards, tex_sampler, in.uv, in.layer);
     if (t.a < 0.5) { discard; }
     return vec4<f32>(t.rgb, 1.0);

@@ -63,6 +63,12 @@ impl Camera {
         Ok(())
     }
 
+    /// Focal length in pixels (vertical): a length `l` at distance `d` projects to
+    /// `l · focal / d` pixels.
+    pub fn focal_pixels(&self) -> f32 {
+        self.viewport.1 as f32 * 0.5 / (self.fov_y_deg.to_radians() * 0.5).tan()
+    }
+
     /// Unit view direction.
     pub fn forward(&self) -> Vec3 {
         (self.target - self.eye).normalize()
@@ -81,7 +87,8 @@ impl Camera {
         proj * glam::camera::rh::view::look_at_mat4(self.eye, self.target, Vec3::Y)
     }
 
-    /// The GPU form: matrix, eye and ε, forward, viewport, normalised frustum planes.
+    /// The GPU form: matrix, eye and ε, forward, viewport, normalised frustum planes; every
+    /// tree drawn as quads (renderers set `forms` for the method they draw).
     pub fn to_gpu(&self) -> GpuCamera {
         let m = self.view_proj();
         let rows = [m.row(0), m.row(1), m.row(2), m.row(3)];
@@ -100,6 +107,7 @@ impl Camera {
             forward: self.forward().extend(0.0).to_array(),
             viewport: [self.viewport.0 as f32, self.viewport.1 as f32, 0.0, 0.0],
             planes,
+            forms: crate::hybrid::FORMS_QUADS,
         }
     }
 }

@@ -245,6 +245,8 @@ pub struct GeometryRenderer {
     camera: wgpu::Buffer,
     method_buf: wgpu::Buffer,
     method: Cell<MeshMethod>,
+    forms: Cell<[f32; 4]>,
+    writes: Cell<(u64, u64)>,
     reset: wgpu::ComputePipeline,
     classify: wgpu::ComputePipeline,
     args_pipeline: wgpu::ComputePipeline,
@@ -891,6 +893,8 @@ impl GeometryRenderer {
             camera,
             method_buf,
             method: Cell::new(method),
+            forms: Cell::new(crate::hybrid::FORMS_GEOMETRY),
+            writes: Cell::new((0, 0)),
             reset: cpl("geo_reset"),
             classify: cpl("geo_classify"),
             args_pipeline: cpl("geo_args"),
@@ -925,6 +929,13 @@ impl GeometryRenderer {
         self.method.get()
     }
 
+    /// Which trees the renderer draws from the next camera write on (the camera's `forms`, see
+    /// [`crate::hybrid`]); [`crate::hybrid::FORMS_GEOMETRY`], every tree, unless the hybrid
+    /// method set it.
+    pub fn set_forms(&self, forms: [f32; 4]) {
+        self.forms.set(forms);
+    }
+
     /// Write the camera and record the frame: classify, arguments, scatter, then draw the
     /// bands nearest first into `colour` and `depth`.
     pub fn encode(
@@ -935,34 +946,8 @@ impl GeometryRenderer {
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) -> Result<(), CameraError> {
-        camera.validate()?;
-        ctx.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera.to_gpu()));
-        let ts = |b: u32| {
-            self.queries
-                .as_ref()
-                .map(|(set, _, _)| (set, Some(b), Some(b + 1)))
-        };
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("geometry cull"),
-                timestamp_writes: ts(0).map(|(query_set, b, e)| wgpu::ComputePassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: b,
-                    end_of_pass_write_index: e,
-                }),
-            });
-            pass.set_bind_group(0, &self.compute_bg, &[]);
-            let segments = BANDS * self.species;
-            pass.set_pipeline(&self.reset);
-            pass.dispatch_workgroups(segments.div_ceil(64).max(1), 1, 1);
-            pass.set_pipeline(&self.classify);
-            pass.dispatch_workgroups(self.instances.div_ceil(256).max(1), 1, 1);
-            pass.set_pipeline(&self.args_pipeline);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&self.scatter);
-            pass.dispatch_workgroups(self.instances.div_ceil(256).max(1), 1, 1);
-        }
+        self.set_camera(ctx, camera)?;
+        self.encode_compute(encoder);
         {
             let mut pass = crate::target::begin_pass(
                 encoder,
@@ -970,35 +955,91 @@ impl GeometryRenderer {
                 colour,
                 depth,
                 self.background.clear_colour(),
-                ts(2).map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: b,
-                    end_of_pass_write_index: e,
-                }),
+                self.queries
+                    .as_ref()
+                    .map(|(query_set, _, _)| wgpu::RenderPassTimestampWrites {
+                        query_set,
+                        beginning_of_pass_write_index: Some(2),
+                        end_of_pass_write_index: Some(3),
+                    }),
             );
-            if self.background == Background::Sky {
-                pass.set_pipeline(&self.ground_pipeline);
-                pass.set_bind_group(0, &self.ground_bg, &[]);
-                pass.draw(0..4, 0..1);
-            }
-            pass.set_bind_group(0, &self.draw_bg, &[]);
-            let first_billboard = self.method.get().first_billboard_band();
-            for band in 0..BANDS {
-                if band == 0 {
-                    pass.set_pipeline(&self.draw);
-                }
-                if band == first_billboard {
-                    pass.set_pipeline(&self.billboard);
-                }
-                for s in 0..self.species {
-                    pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);
-                }
-            }
+            self.record_draw(&mut pass, true);
         }
-        if let Some((set, resolve, _)) = &self.queries {
-            encoder.resolve_query_set(set, 0..4, resolve, 0);
-        }
+        self.resolve_times(encoder, true);
         Ok(())
+    }
+
+    /// Write the camera (with the renderer's `forms`): the one upload of a frame.
+    pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
+        camera.validate()?;
+        let mut g = camera.to_gpu();
+        g.forms = self.forms.get();
+        ctx.queue.write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
+        let (n, bytes) = self.writes.get();
+        self.writes
+            .set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));
+        Ok(())
+    }
+
+    /// Camera writes made by this renderer since it was created: (count, bytes). The method
+    /// uniform is written only by [`Self::set_method`].
+    pub fn uploads(&self) -> (u64, u64) {
+        self.writes.get()
+    }
+
+    /// The compute pass of a frame: classify, arguments, scatter (after [`Self::set_camera`]).
+    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("geometry cull"),
+            timestamp_writes: self.queries.as_ref().map(|(query_set, _, _)| {
+                wgpu::ComputePassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }
+            }),
+        });
+        pass.set_bind_group(0, &self.compute_bg, &[]);
+        let segments = BANDS * self.species;
+        pass.set_pipeline(&self.reset);
+        pass.dispatch_workgroups(segments.div_ceil(64).max(1), 1, 1);
+        pass.set_pipeline(&self.classify);
+        pass.dispatch_workgroups(self.instances.div_ceil(256).max(1), 1, 1);
+        pass.set_pipeline(&self.args_pipeline);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(&self.scatter);
+        pass.dispatch_workgroups(self.instances.div_ceil(256).max(1), 1, 1);
+    }
+
+    /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
+    /// `ground` and the background is the sky), then the bands nearest first.
+    pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
+        if ground && self.background == Background::Sky {
+            pass.set_pipeline(&self.ground_pipeline);
+            pass.set_bind_group(0, &self.ground_bg, &[]);
+            pass.draw(0..4, 0..1);
+        }
+        pass.set_bind_group(0, &self.draw_bg, &[]);
+        let first_billboard = self.method.get().first_billboard_band();
+        for band in 0..BANDS {
+            if band == 0 {
+                pass.set_pipeline(&self.draw);
+            }
+            if band == first_billboard {
+                pass.set_pipeline(&self.billboard);
+            }
+            for s in 0..self.species {
+                pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);
+            }
+        }
+    }
+
+    /// Resolve the frame's pass times: the cull pass's, and the draw pass's when `draw` (the
+    /// render pass carried this renderer's timestamps).
+    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder, draw: bool) {
+        if let Some((set, resolve, _)) = &self.queries {
+            encoder.resolve_query_set(set, 0..if draw { 4 } else { 2 }, resolve, 0);
+        }
     }
 
     /// Write the camera, record the frame into `target`, and submit.

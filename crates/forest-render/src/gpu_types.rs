@@ -3,7 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// The camera: the only data written to the GPU per frame (208 bytes).
+/// The camera: the only data written to the GPU per frame (224 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuCamera {
@@ -18,6 +18,9 @@ pub struct GpuCamera {
     pub viewport: [f32; 4],
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],
+    /// Which form draws each tree (see [`crate::hybrid::quad_share`]): metres, crown radii,
+    /// band fraction, jitter fraction.
+    pub forms: [f32; 4],
 }
 
 /// A tree instance on the GPU (32 bytes).

@@ -14,6 +14,7 @@ pub mod capacity;
 pub mod context;
 pub mod geometry;
 pub mod gpu_types;
+pub mod hybrid;
 pub mod methods;
 pub mod passes;
 pub mod reference;

@@ -1,6 +1,6 @@
 //! Every method behind one switch: the quad stream, static impostors (the stream without
-//! refinement), and the geometry-based methods (full geometry, stochastic simplification,
-//! discrete LODs + billboards). Switching is a uniform write or an iteration count: nothing is
+//! refinement), the geometry-based methods (full geometry, stochastic simplification,
+//! discrete LODs + billboards), and the hybrid (near trees as geometry, the rest as quads). Switching is a uniform write or an iteration count: nothing is
 //! rebuilt, so a viewer or a benchmark can compare methods frame by frame.
 
 use std::cell::Cell;
@@ -8,6 +8,7 @@ use std::cell::Cell;
 use crate::camera::{Camera, CameraError};
 use crate::context::{GpuContext, RenderError};
 use crate::geometry::{GeometryRenderer, MeshMethod};
+use crate::hybrid::{FORMS_GEOMETRY, FORMS_QUADS, Hybrid};
 use crate::renderer::{PassTimes, QuadStream};
 use crate::target::Target;
 
@@ -20,6 +21,8 @@ pub enum Method {
     Impostor,
     /// A geometry-based method.
     Mesh(MeshMethod),
+    /// Near trees as a geometry-based method, the rest as the quad stream.
+    Hybrid(Hybrid),
 }
 
 impl Method {
@@ -32,6 +35,7 @@ impl Method {
             Method::Mesh(MeshMethod::Full { depth_sort: false }) => "geometry-unsorted",
             Method::Mesh(MeshMethod::Stochastic(_)) => "stochastic",
             Method::Mesh(MeshMethod::Lods(_)) => "lods",
+            Method::Hybrid(_) => "hybrid",
         }
     }
 }
@@ -41,10 +45,14 @@ impl Method {
 pub struct MethodStats {
     /// Trees that passed the frustum test.
     pub visible_trees: u32,
-    /// Quads (quad-stream methods) or triangles (geometry-based methods) drawn.
+    /// Quads (quad-stream methods) or triangles (geometry-based methods) drawn; the hybrid's
+    /// quads plus its triangles.
     pub primitives: u64,
     /// Trees drawn as billboards (discrete LODs).
     pub billboards: u32,
+    /// Trees drawn as geometry by the hybrid (near ones and those in the transition band,
+    /// which the quads draw too); 0 for the other methods.
+    pub geometry_trees: u32,
     /// Quads per hierarchy level (quad-stream methods; empty for the others).
     pub per_level: Vec<u32>,
     /// Quads dropped or left unrefined for lack of room (quad-stream methods).
@@ -78,23 +86,38 @@ impl ForestRenderer {
         self.method.get()
     }
 
-    /// Switch the method; the geometry-based ones need the geometry renderer.
+    /// Switch the method; the geometry-based ones and the hybrid need the geometry renderer.
     pub fn set_method(&self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
+        let geometry = || {
+            self.geometry.as_ref().ok_or_else(|| {
+                RenderError::Scene(format!(
+                    "the {} method needs the species' OBJ models (none were loaded)",
+                    method.name()
+                ))
+            })
+        };
         match method {
             Method::Quads | Method::Impostor => self.stream.set_refine(method == Method::Quads),
-            Method::Mesh(m) => self
-                .geometry
-                .as_ref()
-                .ok_or_else(|| {
-                    RenderError::Scene(format!(
-                        "the {} method needs the species' OBJ models (none were loaded)",
-                        method.name()
-                    ))
-                })?
-                .set_method(ctx, m)?,
+            Method::Mesh(m) => geometry()?.set_method(ctx, m)?,
+            Method::Hybrid(h) => {
+                h.validate()?;
+                geometry()?.set_method(ctx, h.near_form)?;
+                self.stream.set_refine(true);
+            }
+        }
+        self.stream.set_forms(FORMS_QUADS);
+        if let Some(g) = &self.geometry {
+            g.set_forms(FORMS_GEOMETRY);
         }
         self.method.set(method);
         Ok(())
+    }
+
+    /// Hierarchy levels of the scene's coarsest species (its finest quads are the largest):
+    /// what [`Hybrid::forms`] needs for its automatic switch distance.
+    pub fn coarsest_levels(&self) -> u32 {
+        let t = &self.stream.scene.tables;
+        t.species.iter().map(|s| s.levels).min().unwrap_or(t.max_levels)
     }
 
     /// Write the camera and record one frame of the current method.
@@ -108,12 +131,51 @@ impl ForestRenderer {
     ) -> Result<(), CameraError> {
         match (self.method.get(), &self.geometry) {
             (Method::Mesh(_), Some(g)) => g.encode(ctx, camera, encoder, colour, depth),
+            (Method::Hybrid(h), Some(g)) => {
+                camera.validate()?;
+                let forms = h.forms(camera, self.coarsest_levels());
+                self.stream.set_forms(forms);
+                g.set_forms(forms);
+                self.stream.set_camera(ctx, camera)?;
+                g.set_camera(ctx, camera)?;
+                self.stream.encode_compute(encoder);
+                g.encode_compute(encoder);
+                {
+                    let mut pass = crate::target::begin_pass(
+                        encoder,
+                        "hybrid draw",
+                        colour,
+                        depth,
+                        self.stream_background(),
+                        self.stream.draw_timestamps(),
+                    );
+                    // Opaque geometry first, depth written; then the quads back to front,
+                    // depth-tested against it.
+                    g.record_draw(&mut pass, true);
+                    self.stream.record_draw(&mut pass, false);
+                }
+                self.stream.resolve_times(encoder);
+                g.resolve_times(encoder, false);
+                Ok(())
+            }
             _ => {
                 self.stream.set_camera(ctx, camera)?;
                 self.stream.encode(encoder, colour, depth);
                 Ok(())
             }
         }
+    }
+
+    fn stream_background(&self) -> wgpu::Color {
+        self.stream.background().clear_colour()
+    }
+
+    /// Camera writes of both forms since they were created: (count, bytes). A hybrid frame
+    /// writes the camera once for each form and nothing else.
+    pub fn uploads(&self) -> (u64, u64) {
+        let (n, b) = self.stream.uploads();
+        let (gn, gb) = self.geometry.as_ref().map_or((0, 0), |g| g.uploads());
+        (n + gn, b + gb)
     }
 
     /// Write the camera, record the frame into `target`, and submit.
@@ -138,12 +200,30 @@ impl ForestRenderer {
     /// Counters and pass times of the last submitted frame; waits for the GPU.
     pub fn read_stats(&self, ctx: &GpuContext) -> MethodStats {
         match (self.method.get(), &self.geometry) {
+            (Method::Hybrid(_), Some(g)) => {
+                let q = self.stream.read_stats(ctx);
+                let s = g.read_stats(ctx);
+                MethodStats {
+                    visible_trees: q.visible_trees,
+                    primitives: u64::from(q.quads) + s.triangles,
+                    billboards: s.billboards,
+                    geometry_trees: s.visible_trees,
+                    per_level: q.per_level,
+                    overflow: q.overflow_cull + q.overflow_refine,
+                    times: q.times.zip(s.times).map(|(q, s)| PassTimes {
+                        cull_ms: q.cull_ms + s.cull_ms,
+                        refine_ms: q.refine_ms,
+                        draw_ms: q.draw_ms,
+                    }),
+                }
+            }
             (Method::Mesh(_), Some(g)) => {
                 let s = g.read_stats(ctx);
                 MethodStats {
                     visible_trees: s.visible_trees,
                     primitives: s.triangles,
                     billboards: s.billboards,
+                    geometry_trees: 0,
                     per_level: Vec::new(),
                     overflow: 0,
                     times: s.times,
@@ -155,6 +235,7 @@ impl ForestRenderer {
                     visible_trees: s.visible_trees,
                     primitives: u64::from(s.quads),
                     billboards: 0,
+                    geometry_trees: 0,
                     per_level: s.per_level,
                     overflow: s.overflow_cull + s.overflow_refine,
                     times: s.times,

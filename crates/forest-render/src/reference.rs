@@ -91,7 +91,18 @@ fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> bool {
 fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let inst = &t.instances[inst_id as usize];
     let sp = &t.species[inst.species as usize];
-    let eye_obj = to_object_dir(inst, xyz(cam.eye) - to_world(inst, xyz(sp.sphere)));
+    let centre = to_world(inst, xyz(sp.sphere));
+    // Trees drawn as geometry alone (the hybrid method) have no quads.
+    if crate::hybrid::quad_share(
+        cam.forms,
+        xyz(cam.eye).distance(centre),
+        sp.sphere[3] * inst.scale,
+        inst_id,
+    ) == 0
+    {
+        return Vec::new();
+    }
+    let eye_obj = to_object_dir(inst, xyz(cam.eye) - centre);
     let base = sp.dir_base as usize;
     let dirs: Vec<Vec3> = t.frames[base..base + sp.directions as usize]
         .iter()

@@ -303,6 +303,7 @@ pub struct QuadStream {
     camera_set: Cell<bool>,
     debug: Cell<DebugView>,
     options: Cell<StreamOptions>,
+    forms: Cell<[f32; 4]>,
     background: Background,
     owned: Vec<(&'static str, wgpu::Buffer)>,
 }
@@ -527,6 +528,7 @@ impl QuadStream {
             camera_set: Cell::new(false),
             debug: Cell::new(DebugView::Off),
             options: Cell::new(StreamOptions::default()),
+            forms: Cell::new(crate::hybrid::FORMS_QUADS),
             background: opts.background,
             owned,
         })
@@ -555,6 +557,18 @@ impl QuadStream {
     /// The run-time options in use.
     pub fn options(&self) -> StreamOptions {
         self.options.get()
+    }
+
+    /// What the trees are drawn over.
+    pub fn background(&self) -> Background {
+        self.background
+    }
+
+    /// Which trees the stream draws from the next camera write on (the camera's `forms`, see
+    /// [`crate::hybrid`]); [`crate::hybrid::FORMS_QUADS`], every tree, unless the hybrid
+    /// method set it.
+    pub fn set_forms(&self, forms: [f32; 4]) {
+        self.forms.set(forms);
     }
 
     /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
@@ -596,6 +610,7 @@ impl QuadStream {
         let mut g = camera.to_gpu();
         g.viewport[2] = self.debug.get() as u32 as f32;
         g.viewport[3] = self.options.get().flags() as f32;
+        g.forms = self.forms.get();
         ctx.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
         let (n, bytes) = self.writes.get();
@@ -618,6 +633,24 @@ impl QuadStream {
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) {
+        self.encode_compute(encoder);
+        {
+            let mut pass = crate::target::begin_pass(
+                encoder,
+                "draw",
+                colour,
+                depth,
+                self.background.clear_colour(),
+                self.draw_timestamps(),
+            );
+            self.record_draw(&mut pass, true);
+        }
+        self.resolve_times(encoder);
+    }
+
+    /// The compute passes of a frame: cull and refine. `set_camera` must have been called
+    /// once before.
+    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
         assert!(self.camera_set.get(), "set_camera before the first frame");
         let ts = |b: u32| {
             self.queries
@@ -643,28 +676,33 @@ impl QuadStream {
             self.refine
                 .record(&mut pass, self.iterations(), &self.bindings(), &self.scan);
         }
-        {
-            let mut pass = crate::target::begin_pass(
-                encoder,
-                "draw",
-                colour,
-                depth,
-                self.background.clear_colour(),
-                self.queries
-                    .as_ref()
-                    .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(4),
-                        end_of_pass_write_index: Some(5),
-                    }),
-            );
-            self.draw.record(
-                &mut pass,
-                &self.bg_draw[(self.iterations() % 2) as usize],
-                &self.args,
-                self.background == Background::Sky,
-            );
-        }
+    }
+
+    /// Timestamp writes for the render pass that draws the stream (its draw time).
+    pub fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.queries
+            .as_ref()
+            .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(4),
+                end_of_pass_write_index: Some(5),
+            })
+    }
+
+    /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
+    /// `ground` and the background is the sky), then the quads.
+    pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
+        self.draw.record(
+            pass,
+            &self.bg_draw[(self.iterations() % 2) as usize],
+            &self.args,
+            ground && self.background == Background::Sky,
+        );
+    }
+
+    /// Resolve the frame's pass times (after the render pass that used
+    /// [`Self::draw_timestamps`]).
+    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder) {
         if let Some((set, resolve, _)) = &self.queries {
             encoder.resolve_query_set(set, 0..6, resolve, 0);
         }

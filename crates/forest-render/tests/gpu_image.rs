@@ -100,8 +100,8 @@ fn a_frame_writes_only_the_camera() {
     }
     assert_eq!(
         stream.uploads(),
-        (3, 3 * 208),
-        "one 208-byte camera write per frame"
+        (3, 3 * 224),
+        "one 224-byte camera write per frame"
     );
     assert_ne!(
         streams[0], streams[1],

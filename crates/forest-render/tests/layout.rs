@@ -57,6 +57,7 @@ fn shared() -> Vec<Expect> {
                 ("forward", offset_of!(GpuCamera, forward)),
                 ("viewport", offset_of!(GpuCamera, viewport)),
                 ("planes", offset_of!(GpuCamera, planes)),
+                ("forms", offset_of!(GpuCamera, forms)),
             ],
         ),
         (

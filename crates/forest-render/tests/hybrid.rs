@@ -1,0 +1,285 @@
+//! The hybrid method: at a switch distance of 0 it is the quad stream and at infinity the full
+//! geometry, byte for byte; a tree in the transition band is drawn by both forms through
+//! complementary masks (every pixel from exactly one of them); the GPU's classification equals
+//! the CPU mirror; a frame writes only the camera; empty, single-tree and 1M-tree forests
+//! render without validation errors.
+
+mod common;
+
+use forest_format::forest::Forest;
+use forest_render::geometry::{GeometryRenderer, MeshMethod};
+use forest_render::hybrid::{self, Hybrid, Near};
+use forest_render::methods::{ForestRenderer, Method};
+use forest_render::renderer::{Background, RendererOptions};
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream, reference};
+use glam::Vec3;
+
+const WEIGHT_ONE: u32 = forest_render::gpu_types::WEIGHT_ONE;
+
+fn renderer(
+    ctx: &GpuContext,
+    forest: &Forest,
+    viewport: (u32, u32),
+    background: Background,
+) -> ForestRenderer {
+    let scene = GpuScene::new(ctx, &common::species(), forest).unwrap();
+    let opts = RendererOptions {
+        viewport,
+        background,
+        ..Default::default()
+    };
+    let geometry =
+        GeometryRenderer::new(ctx, common::prepared(), forest, TARGET_FORMAT, background).unwrap();
+    ForestRenderer::new(QuadStream::new(ctx, scene, &opts).unwrap(), Some(geometry))
+}
+
+fn frame(ctx: &GpuContext, r: &ForestRenderer, method: Method, cam: &Camera) -> image::RgbaImage {
+    r.set_method(ctx, method).unwrap();
+    let target = Target::new(ctx, cam.viewport.0, cam.viewport.1);
+    r.render_frame(ctx, cam, &target).unwrap();
+    target.read(ctx)
+}
+
+fn hybrid_at(near: f32) -> Method {
+    Method::Hybrid(Hybrid {
+        near: Near::Metres(near),
+        ..Default::default()
+    })
+}
+
+fn save(name: &str, images: &[(&str, &image::RgbaImage)]) {
+    let out = common::root().join("target/test-output");
+    std::fs::create_dir_all(&out).unwrap();
+    for (n, img) in images {
+        img.save(out.join(format!("{name}-{n}.png"))).unwrap();
+    }
+}
+
+#[test]
+fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    for background in [Background::Transparent, Background::Sky] {
+        let r = renderer(&ctx, &forest, (160, 120), background);
+        for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
+            let quads = frame(&ctx, &r, Method::Quads, &cam);
+            let zero = frame(&ctx, &r, hybrid_at(0.0), &cam);
+            let geometry = frame(
+                &ctx,
+                &r,
+                Method::Mesh(MeshMethod::Full { depth_sort: true }),
+                &cam,
+            );
+            let infinity = frame(&ctx, &r, hybrid_at(f32::INFINITY), &cam);
+            assert_ne!(quads, geometry, "{name}: the two forms differ");
+            for (what, got, want) in [
+                ("at 0", &zero, &quads),
+                ("at infinity", &infinity, &geometry),
+            ] {
+                if got != want {
+                    save(
+                        &format!("hybrid-{name}-{background:?}"),
+                        &[("expected", want), ("hybrid", got)],
+                    );
+                    panic!("{name} {background:?}: the hybrid {what} differs");
+                }
+            }
+        }
+    }
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
+/// The tree's distance from the eye and crown radius, as the GPU computes them.
+fn tree_distance(r: &ForestRenderer, cam: &Camera, instance: usize) -> (f32, f32) {
+    let t = &r.stream.scene.tables;
+    let inst = &t.instances[instance];
+    let sp = &t.species[inst.species as usize];
+    let c = Vec3::from_slice(&sp.sphere[..3]) * inst.scale;
+    let c = Vec3::new(
+        inst.cos_rot * c.x + inst.sin_rot * c.z,
+        c.y,
+        -inst.sin_rot * c.x + inst.cos_rot * c.z,
+    ) + Vec3::from_array(inst.position);
+    (cam.eye.distance(c), sp.sphere[3] * inst.scale)
+}
+
+#[test]
+fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
+    let ctx = common::ctx();
+    for species in [0, 1] {
+        let forest = common::one_tree(species, 0.4);
+        let r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
+        let cam = common::camera(Vec3::new(2.0, 2.0, 9.0), Vec3::new(0.0, 2.0, 0.0), 2.0);
+        let (d, radius) = tree_distance(&r, &cam, 0);
+        let quads = frame(&ctx, &r, hybrid_at(0.0), &cam);
+        let geometry = frame(&ctx, &r, hybrid_at(f32::INFINITY), &cam);
+        // The band [d/1.4, d/1.4 · 1.8] puts the tree half-way through.
+        let method = Method::Hybrid(Hybrid {
+            near: Near::Metres(d / 1.4),
+            band: 0.8,
+            jitter: 0.0,
+            ..Default::default()
+        });
+        let mixed = frame(&ctx, &r, method, &cam);
+        let Method::Hybrid(h) = method else {
+            unreachable!()
+        };
+        let share = hybrid::quad_share(h.forms(&cam, r.coarsest_levels()), d, radius, 0);
+        assert!(
+            (1500..2600).contains(&share),
+            "the tree is inside the band: share {share}"
+        );
+        let stats = r.read_stats(&ctx);
+        assert_eq!(stats.geometry_trees, 1, "drawn as geometry: {stats:?}");
+        assert!(stats.primitives > stats.per_level.iter().sum::<u32>() as u64);
+        // Every pixel from exactly one form: the quads' where the mask is below the share.
+        let expected = image::RgbaImage::from_fn(160, 120, |x, y| {
+            if hybrid::form_threshold(x, y, 0) < share {
+                *quads.get_pixel(x, y)
+            } else {
+                *geometry.get_pixel(x, y)
+            }
+        });
+        let wrong = mixed
+            .pixels()
+            .zip(expected.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        let from_quads = (0..120)
+            .flat_map(|y| (0..160).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                quads.get_pixel(x, y) != geometry.get_pixel(x, y)
+                    && mixed.get_pixel(x, y) == quads.get_pixel(x, y)
+            })
+            .count();
+        let differ = quads
+            .pixels()
+            .zip(geometry.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        eprintln!(
+            "species {species}: share {share}, {from_quads} of {differ} differing pixels \
+             from the quads, {wrong} unexpected"
+        );
+        if wrong != 0 {
+            save(
+                &format!("hybrid-band-{species}"),
+                &[("mixed", &mixed), ("expected", &expected)],
+            );
+            panic!("{wrong} pixels are not from the form their mask gives");
+        }
+        let f = from_quads as f32 / differ as f32;
+        let want = share as f32 / WEIGHT_ONE as f32;
+        assert!((f - want).abs() < 0.1, "quads draw {f} of the tree, want {want}");
+    }
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
+#[test]
+fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera() {
+    let ctx = common::ctx();
+    let forest = common::forest(2000);
+    let r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
+    let target = Target::new(&ctx, 160, 120);
+    let h = Hybrid {
+        near: Near::Metres(10.0),
+        band: 0.5,
+        jitter: 0.3,
+        ..Default::default()
+    };
+    r.set_method(&ctx, Method::Hybrid(h)).unwrap();
+    let before = r.uploads();
+    let (mut both, mut frames) = (0, 0);
+    for (name, cam) in common::cameras(forest.extent()) {
+        r.render_frame(&ctx, &cam, &target).unwrap();
+        frames += 1;
+        let forms = h.forms(&cam, r.coarsest_levels());
+        let mut g = cam.to_gpu();
+        g.forms = forms;
+        // Quads: the CPU reference skips the trees drawn as geometry alone.
+        let cpu = reference::run(&r.stream.scene.tables, &g, r.stream.capacity.quads);
+        assert!(
+            r.stream.read_quads(&ctx) == cpu.quads,
+            "{name}: the GPU stream differs from the reference"
+        );
+        // Geometry: the visible trees whose quad share is below one.
+        let mut near = 0;
+        let t = &r.stream.scene.tables;
+        let planes = g.planes;
+        for i in 0..t.instances.len() {
+            let (d, radius) = tree_distance(&r, &cam, i);
+            let inst = &t.instances[i];
+            let sp = &t.species[inst.species as usize];
+            let c = Vec3::from_slice(&sp.sphere[..3]) * inst.scale;
+            let c = Vec3::new(
+                inst.cos_rot * c.x + inst.sin_rot * c.z,
+                c.y,
+                -inst.sin_rot * c.x + inst.cos_rot * c.z,
+            ) + Vec3::from_array(inst.position);
+            let visible = planes
+                .iter()
+                .all(|p| p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] >= -radius);
+            let share = hybrid::quad_share(forms, d, radius, i as u32);
+            if visible && share < WEIGHT_ONE {
+                near += 1;
+                both += u32::from(share > 0);
+            }
+        }
+        let stats = r.read_stats(&ctx);
+        assert_eq!(stats.geometry_trees, near, "{name}: trees drawn as geometry");
+    }
+    assert!(both > 0, "some trees were in the band");
+    let (n, bytes) = r.uploads();
+    let size = std::mem::size_of::<forest_render::gpu_types::GpuCamera>() as u64;
+    assert_eq!(
+        (n - before.0, bytes - before.1),
+        (2 * frames, 2 * frames * size),
+        "a hybrid frame writes the camera once per form and nothing else"
+    );
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
+#[test]
+fn empty_single_and_million_tree_forests_render_without_errors() {
+    let ctx = common::ctx();
+    let empty = Forest::new(vec!["bush".into(), "pine".into()], Vec::new(), 15);
+    let million = forest_format::generate::generate(&forest_format::generate::GenerateParams {
+        trees: 1_000_000,
+        species: vec!["bush".into(), "pine".into()],
+        area_per_tree: 12.0,
+        seed: 9,
+        ..Default::default()
+    })
+    .unwrap();
+    for (name, forest) in [
+        ("empty", &empty),
+        ("single", &common::one_tree(1, 0.3)),
+        ("million", &million),
+    ] {
+        let mut cam = if name == "single" {
+            common::camera(Vec3::new(0.0, 3.0, 6.0), Vec3::new(0.0, 2.5, 0.0), 1.0)
+        } else {
+            common::cameras(forest.extent().max(10.0)).remove(0).1
+        };
+        cam.far = 40.0;
+        let r = renderer(&ctx, forest, cam.viewport, Background::Transparent);
+        let img = frame(&ctx, &r, Method::Hybrid(Hybrid::default()), &cam);
+        let stats = r.read_stats(&ctx);
+        assert_eq!(ctx.take_errors(), Vec::<String>::new(), "{name}");
+        let covered = img.pixels().filter(|p| p[3] > 0).count();
+        match name {
+            "empty" => assert_eq!(covered, 0),
+            _ => {
+                assert!(covered > 100, "{name}: trees drawn");
+                assert!(stats.geometry_trees > 0, "{name}: near trees as geometry");
+            }
+        }
+        if name == "million" {
+            assert!(
+                stats.per_level.iter().sum::<u32>() > 0,
+                "{name}: far trees as quads"
+            );
+        }
+    }
+}
