@@ -74,12 +74,21 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
     }
     // Every method appears in the accuracy and stability tables.
     let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
-    for m in ["quads", "impostor", "geometry", "stochastic", "lods"] {
+    let stability = std::fs::read_to_string(results.join("stability.csv")).unwrap();
+    for m in ["quads", "impostor", "geometry", "stochastic", "lods", "hybrid"] {
         assert!(
             accuracy.lines().any(|l| l.starts_with(&format!("{m},"))),
             "{m}"
         );
+        assert!(
+            stability.lines().any(|l| l.contains(&format!(",{m},"))),
+            "{m}"
+        );
     }
+    // The walkthrough of random eye-height cameras, and the hybrid's switch choices.
+    assert!(accuracy.lines().any(|l| l.contains(",walkthrough,")));
+    let budget = std::fs::read_to_string(results.join("budget.csv")).unwrap();
+    assert!(budget.lines().any(|l| l.starts_with("hybrid near=auto,")));
     let report = std::fs::read_to_string(results.join("REPORT.md")).unwrap();
     let mut charts = 0;
     for line in report.lines().filter(|l| l.starts_with("![")) {

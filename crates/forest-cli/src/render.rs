@@ -8,6 +8,8 @@ use forest_format::forest::Forest;
 use forest_render::geometry::{
     GeometryRenderer, GeometrySpecies, Lods, MeshMethod, PreparedGeometry, Stochastic,
 };
+use forest_render::hybrid::{Hybrid, Near};
+use forest_render::methods::{ForestRenderer, Method};
 use forest_render::renderer::{AspectBlend, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -54,14 +56,22 @@ pub struct RenderArgs {
 }
 
 /// The `--method` values.
-pub const METHODS: [&str; 5] = ["quads", "impostor", "geometry", "stochastic", "lods"];
+pub const METHODS: [&str; 6] = [
+    "quads",
+    "impostor",
+    "geometry",
+    "stochastic",
+    "lods",
+    "hybrid",
+];
 
 /// The method and its parameters (shared by `forest render` and `forest view`).
 #[derive(clap::Args, Debug, Clone)]
 pub struct MethodArgs {
     /// Rendering method: the quad stream; static impostors (the stream without refinement);
     /// full geometry (the reference and brute-force baseline); stochastic simplification;
-    /// discrete LODs + billboards. The last three need --models.
+    /// discrete LODs + billboards; hybrid (trees nearer than --near as full geometry, the
+    /// rest as the quad stream). The last four need --models.
     #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
     /// OBJ models of the forest's species, in its species order (geometry-based methods).
@@ -97,6 +107,25 @@ pub struct MethodArgs {
     /// projected edge length (the paper's metric).
     #[arg(long)]
     pub depth_error: bool,
+    /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
+    /// geometry; `auto`: where the quad stream runs out of levels, i.e. where a tree's finest
+    /// quads project longer than ε (it follows each tree's size, the view and ε).
+    #[arg(long, default_value = "auto", value_parser = parse_near)]
+    pub near: Near,
+    /// Hybrid: width of the transition band, as a fraction of the switch distance (a tree
+    /// in it is drawn by both forms through complementary screen-door masks).
+    #[arg(long, default_value_t = Hybrid::default().band)]
+    pub band: f32,
+}
+
+fn parse_near(s: &str) -> Result<Near, String> {
+    if s == "auto" {
+        return Ok(Near::Auto);
+    }
+    match s.parse::<f32>() {
+        Ok(m) if m >= 0.0 => Ok(Near::Metres(m)),
+        _ => Err(format!("{s:?}: expected auto or a distance of 0 metres or more")),
+    }
 }
 
 impl MethodArgs {
@@ -108,10 +137,11 @@ impl MethodArgs {
         }
     }
 
-    /// The geometry method `name` names (None for the quad-stream methods).
+    /// The geometry method `name` names (for the hybrid: its near trees' form; None for the
+    /// quad-stream methods).
     pub fn method(&self, name: &str) -> Result<Option<MeshMethod>> {
         let m = match name {
-            "geometry" => MeshMethod::Full {
+            "geometry" | "hybrid" => MeshMethod::Full {
                 depth_sort: !self.unsorted,
             },
             "stochastic" => MeshMethod::Stochastic(Stochastic {
@@ -138,6 +168,26 @@ impl MethodArgs {
 }
 
 impl MethodArgs {
+    /// The method `--method` names, with `mesh` (from [`Self::checked_method`]) for the
+    /// geometry-based ones and the hybrid's near trees.
+    pub fn chosen(&self, mesh: Option<MeshMethod>) -> Result<Method> {
+        Ok(match (self.method.as_str(), mesh) {
+            ("hybrid", Some(near_form)) => {
+                let h = Hybrid {
+                    near: self.near,
+                    band: self.band,
+                    near_form,
+                    ..Default::default()
+                };
+                h.validate()?;
+                Method::Hybrid(h)
+            }
+            (_, Some(x)) => Method::Mesh(x),
+            ("impostor", None) => Method::Impostor,
+            _ => Method::Quads,
+        })
+    }
+
     /// The geometry method chosen (None for the quad-stream methods), requiring one OBJ model
     /// per species for it.
     pub fn checked_method(&self, species: usize) -> Result<Option<MeshMethod>> {
@@ -262,23 +312,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let mesh_method = args.m.checked_method(forest.species.len())?;
     let ctx = GpuContext::headless()?;
+    if let Method::Hybrid(h) = args.m.chosen(mesh_method)? {
+        return render_hybrid(args, h, &ctx, &forest, &species, &cameras);
+    }
     if let Some(m) = mesh_method {
         return render_geometry(args, m, &ctx, &forest, &species, &cameras);
     }
-    let (sw, sh) = (
-        args.size.0 * args.supersample,
-        args.size.1 * args.supersample,
-    );
-    let scene = GpuScene::new(&ctx, &species, &forest)?;
-    let opts = RendererOptions {
-        format: TARGET_FORMAT,
-        min_epsilon: args.epsilon.min(8.0),
-        viewport: (sw, sh),
-        background: background(args),
-        refine: args.m.method != "impostor",
-        ..Default::default()
-    };
-    let stream = QuadStream::new(&ctx, scene, &opts)?;
+    let (sw, sh) = stream_viewport(args);
+    let stream = stream_for(args, &ctx, &species, &forest)?;
     stream.set_options(args.m.stream_options());
     let target = Target::new(&ctx, sw, sh);
     for (name, cam) in &cameras {
@@ -309,6 +350,90 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 stats.per_level,
                 stats.overflow_cull,
                 stats.overflow_refine,
+                t.cull_ms,
+                t.refine_ms,
+                t.draw_ms,
+                ctx.adapter_info.name,
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The viewport rendered (the image size times the supersampling).
+fn stream_viewport(args: &RenderArgs) -> (u32, u32) {
+    (
+        args.size.0 * args.supersample,
+        args.size.1 * args.supersample,
+    )
+}
+
+/// The quad stream of the scene, sized for the rendered viewport and ε.
+fn stream_for(
+    args: &RenderArgs,
+    ctx: &GpuContext,
+    species: &[SpeciesData],
+    forest: &Forest,
+) -> Result<QuadStream> {
+    let scene = GpuScene::new(ctx, species, forest)?;
+    let opts = RendererOptions {
+        format: TARGET_FORMAT,
+        min_epsilon: args.epsilon.min(8.0),
+        viewport: stream_viewport(args),
+        background: background(args),
+        refine: args.m.method != "impostor",
+        ..Default::default()
+    };
+    let stream = QuadStream::new(ctx, scene, &opts)?;
+    stream.set_options(args.m.stream_options());
+    Ok(stream)
+}
+
+/// The hybrid: near trees as full geometry, the rest as the quad stream.
+fn render_hybrid(
+    args: &RenderArgs,
+    hybrid: Hybrid,
+    ctx: &GpuContext,
+    forest: &Forest,
+    species: &[SpeciesData],
+    cameras: &[(String, Camera)],
+) -> Result<()> {
+    let prepared = prepare_models(&args.m.models, species)?;
+    let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
+    let r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
+    r.set_method(ctx, Method::Hybrid(hybrid))?;
+    let (sw, sh) = stream_viewport(args);
+    let target = Target::new(ctx, sw, sh);
+    for (name, cam) in cameras {
+        let mut cam = *cam;
+        cam.viewport = (sw, sh);
+        r.render_frame(ctx, &cam, &target)?;
+        let stats = r.read_stats(ctx);
+        let out = finish_view(ctx, &target, args, name, cameras.len())?;
+        let t = stats.times.unwrap_or_default();
+        let quads: u32 = stats.per_level.iter().sum();
+        if args.json {
+            println!(
+                "{}",
+                serde_json::json!({
+                    "view": name, "output": out.display().to_string(),
+                    "adapter": ctx.adapter_info.name, "method": "hybrid",
+                    "visible_trees": stats.visible_trees,
+                    "geometry_trees": stats.geometry_trees, "quads": quads,
+                    "triangles": stats.primitives - u64::from(quads),
+                    "overflow": stats.overflow,
+                    "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+                })
+            );
+        } else {
+            println!(
+                "{name}: hybrid: {} visible trees, {} as geometry, {} quads + {} triangles, overflow {}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms ({}) -> {}",
+                stats.visible_trees,
+                stats.geometry_trees,
+                quads,
+                stats.primitives - u64::from(quads),
+                stats.overflow,
                 t.cull_ms,
                 t.refine_ms,
                 t.draw_ms,

@@ -9,8 +9,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
-use forest_render::geometry::{GeometryRenderer, MeshMethod, PreparedGeometry};
-use forest_render::methods::{ForestRenderer, Method};
+use forest_render::geometry::{GeometryRenderer, PreparedGeometry};
+use forest_render::methods::ForestRenderer;
 use forest_render::renderer::{Background, DebugView, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -100,15 +100,6 @@ fn geometry(
     )?)
 }
 
-/// The method `--method` names, with the parameters of `mesh` for the geometry-based ones.
-fn chosen_method(m: &MethodArgs, mesh: Option<MeshMethod>) -> Method {
-    match (mesh, m.method.as_str()) {
-        (Some(x), _) => Method::Mesh(x),
-        (None, "impostor") => Method::Impostor,
-        _ => Method::Quads,
-    }
-}
-
 /// Far plane (metres): beyond the farthest tree from anywhere in the forest.
 fn far_plane(forest: &Forest) -> f32 {
     (forest.extent() * 3.0 + 100.0).max(1000.0)
@@ -178,7 +169,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     );
     r.stream.set_debug_view(args.debug_view);
     r.stream.set_options(args_models.stream_options());
-    let method = chosen_method(&args_models, mesh_method);
+    let method = args_models.chosen(mesh_method)?;
     r.set_method(&ctx, method)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
     let far = far_plane(&forest);
@@ -226,11 +217,9 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
     };
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
     let far = far_plane(&forest);
-    let methods = crate::window::offered(mesh_method, prepared.is_some());
-    let start = methods
-        .iter()
-        .position(|x| *x == chosen_method(m, mesh_method))
-        .unwrap_or(0);
+    let chosen = m.chosen(mesh_method)?;
+    let methods = crate::window::offered(chosen, prepared.is_some());
+    let start = methods.iter().position(|x| *x == chosen).unwrap_or(0);
     let (size, epsilon) = (args.size, args.epsilon);
     // Both builders hold the forest: the stream's is called again when it must grow.
     let forest = Rc::new(forest);

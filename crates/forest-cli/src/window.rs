@@ -3,7 +3,7 @@
 //! method switch, debug views).
 //!
 //! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
-//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–5 pick a method, [ and
+//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–6 pick a method, [ and
 //! ] halve and double ε, V cycles the debug views, H hides the HUD, F12 saves a screenshot, R
 //! starts and stops recording a camera path, P plays the `--path` back, Esc quits.
 //!
@@ -40,7 +40,7 @@ pub const EPSILON_RANGE: (f32, f32) = (0.5, 64.0);
 /// The key list shown on screen.
 pub const KEYS: [&str; 3] = [
     "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
-    "F: walk/fly · 1-5: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
+    "F: walk/fly · 1-6: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
     "F12: screenshot · R: record path · P: play --path · Esc: quit",
 ];
 
@@ -394,11 +394,23 @@ impl Viewer {
                     )),
                     None => ui.label("GPU pass times: no timestamp queries on this adapter"),
                 };
-                let unit = if mesh { "triangles" } else { "quads" };
-                ui.label(format!(
-                    "{} visible trees, {} {unit}, {} billboards, overflow {}",
-                    s.visible_trees, s.primitives, s.billboards, s.overflow
-                ));
+                if matches!(self.methods[self.method], Method::Hybrid(_)) {
+                    let quads: u32 = s.per_level.iter().sum();
+                    ui.label(format!(
+                        "{} visible trees, {} as geometry, {quads} quads + {} triangles, \
+                         overflow {}",
+                        s.visible_trees,
+                        s.geometry_trees,
+                        s.primitives - u64::from(quads),
+                        s.overflow
+                    ));
+                } else {
+                    let unit = if mesh { "triangles" } else { "quads" };
+                    ui.label(format!(
+                        "{} visible trees, {} {unit}, {} billboards, overflow {}",
+                        s.visible_trees, s.primitives, s.billboards, s.overflow
+                    ));
+                }
                 if !s.per_level.is_empty() {
                     let levels: Vec<String> = s
                         .per_level
@@ -691,6 +703,7 @@ impl Viewer {
             KeyCode::Digit3 => self.set_method(2)?,
             KeyCode::Digit4 => self.set_method(3)?,
             KeyCode::Digit5 => self.set_method(4)?,
+            KeyCode::Digit6 => self.set_method(5)?,
             KeyCode::F12 => {
                 // A failed screenshot is reported in the HUD and on stderr; the walk goes on.
                 if let Err(e) = self.screenshot() {
@@ -840,11 +853,16 @@ impl ApplicationHandler for Viewer {
     }
 }
 
-/// The methods a viewer offers, in a fixed order (keys 1–5): quads, impostor, and with models
-/// LODs, stochastic, geometry, the kind named on the command line (`mesh`) with its parameters.
-pub fn offered(mesh: Option<MeshMethod>, geometry: bool) -> Vec<Method> {
+/// The methods a viewer offers, in a fixed order (keys 1–6): quads, impostor, and with models
+/// LODs, stochastic, geometry, hybrid; the kind named on the command line (`chosen`) with its
+/// parameters.
+pub fn offered(chosen: Method, geometry: bool) -> Vec<Method> {
     let mut m = vec![Method::Quads, Method::Impostor];
     if geometry {
+        let mesh = match chosen {
+            Method::Mesh(x) => Some(x),
+            _ => None,
+        };
         for default in [
             MeshMethod::Lods(Default::default()),
             MeshMethod::Stochastic(Default::default()),
@@ -854,6 +872,10 @@ pub fn offered(mesh: Option<MeshMethod>, geometry: bool) -> Vec<Method> {
                 |x: &MeshMethod| std::mem::discriminant(x) == std::mem::discriminant(&default);
             m.push(Method::Mesh(mesh.filter(same_kind).unwrap_or(default)));
         }
+        m.push(match chosen {
+            Method::Hybrid(h) => Method::Hybrid(h),
+            _ => Method::Hybrid(Default::default()),
+        });
     }
     m
 }
@@ -928,19 +950,27 @@ mod tests {
 
     #[test]
     fn offered_methods_keep_their_order_with_the_named_parameters() {
-        assert_eq!(offered(None, false), vec![Method::Quads, Method::Impostor]);
+        assert_eq!(
+            offered(Method::Quads, false),
+            vec![Method::Quads, Method::Impostor]
+        );
         let names = |m: &[Method]| m.iter().map(|x| x.name()).collect::<Vec<_>>();
-        let all = offered(None, true);
+        let all = offered(Method::Quads, true);
         assert_eq!(
             names(&all),
-            ["quads", "impostor", "lods", "stochastic", "geometry"]
+            ["quads", "impostor", "lods", "stochastic", "geometry", "hybrid"]
         );
-        let unsorted = offered(Some(MeshMethod::Full { depth_sort: false }), true);
+        let unsorted = offered(Method::Mesh(MeshMethod::Full { depth_sort: false }), true);
         assert_eq!(names(&unsorted)[4], "geometry-unsorted");
-        assert_eq!(unsorted.len(), 5);
+        assert_eq!(unsorted.len(), 6);
         let lods = MeshMethod::Lods(forest_render::geometry::Lods {
             distances: [1.0, 2.0, 3.0],
         });
-        assert_eq!(offered(Some(lods), true)[2], Method::Mesh(lods));
+        assert_eq!(offered(Method::Mesh(lods), true)[2], Method::Mesh(lods));
+        let near = Method::Hybrid(forest_render::hybrid::Hybrid {
+            near: forest_render::hybrid::Near::Metres(7.0),
+            ..Default::default()
+        });
+        assert_eq!(offered(near, true)[5], near);
     }
 }

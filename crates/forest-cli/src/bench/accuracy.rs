@@ -1,11 +1,14 @@
 //! Speed against accuracy: every setting of every method, mean FLIP against the 4×4
 //! supersampled full-geometry reference versus GPU frame time, with each method's Pareto front,
-//! at a close-up, a mid-range and a bird's-eye view.
+//! at a close-up, a mid-range and a bird's-eye view, and over a walkthrough of seeded random
+//! eye-height cameras inside the forest.
 
 use anyhow::Result;
 use forest_format::forest::Forest;
 use forest_render::Camera;
+use forest_format::generate::SplitMix64;
 use forest_render::geometry::{Lods, MeshMethod, Stochastic, downsample};
+use forest_render::hybrid::{Hybrid, Near};
 use forest_render::methods::{ForestRenderer, Method};
 use forest_render::renderer::Background;
 use forest_render::target::Target;
@@ -87,6 +90,39 @@ pub fn views(
     ]
 }
 
+/// Seed of the walkthrough cameras.
+pub const WALK_SEED: u64 = 0x3a1f_2c77;
+
+/// `n` seeded random eye-height cameras inside the forest, as a walkthrough meets them: eyes
+/// 1.7 m up anywhere in the inner half of the forest (inside crowns too: none is rejected),
+/// any heading, pitched −10°…+30°.
+pub fn walkthrough(side: f32, viewport: (u32, u32), n: usize) -> Vec<Camera> {
+    let mut rng = SplitMix64(WALK_SEED);
+    (0..n)
+        .map(|_| {
+            let x = (rng.next_f32() - 0.5) * side * 0.5;
+            let z = (rng.next_f32() - 0.5) * side * 0.5;
+            let heading = rng.next_f32() * std::f32::consts::TAU;
+            let pitch = (-10.0 + 40.0 * rng.next_f32()).to_radians();
+            let eye = Vec3::new(x, 1.7, z);
+            let dir = Vec3::new(
+                heading.cos() * pitch.cos(),
+                pitch.sin(),
+                heading.sin() * pitch.cos(),
+            );
+            Camera {
+                eye,
+                target: eye + dir * 10.0,
+                fov_y_deg: 60.0,
+                near: 0.1,
+                far: side * 3.0,
+                viewport,
+                epsilon: 16.0,
+            }
+        })
+        .collect()
+}
+
 /// The 4×4 supersampled full-geometry reference of `cam`, downsampled.
 pub fn reference(b: &Bench, r: &ForestRenderer, cam: &Camera) -> Result<image::RgbaImage> {
     let (w, h) = cam.viewport;
@@ -141,6 +177,20 @@ pub fn settings(quick: bool) -> Vec<(Method, String)> {
             format!("d0={d0} h={h}"),
         ));
     }
+    for &e in eps {
+        s.push((Method::Hybrid(Hybrid::default()), format!("eps={e} near=auto")));
+    }
+    if !quick {
+        for near in [5.0, 10.0, 20.0] {
+            s.push((
+                Method::Hybrid(Hybrid {
+                    near: Near::Metres(near),
+                    ..Default::default()
+                }),
+                format!("eps=4 near={near}"),
+            ));
+        }
+    }
     let lod: &[f32] = if quick {
         &[1.0]
     } else {
@@ -160,7 +210,7 @@ pub fn settings(quick: bool) -> Vec<(Method, String)> {
 fn epsilon_of(param: &str) -> f32 {
     param
         .strip_prefix("eps=")
-        .and_then(|e| e.parse().ok())
+        .and_then(|e| e.split(' ').next()?.parse().ok())
         .unwrap_or(16.0)
 }
 
@@ -182,36 +232,59 @@ pub fn run(b: &Bench) -> Result<Section> {
     ]);
     let mut charts = Vec::new();
     let mut summary = Vec::new();
-    for (view, cam) in views(&forest, side, viewport, b.clearance()) {
-        let reference = reference(b, &r, &cam)?;
+    let walk = if b.quick { 2 } else { 6 };
+    let mut groups: Vec<(&str, Vec<Camera>)> = views(&forest, side, viewport, b.clearance())
+        .into_iter()
+        .map(|(v, c)| (v, vec![c]))
+        .collect();
+    groups.push(("walkthrough", walkthrough(side, viewport, walk)));
+    let mut walk_means: Vec<(String, f64, f64)> = Vec::new();
+    for (view, cams) in groups {
+        let references = cams
+            .iter()
+            .map(|c| reference(b, &r, c))
+            .collect::<Result<Vec<_>>>()?;
         let mut series: Vec<Series> = Vec::new();
         for (method, param) in settings(b.quick) {
-            let mut c = cam;
-            c.epsilon = epsilon_of(&param);
-            let (s, frame_ms) = b.measure(&r, method, &c, &target, b.frames_for(method))?;
-            let m = forest_metrics::compare(&reference, &target.read(&b.ctx))?;
+            // Means over the view's cameras (one, or the walkthrough's).
+            let (mut frame_ms, mut flip, mut ssim, mut psnr, mut prims) = (0.0, 0.0, 0.0, 0.0, 0);
+            for (cam, reference) in cams.iter().zip(&references) {
+                let mut c = *cam;
+                c.epsilon = epsilon_of(&param);
+                let (s, t) = b.measure(&r, method, &c, &target, b.frames_for(method))?;
+                let m = forest_metrics::compare(reference, &target.read(&b.ctx))?;
+                frame_ms += t;
+                flip += f64::from(m.flip_mean);
+                ssim += m.ssim;
+                psnr += m.psnr;
+                prims += s.primitives;
+            }
+            let n = cams.len().max(1) as f64;
+            let (frame_ms, flip) = (frame_ms / n, flip / n);
             println!(
-                "{view} {} {param}: {frame_ms:.2} ms, FLIP {:.4}, {} primitives",
+                "{view} {} {param}: {frame_ms:.2} ms, FLIP {flip:.4}, {} primitives",
                 method.name(),
-                m.flip_mean,
-                s.primitives
+                prims / cams.len().max(1) as u64
             );
             table.push(vec![
                 method.name().into(),
                 param.clone(),
                 view.into(),
                 ms(frame_ms),
-                format!("{:.5}", m.flip_mean),
-                format!("{:.4}", m.ssim),
-                format!("{:.2}", m.psnr),
-                s.primitives.to_string(),
+                format!("{flip:.5}"),
+                format!("{:.4}", ssim / n),
+                format!("{:.2}", psnr / n),
+                (prims / cams.len().max(1) as u64).to_string(),
             ]);
+            if view == "walkthrough" {
+                walk_means.push((format!("{} {param}", method.name()), frame_ms, flip));
+            }
             let name = method.name();
             match series.iter_mut().find(|x| x.name == name) {
-                Some(x) => x.points.push((frame_ms, f64::from(m.flip_mean))),
+                Some(x) => x.points.push((frame_ms, flip)),
                 None => series.push(Series {
                     name: name.into(),
-                    points: vec![(frame_ms, f64::from(m.flip_mean))],
+                    points: vec![(frame_ms, flip)],
                     front: true,
                     ..Default::default()
                 }),
@@ -252,6 +325,22 @@ pub fn run(b: &Bench) -> Result<Section> {
         charts.push(stem);
     }
     b.write("accuracy.csv", &table.csv())?;
+    // The hybrid against the quad stream in the walkthrough, at the same ε.
+    let walk_ratio = walk_means
+        .iter()
+        .filter_map(|(name, t, f)| {
+            let rest = name.strip_prefix("hybrid ")?;
+            let eps = rest.split(' ').next()?;
+            let (_, tq, fq) = walk_means
+                .iter()
+                .find(|(n, _, _)| n == &format!("quads {eps}"))?;
+            Some(format!(
+                "{eps}: {:.2}× the quad stream's frame time, FLIP {f:.4} against {fq:.4}",
+                t / tq
+            ))
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
     let text = format!(
         "{trees} trees over {side:.0} m, {}x{}, transparent background (trees only). The \
          reference is full geometry supersampled 4×4; every other image is compared with it \
@@ -259,7 +348,11 @@ pub fn run(b: &Bench) -> Result<Section> {
          and h, the discrete LODs their switch distances (×¼ to ×2 of 15/40/100 m); impostors \
          and full geometry at 1× are single points. Lines are each method's Pareto front \
          (nothing both faster and more accurate). On a CPU rasteriser full geometry and \
-         stochastic simplification are timed over one frame.\n\n{}",
+         stochastic simplification are timed over one frame. The hybrid draws trees nearer \
+         than its switch distance as full geometry and the rest as the quad stream (`near=auto`: \
+         where a tree's finest quads project longer than ε). The walkthrough view is the mean \
+         over {walk} seeded random eye-height cameras inside the forest (seed {WALK_SEED:#x}; \
+         none rejected). Hybrid in the walkthrough, with its automatic switch: {walk_ratio}.\n\n{}",
         viewport.0,
         viewport.1,
         summary

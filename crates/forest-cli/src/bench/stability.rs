@@ -133,6 +133,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         Method::Mesh(MeshMethod::Full { depth_sort: true }),
         Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
         Method::Mesh(MeshMethod::Lods(Default::default())),
+        Method::Hybrid(forest_render::hybrid::Hybrid::default()),
     ];
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&["case", "method", "flip_mean", "flicker", "pops", "frame_ms"]);
@@ -237,14 +238,17 @@ pub fn run(b: &Bench) -> Result<Section> {
          4×4 supersampled reference per frame; `flicker` is the method's mean frame-to-frame \
          FLIP minus the reference's over the same move (above 0: changes the reference does \
          not have); `pops` counts frames whose change exceeds the reference's by more than \
-         {POP_MARGIN}. Worst case per method: quad stream {}; impostors {}; stochastic {}; \
-         LODs {}.",
+         {POP_MARGIN}. The hybrid (near trees as full geometry, switch where a tree's finest \
+         quads project longer than ε, a dithered band jittered per tree) must add no pops at \
+         its switch. Worst case per method: quad stream {}; impostors {}; stochastic {}; LODs \
+         {}; hybrid {}.",
         viewport.0,
         viewport.1,
         worst("quads"),
         worst("impostor"),
         worst("stochastic"),
         worst("lods"),
+        worst("hybrid"),
     );
     Ok(Section {
         title: "Stability: where methods fail".into(),
