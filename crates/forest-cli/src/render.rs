@@ -109,7 +109,8 @@ pub struct MethodArgs {
     pub depth_error: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
     /// geometry; `auto`: where the quad stream runs out of levels, i.e. where a tree's finest
-    /// quads project longer than ε (it follows each tree's size, the view and ε).
+    /// quads project longer than ε (at least 1.5 px; it follows each tree's size, the view
+    /// and ε).
     #[arg(long, default_value = "auto", value_parser = parse_near)]
     pub near: Near,
     /// Hybrid: width of the transition band, as a fraction of the switch distance (a tree
