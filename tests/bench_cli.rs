@@ -75,7 +75,14 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
     // Every method appears in the accuracy and stability tables.
     let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
     let stability = std::fs::read_to_string(results.join("stability.csv")).unwrap();
-    for m in ["quads", "impostor", "geometry", "stochastic", "lods", "hybrid"] {
+    for m in [
+        "quads",
+        "impostor",
+        "geometry",
+        "stochastic",
+        "lods",
+        "hybrid",
+    ] {
         assert!(
             accuracy.lines().any(|l| l.starts_with(&format!("{m},"))),
             "{m}"

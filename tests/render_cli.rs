@@ -91,6 +91,42 @@ fn bake_scene_render_end_to_end() {
         "64x48",
     ]));
     assert!(d.join("small.png").is_file());
+    // The hybrid: near trees as geometry (a fixed switch distance), the rest as quads.
+    let text = ok(&forest(&[
+        "render",
+        &p("small.json"),
+        "-o",
+        &p("hybrid.png"),
+        "--eye",
+        "0,2,30",
+        "--target",
+        "0,2,0",
+        "--size",
+        "64x48",
+        "--method",
+        "hybrid",
+        "--near",
+        "1000",
+        "--json",
+        "--models",
+        &format!("{},{}", model("bush"), model("aspen")),
+    ]));
+    let v: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    assert_eq!(v["method"], "hybrid");
+    assert!(v["geometry_trees"].as_u64().unwrap() > 0, "{v}");
+    assert_eq!(v["quads"], 0, "every tree nearer than 1 km: {v}");
+    let e = err(&forest(&[
+        "render",
+        &p("small.json"),
+        "-o",
+        &p("x.png"),
+        "--view",
+        "inside",
+        "--method",
+        "hybrid",
+        "--near=-3",
+    ]));
+    assert!(e.contains("auto or a distance"), "{e}");
 
     // `forest view` plays a camera path back headless, one PNG per key, with any method.
     let walk = d.join("walk.json");

@@ -125,7 +125,9 @@ fn parse_near(s: &str) -> Result<Near, String> {
     }
     match s.parse::<f32>() {
         Ok(m) if m >= 0.0 => Ok(Near::Metres(m)),
-        _ => Err(format!("{s:?}: expected auto or a distance of 0 metres or more")),
+        _ => Err(format!(
+            "{s:?}: expected auto or a distance of 0 metres or more"
+        )),
     }
 }
 

@@ -958,7 +958,14 @@ mod tests {
         let all = offered(Method::Quads, true);
         assert_eq!(
             names(&all),
-            ["quads", "impostor", "lods", "stochastic", "geometry", "hybrid"]
+            [
+                "quads",
+                "impostor",
+                "lods",
+                "stochastic",
+                "geometry",
+                "hybrid"
+            ]
         );
         let unsorted = offered(Method::Mesh(MeshMethod::Full { depth_sort: false }), true);
         assert_eq!(names(&unsorted)[4], "geometry-unsorted");

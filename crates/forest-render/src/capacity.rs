@@ -1,4 +1,6 @@
-//! The one place that sizes every GPU buffer of the runtime.
+//! The one place that sizes every GPU buffer of the runtime: the quad stream's ([`Capacity`])
+//! and the geometry renderer's per-frame lists ([`GeometryCapacity`]), which the hybrid uses
+//! side by side.
 
 use crate::gpu_types::{GpuArgs, GpuState, Quad};
 
@@ -71,6 +73,34 @@ impl Capacity {
     }
 }
 
+/// The geometry renderer's per-frame buffers, in elements. Every tree can be drawn as
+/// geometry at once (the hybrid's near trees are a subset), so the lists hold every instance
+/// and nothing can overflow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GeometryCapacity {
+    /// Draw segments: distance bands × species (at least 1).
+    pub segments: u32,
+    /// Elements of the classification-key and visible-instance lists: every instance (at
+    /// least 1, so that empty forests still bind a buffer).
+    pub instances: u32,
+}
+
+impl GeometryCapacity {
+    /// Sizes for `instances` trees of `species` species drawn in `bands` distance bands.
+    pub fn new(instances: u32, species: u32, bands: u32) -> Self {
+        Self {
+            segments: (bands * species).max(1),
+            instances: instances.max(1),
+        }
+    }
+
+    /// Bytes of the per-frame buffers: keys and visible list (4 bytes per instance), counts
+    /// and cursors (4 bytes per segment), indirect draw arguments (16 bytes per segment).
+    pub fn bytes(&self) -> u64 {
+        2 * u64::from(self.instances) * 4 + u64::from(self.segments) * (4 + 4 + 16)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -101,5 +131,9 @@ mod tests {
             }
         });
         assert_eq!((fixed.quads, fixed.items), (10, 10));
+        let g = GeometryCapacity::new(1000, 2, 12);
+        assert_eq!((g.segments, g.instances), (24, 1000));
+        assert_eq!(g.bytes(), 8000 + 24 * 24);
+        assert_eq!(GeometryCapacity::new(0, 0, 12).segments, 1);
     }
 }

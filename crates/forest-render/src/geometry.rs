@@ -635,7 +635,12 @@ impl GeometryRenderer {
             ground: l.ground.extend(0.0).to_array(),
         };
         let instances = crate::scene::gpu_instances(forest);
-        let segments = (BANDS as usize * geo_species.len()).max(1);
+        let cap = crate::capacity::GeometryCapacity::new(
+            instances.len() as u32,
+            geo_species.len() as u32,
+            BANDS,
+        );
+        let (segments, listed) = (cap.segments as usize, cap.instances as usize);
         let gpu_bytes = Cell::new(0u64);
         use wgpu::BufferUsages as U;
         let init = |label: &str, bytes: &[u8], usage: U| {
@@ -693,10 +698,10 @@ impl GeometryRenderer {
             bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
             U::UNIFORM,
         );
-        let keys = zeros("segment keys", instances.len().max(1) * 4, U::STORAGE);
+        let keys = zeros("segment keys", listed * 4, U::STORAGE);
         let counts = zeros("segment counts", segments * 4, U::STORAGE | U::COPY_SRC);
         let cursor = zeros("segment cursors", segments * 4, U::STORAGE);
-        let visible = zeros("visible instances", instances.len().max(1) * 4, U::STORAGE);
+        let visible = zeros("visible instances", listed * 4, U::STORAGE);
         let args = zeros(
             "geometry draw args",
             segments * 16,
@@ -974,7 +979,8 @@ impl GeometryRenderer {
         camera.validate()?;
         let mut g = camera.to_gpu();
         g.forms = self.forms.get();
-        ctx.queue.write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
+        ctx.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
         let (n, bytes) = self.writes.get();
         self.writes
             .set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));

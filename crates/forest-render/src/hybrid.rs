@@ -79,7 +79,7 @@ impl Hybrid {
     /// Check the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), RenderError> {
         if let Near::Metres(m) = self.near
-            && !(m >= 0.0)
+            && (m.is_nan() || m < 0.0)
         {
             return Err(RenderError::Scene(format!(
                 "the hybrid's switch distance {m} m must be 0 or more"
@@ -148,7 +148,11 @@ pub fn quad_share(forms: [f32; 4], distance: f32, radius: f32, instance: u32) ->
 pub fn dither_threshold(x: u32, y: u32, instance: u32) -> u32 {
     let (x, y) = (x & 7, y & 7);
     let xy = x ^ y;
-    let b = ((xy & 1) << 5) | ((y & 1) << 4) | ((xy & 2) << 2) | ((y & 2) << 1) | ((xy & 4) >> 1)
+    let b = ((xy & 1) << 5)
+        | ((y & 1) << 4)
+        | ((xy & 2) << 2)
+        | ((y & 2) << 1)
+        | ((xy & 4) >> 1)
         | ((y & 4) >> 2);
     let u = ((b as f32 + 0.5) / 64.0 + instance_hash(instance)).fract();
     ((u * WEIGHT_ONE as f32) as u32).min(WEIGHT_ONE - 1)

@@ -117,7 +117,11 @@ impl ForestRenderer {
     /// what [`Hybrid::forms`] needs for its automatic switch distance.
     pub fn coarsest_levels(&self) -> u32 {
         let t = &self.stream.scene.tables;
-        t.species.iter().map(|s| s.levels).min().unwrap_or(t.max_levels)
+        t.species
+            .iter()
+            .map(|s| s.levels)
+            .min()
+            .unwrap_or(t.max_levels)
     }
 
     /// Write the camera and record one frame of the current method.

@@ -171,7 +171,10 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
         }
         let f = from_quads as f32 / differ as f32;
         let want = share as f32 / WEIGHT_ONE as f32;
-        assert!((f - want).abs() < 0.1, "quads draw {f} of the tree, want {want}");
+        assert!(
+            (f - want).abs() < 0.1,
+            "quads draw {f} of the tree, want {want}"
+        );
     }
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
@@ -227,7 +230,10 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
             }
         }
         let stats = r.read_stats(&ctx);
-        assert_eq!(stats.geometry_trees, near, "{name}: trees drawn as geometry");
+        assert_eq!(
+            stats.geometry_trees, near,
+            "{name}: trees drawn as geometry"
+        );
     }
     assert!(both > 0, "some trees were in the band");
     let (n, bytes) = r.uploads();

@@ -3,10 +3,10 @@
 //! at a close-up, a mid-range and a bird's-eye view, and over a walkthrough of seeded random
 //! eye-height cameras inside the forest.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use forest_format::forest::Forest;
-use forest_render::Camera;
 use forest_format::generate::SplitMix64;
+use forest_render::Camera;
 use forest_render::geometry::{Lods, MeshMethod, Stochastic, downsample};
 use forest_render::hybrid::{Hybrid, Near};
 use forest_render::methods::{ForestRenderer, Method};
@@ -178,7 +178,10 @@ pub fn settings(quick: bool) -> Vec<(Method, String)> {
         ));
     }
     for &e in eps {
-        s.push((Method::Hybrid(Hybrid::default()), format!("eps={e} near=auto")));
+        s.push((
+            Method::Hybrid(Hybrid::default()),
+            format!("eps={e} near=auto"),
+        ));
     }
     if !quick {
         for near in [5.0, 10.0, 20.0] {
@@ -230,21 +233,17 @@ pub fn run(b: &Bench) -> Result<Section> {
         "psnr",
         "primitives",
     ]);
-    let mut charts = Vec::new();
-    let mut summary = Vec::new();
-    let walk = if b.quick { 2 } else { 6 };
+    let walk = walk_cameras(b.quick);
     let mut groups: Vec<(&str, Vec<Camera>)> = views(&forest, side, viewport, b.clearance())
         .into_iter()
         .map(|(v, c)| (v, vec![c]))
         .collect();
     groups.push(("walkthrough", walkthrough(side, viewport, walk)));
-    let mut walk_means: Vec<(String, f64, f64)> = Vec::new();
     for (view, cams) in groups {
         let references = cams
             .iter()
             .map(|c| reference(b, &r, c))
             .collect::<Result<Vec<_>>>()?;
-        let mut series: Vec<Series> = Vec::new();
         for (method, param) in settings(b.quick) {
             // Means over the view's cameras (one, or the walkthrough's).
             let (mut frame_ms, mut flip, mut ssim, mut psnr, mut prims) = (0.0, 0.0, 0.0, 0.0, 0);
@@ -276,15 +275,40 @@ pub fn run(b: &Bench) -> Result<Section> {
                 format!("{:.2}", psnr / n),
                 (prims / cams.len().max(1) as u64).to_string(),
             ]);
-            if view == "walkthrough" {
-                walk_means.push((format!("{} {param}", method.name()), frame_ms, flip));
-            }
-            let name = method.name();
-            match series.iter_mut().find(|x| x.name == name) {
-                Some(x) => x.points.push((frame_ms, flip)),
+        }
+    }
+    b.write("accuracy.csv", &table.csv())?;
+    report(b, table)
+}
+
+/// Cameras of the walkthrough view.
+fn walk_cameras(quick: bool) -> usize {
+    if quick { 2 } else { 6 }
+}
+
+/// Charts, readings and text of the suite from its table (as measured, or as read back from
+/// `accuracy.csv` by [`redraw`]).
+pub fn report(b: &Bench, table: Table) -> Result<Section> {
+    let (trees, side, viewport) = scene(b);
+    let walk = walk_cameras(b.quick);
+    let cell = |row: &[String], k: usize| row[k].parse::<f64>().unwrap_or(f64::NAN);
+    let mut view_names: Vec<String> = Vec::new();
+    for row in &table.rows {
+        if !view_names.contains(&row[2]) {
+            view_names.push(row[2].clone());
+        }
+    }
+    let mut charts = Vec::new();
+    let mut summary = Vec::new();
+    for view in &view_names {
+        let mut series: Vec<Series> = Vec::new();
+        for row in table.rows.iter().filter(|r| &r[2] == view) {
+            let point = (cell(row, 3), cell(row, 4));
+            match series.iter_mut().find(|x| x.name == row[0]) {
+                Some(x) => x.points.push(point),
                 None => series.push(Series {
-                    name: name.into(),
-                    points: vec![(frame_ms, flip)],
+                    name: row[0].clone(),
+                    points: vec![point],
                     front: true,
                     ..Default::default()
                 }),
@@ -324,19 +348,23 @@ pub fn run(b: &Bench) -> Result<Section> {
         )?;
         charts.push(stem);
     }
-    b.write("accuracy.csv", &table.csv())?;
     // The hybrid against the quad stream in the walkthrough, at the same ε.
-    let walk_ratio = walk_means
+    let walk_rows: Vec<&Vec<String>> = table
+        .rows
         .iter()
-        .filter_map(|(name, t, f)| {
-            let rest = name.strip_prefix("hybrid ")?;
-            let eps = rest.split(' ').next()?;
-            let (_, tq, fq) = walk_means
-                .iter()
-                .find(|(n, _, _)| n == &format!("quads {eps}"))?;
+        .filter(|r| r[2] == "walkthrough")
+        .collect();
+    let walk_ratio = walk_rows
+        .iter()
+        .filter(|r| r[0] == "hybrid" && r[1].ends_with("near=auto"))
+        .filter_map(|h| {
+            let eps = h[1].split(' ').next()?;
+            let q = walk_rows.iter().find(|r| r[0] == "quads" && r[1] == eps)?;
             Some(format!(
-                "{eps}: {:.2}× the quad stream's frame time, FLIP {f:.4} against {fq:.4}",
-                t / tq
+                "{eps}: {:.2}× the quad stream's frame time, FLIP {:.4} against {:.4}",
+                cell(h, 3) / cell(q, 3),
+                cell(h, 4),
+                cell(q, 4)
             ))
         })
         .collect::<Vec<_>>()
@@ -350,9 +378,10 @@ pub fn run(b: &Bench) -> Result<Section> {
          (nothing both faster and more accurate). On a CPU rasteriser full geometry and \
          stochastic simplification are timed over one frame. The hybrid draws trees nearer \
          than its switch distance as full geometry and the rest as the quad stream (`near=auto`: \
-         where a tree's finest quads project longer than ε). The walkthrough view is the mean \
-         over {walk} seeded random eye-height cameras inside the forest (seed {WALK_SEED:#x}; \
-         none rejected). Hybrid in the walkthrough, with its automatic switch: {walk_ratio}.\n\n{}",
+         where a tree's finest quads project longer than ε, at least 1.5 px). The walkthrough \
+         view is the mean over {walk} seeded random eye-height cameras inside the forest (seed \
+         {WALK_SEED:#x}; none rejected). Hybrid in the walkthrough, with its automatic switch: \
+         {walk_ratio}.\n\n{}",
         viewport.0,
         viewport.1,
         summary
@@ -367,4 +396,35 @@ pub fn run(b: &Bench) -> Result<Section> {
         table,
         charts,
     })
+}
+
+/// Rebuild the charts and the report section from `accuracy.csv` in the results folder,
+/// without measuring (after a change to how results are drawn).
+pub fn redraw(b: &Bench) -> Result<Section> {
+    let path = b.out.join("accuracy.csv");
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("reading {} (run the accuracy suite first)", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let mut table = Table::new(&[
+        "method",
+        "param",
+        "view",
+        "frame_ms",
+        "flip_mean",
+        "ssim",
+        "psnr",
+        "primitives",
+    ]);
+    if header != table.header {
+        anyhow::bail!("{}: unexpected columns {header:?}", path.display());
+    }
+    for l in lines.filter(|l| !l.is_empty()) {
+        let row: Vec<String> = l.split(',').map(str::to_string).collect();
+        if row.len() != table.header.len() {
+            anyhow::bail!("{}: a row with {} cells: {l}", path.display(), row.len());
+        }
+        table.push(row);
+    }
+    report(b, table)
 }

@@ -187,11 +187,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             .unwrap_or(0)
     };
     let atlas_disk: u64 = b.species_paths.iter().map(|p| folder_bytes(p)).sum();
-    let atlas_gpu: u64 = b
-        .species
-        .iter()
-        .map(|s| s.atlas.manifest.gpu_bytes())
-        .sum();
+    let atlas_gpu: u64 = b.species.iter().map(|s| s.atlas.manifest.gpu_bytes()).sum();
     let model_disk: u64 = b
         .models
         .iter()

@@ -92,6 +92,7 @@ fn colour_of(name: &str, k: usize) -> (u8, u8, u8) {
         "geometry" | "geometry-unsorted" => PALETTE[2],
         "stochastic" => PALETTE[3],
         "lods" => PALETTE[4],
+        "hybrid" => PALETTE[5],
         _ => PALETTE[k % PALETTE.len()],
     }
 }

@@ -61,6 +61,10 @@ pub struct BenchArgs {
     /// suites run; the figures mean little).
     #[arg(long)]
     pub quick: bool,
+    /// Accuracy suite: redraw its charts and report section from the `accuracy.csv` already
+    /// in the results folder, measuring nothing.
+    #[arg(long)]
+    pub redraw: bool,
     /// Frames measured per setting (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub frames: u32,
@@ -388,6 +392,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "storage" => storage::run(&b)?,
             "table1" => table1::run(&b)?,
             "path" => path::run(&b)?,
+            "accuracy" if args.redraw => accuracy::redraw(&b)?,
             "accuracy" => accuracy::run(&b)?,
             "stability" => stability::run(&b)?,
             "budget" => budget::run(&b)?,

@@ -54,10 +54,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             stride,
         ));
         methods.push((Method::Mesh(MeshMethod::Full { depth_sort: true }), stride));
-        methods.push((
-            Method::Hybrid(forest_render::hybrid::Hybrid::default()),
-            1,
-        ));
+        methods.push((Method::Hybrid(forest_render::hybrid::Hybrid::default()), 1));
     }
     let mut table = Table::new(&["view", "method", "frame_ms", "primitives", "visible_trees"]);
     let mut series = Vec::new();
