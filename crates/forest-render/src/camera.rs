@@ -112,6 +112,19 @@ impl Camera {
     }
 }
 
+/// Write a renderer's camera uniform and count the write in `writes` (count, bytes): what
+/// every renderer's `set_camera` does once it has filled in its own fields.
+pub(crate) fn upload(
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    camera: &GpuCamera,
+    writes: &std::cell::Cell<(u64, u64)>,
+) {
+    queue.write_buffer(buffer, 0, bytemuck::bytes_of(camera));
+    let (n, bytes) = writes.get();
+    writes.set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

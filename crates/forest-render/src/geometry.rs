@@ -979,11 +979,7 @@ impl GeometryRenderer {
         camera.validate()?;
         let mut g = camera.to_gpu();
         g.forms = self.forms.get();
-        ctx.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
-        let (n, bytes) = self.writes.get();
-        self.writes
-            .set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));
+        crate::camera::upload(&ctx.queue, &self.camera, &g, &self.writes);
         Ok(())
     }
 

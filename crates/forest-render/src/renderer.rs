@@ -611,11 +611,7 @@ impl QuadStream {
         g.viewport[2] = self.debug.get() as u32 as f32;
         g.viewport[3] = self.options.get().flags() as f32;
         g.forms = self.forms.get();
-        ctx.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&g));
-        let (n, bytes) = self.writes.get();
-        self.writes
-            .set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));
+        crate::camera::upload(&ctx.queue, &self.camera, &g, &self.writes);
         self.camera_set.set(true);
         Ok(())
     }

@@ -90,8 +90,8 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
 
-/// The tree's distance from the eye and crown radius, as the GPU computes them.
-fn tree_distance(r: &ForestRenderer, cam: &Camera, instance: usize) -> (f32, f32) {
+/// The tree's bounding sphere in the world (centre, crown radius), as the GPU computes it.
+fn tree_sphere(r: &ForestRenderer, instance: usize) -> (Vec3, f32) {
     let t = &r.stream.scene.tables;
     let inst = &t.instances[instance];
     let sp = &t.species[inst.species as usize];
@@ -101,7 +101,13 @@ fn tree_distance(r: &ForestRenderer, cam: &Camera, instance: usize) -> (f32, f32
         c.y,
         -inst.sin_rot * c.x + inst.cos_rot * c.z,
     ) + Vec3::from_array(inst.position);
-    (cam.eye.distance(c), sp.sphere[3] * inst.scale)
+    (c, sp.sphere[3] * inst.scale)
+}
+
+/// The tree's distance from the eye and crown radius, as the GPU computes them.
+fn tree_distance(r: &ForestRenderer, cam: &Camera, instance: usize) -> (f32, f32) {
+    let (c, radius) = tree_sphere(r, instance);
+    (cam.eye.distance(c), radius)
 }
 
 #[test]
@@ -208,18 +214,10 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
         );
         // Geometry: the visible trees whose quad share is below one.
         let mut near = 0;
-        let t = &r.stream.scene.tables;
         let planes = g.planes;
-        for i in 0..t.instances.len() {
-            let (d, radius) = tree_distance(&r, &cam, i);
-            let inst = &t.instances[i];
-            let sp = &t.species[inst.species as usize];
-            let c = Vec3::from_slice(&sp.sphere[..3]) * inst.scale;
-            let c = Vec3::new(
-                inst.cos_rot * c.x + inst.sin_rot * c.z,
-                c.y,
-                -inst.sin_rot * c.x + inst.cos_rot * c.z,
-            ) + Vec3::from_array(inst.position);
+        for i in 0..r.stream.scene.tables.instances.len() {
+            let (c, radius) = tree_sphere(&r, i);
+            let d = cam.eye.distance(c);
             let visible = planes
                 .iter()
                 .all(|p| p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] >= -radius);
@@ -249,15 +247,7 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
 #[test]
 fn empty_single_and_million_tree_forests_render_without_errors() {
     let ctx = common::ctx();
-    let empty = Forest::new(vec!["bush".into(), "pine".into()], Vec::new(), 15);
-    let million = forest_format::generate::generate(&forest_format::generate::GenerateParams {
-        trees: 1_000_000,
-        species: vec!["bush".into(), "pine".into()],
-        area_per_tree: 12.0,
-        seed: 9,
-        ..Default::default()
-    })
-    .unwrap();
+    let (empty, million) = common::empty_and_million();
     for (name, forest) in [
         ("empty", &empty),
         ("single", &common::one_tree(1, 0.3)),

@@ -215,15 +215,7 @@ fn gpu_bands_match_the_cpu_classification() {
 #[test]
 fn every_method_renders_empty_single_and_million_tree_forests() {
     let ctx = common::ctx();
-    let empty = Forest::new(vec!["bush".into(), "pine".into()], Vec::new(), 15);
-    let million = forest_format::generate::generate(&forest_format::generate::GenerateParams {
-        trees: 1_000_000,
-        species: vec!["bush".into(), "pine".into()],
-        area_per_tree: 12.0,
-        seed: 9,
-        ..Default::default()
-    })
-    .unwrap();
+    let (empty, million) = common::empty_and_million();
     let methods = [
         ("geometry", MeshMethod::Full { depth_sort: false }),
         ("geometry-sorted", MeshMethod::Full { depth_sort: true }),

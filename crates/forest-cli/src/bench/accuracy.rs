@@ -90,6 +90,18 @@ pub fn views(
     ]
 }
 
+/// Columns of `accuracy.csv`.
+const COLUMNS: [&str; 8] = [
+    "method",
+    "param",
+    "view",
+    "frame_ms",
+    "flip_mean",
+    "ssim",
+    "psnr",
+    "primitives",
+];
+
 /// Seed of the walkthrough cameras.
 pub const WALK_SEED: u64 = 0x3a1f_2c77;
 
@@ -223,16 +235,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     let forest = b.forest(trees, side, 7)?;
     let r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
-    let mut table = Table::new(&[
-        "method",
-        "param",
-        "view",
-        "frame_ms",
-        "flip_mean",
-        "ssim",
-        "psnr",
-        "primitives",
-    ]);
+    let mut table = Table::new(&COLUMNS);
     let walk = walk_cameras(b.quick);
     let mut groups: Vec<(&str, Vec<Camera>)> = views(&forest, side, viewport, b.clearance())
         .into_iter()
@@ -406,16 +409,7 @@ pub fn redraw(b: &Bench) -> Result<Section> {
         .with_context(|| format!("reading {} (run the accuracy suite first)", path.display()))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let mut table = Table::new(&[
-        "method",
-        "param",
-        "view",
-        "frame_ms",
-        "flip_mean",
-        "ssim",
-        "psnr",
-        "primitives",
-    ]);
+    let mut table = Table::new(&COLUMNS);
     if header != table.header {
         anyhow::bail!("{}: unexpected columns {header:?}", path.display());
     }

@@ -59,6 +59,21 @@ pub fn forest(trees: u32) -> Forest {
     .unwrap()
 }
 
+/// The bad-size forests every method must render without validation errors: empty and
+/// 1M trees (bush and pine, 12 m² per tree).
+pub fn empty_and_million() -> (Forest, Forest) {
+    let empty = Forest::new(vec!["bush".into(), "pine".into()], Vec::new(), 15);
+    let million = generate(&GenerateParams {
+        trees: 1_000_000,
+        species: vec!["bush".into(), "pine".into()],
+        area_per_tree: 12.0,
+        seed: 9,
+        ..Default::default()
+    })
+    .unwrap();
+    (empty, million)
+}
+
 /// One unit-scale tree of test species `species` (0 bush, 1 pine) at the origin, turned by
 /// `rotation` radians.
 pub fn one_tree(species: u32, rotation: f32) -> Forest {
