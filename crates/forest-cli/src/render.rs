@@ -4,12 +4,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use forest_format::forest::Forest;
-use forest_render::geometry::{
+use forest_baselines::geometry::{
     GeometryRenderer, GeometrySpecies, Lods, MeshMethod, PreparedGeometry, Stochastic,
 };
-use forest_render::hybrid::{Hybrid, Near};
-use forest_render::methods::{ForestRenderer, Method};
+use forest_baselines::hybrid::{Hybrid, Near};
+use forest_baselines::methods::{ForestRenderer, Method};
+use forest_format::forest::Forest;
 use forest_render::renderer::{AspectBlend, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -474,7 +474,7 @@ fn finish_view(
 fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Result<()> {
     let mut img = target.read(ctx);
     if supersample > 1 {
-        img = forest_render::geometry::downsample(&img, supersample);
+        img = forest_baselines::geometry::downsample(&img, supersample);
     }
     write_png(&img, out)
 }

@@ -7,10 +7,10 @@ use std::rc::Rc;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
+use forest_baselines::methods::ForestRenderer;
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
-use forest_render::geometry::{GeometryRenderer, PreparedGeometry};
-use forest_render::methods::ForestRenderer;
 use forest_render::renderer::{Background, DebugView, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};

@@ -16,11 +16,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use forest_baselines::geometry::GeometryRenderer;
+use forest_baselines::geometry::MeshMethod;
+use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::camera_path::CameraPath;
 use forest_render::context::GpuContext;
-use forest_render::geometry::GeometryRenderer;
-use forest_render::geometry::MeshMethod;
-use forest_render::methods::{ForestRenderer, Method, MethodStats};
 use forest_render::passes::draw::DEPTH_FORMAT;
 use forest_render::renderer::DebugView;
 use forest_render::{Camera, QuadStream};
@@ -970,12 +970,12 @@ mod tests {
         let unsorted = offered(Method::Mesh(MeshMethod::Full { depth_sort: false }), true);
         assert_eq!(names(&unsorted)[4], "geometry-unsorted");
         assert_eq!(unsorted.len(), 6);
-        let lods = MeshMethod::Lods(forest_render::geometry::Lods {
+        let lods = MeshMethod::Lods(forest_baselines::geometry::Lods {
             distances: [1.0, 2.0, 3.0],
         });
         assert_eq!(offered(Method::Mesh(lods), true)[2], Method::Mesh(lods));
-        let near = Method::Hybrid(forest_render::hybrid::Hybrid {
-            near: forest_render::hybrid::Near::Metres(7.0),
+        let near = Method::Hybrid(forest_baselines::hybrid::Hybrid {
+            near: forest_baselines::hybrid::Near::Metres(7.0),
             ..Default::default()
         });
         assert_eq!(offered(near, true)[5], near);

@@ -107,14 +107,14 @@ impl Camera {
             forward: self.forward().extend(0.0).to_array(),
             viewport: [self.viewport.0 as f32, self.viewport.1 as f32, 0.0, 0.0],
             planes,
-            forms: crate::hybrid::FORMS_QUADS,
+            forms: crate::forms::FORMS_QUADS,
         }
     }
 }
 
 /// Write a renderer's camera uniform and count the write in `writes` (count, bytes): what
 /// every renderer's `set_camera` does once it has filled in its own fields.
-pub(crate) fn upload(
+pub fn upload(
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,
     camera: &GpuCamera,

@@ -2,28 +2,7 @@
 
 use std::sync::{Arc, Mutex};
 
-/// Why the renderer cannot start or load a scene.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    /// No usable GPU adapter.
-    #[error(
-        "no GPU adapter found ({0}). Without a GPU, install a software Vulkan driver: \
-         `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu)"
-    )]
-    NoAdapter(String),
-    /// The adapter refused the device.
-    #[error("cannot open the GPU device: {0}")]
-    Device(String),
-    /// The scene does not fit the device or is inconsistent.
-    #[error("{0}")]
-    Scene(String),
-    /// The device reported validation or out-of-memory errors.
-    #[error("the GPU reported: {}", .0.join("; "))]
-    Gpu(Vec<String>),
-    /// An atlas or forest file problem.
-    #[error(transparent)]
-    Format(#[from] forest_format::FormatError),
-}
+pub use crate::error::RenderError;
 
 /// How colour layers are stored on the GPU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

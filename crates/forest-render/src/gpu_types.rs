@@ -18,7 +18,7 @@ pub struct GpuCamera {
     pub viewport: [f32; 4],
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],
-    /// Which form draws each tree (see [`crate::hybrid::quad_share`]): metres, crown radii,
+    /// Which form draws each tree (see [`crate::forms::quad_share`]): metres, crown radii,
     /// band fraction, jitter fraction.
     pub forms: [f32; 4],
 }
@@ -204,80 +204,4 @@ pub struct SceneConsts {
 pub struct GpuGround {
     /// Lit colour (linear) and the half side of the ground square (metres).
     pub colour: [f32; 4],
-}
-
-/// A species of the geometry-based methods (80 bytes; `GeoSpecies` in
-/// `shaders/geometry_types.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuGeoSpecies {
-    /// Bounding sphere (object space): centre, radius (metres).
-    pub sphere: [f32; 4],
-    /// First vertex of LOD 0, 1, 2; first billboard layer.
-    pub lod_first: [u32; 4],
-    /// Vertex counts of LOD 0, 1, 2; unused.
-    pub lod_count: [u32; 4],
-    /// Branch vertices at the start of LOD 0.
-    pub branch_vertices: u32,
-    /// Leaves (stochastic elements) N.
-    pub leaves: u32,
-    /// Offset of the species' leaves in the leaf-end and leaf-centre buffers.
-    pub leaf_base: u32,
-    /// `r` of the area-preservation factor.
-    pub r: f32,
-    /// Mean shaded leaf colour (linear RGB) for contrast preservation; w unused.
-    pub mean_leaf: [f32; 4],
-}
-
-/// The geometry method and its parameters (48 bytes; `Method` in
-/// `shaders/geometry_types.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuMethod {
-    /// 0 full geometry, 1 stochastic simplification, 2 discrete LODs + billboards.
-    pub mode: u32,
-    /// Full geometry: draw the nearest distance bands first (0/1).
-    pub depth_sort: u32,
-    /// Stochastic: area preservation on (0/1).
-    pub area: u32,
-    /// Stochastic: contrast preservation on (0/1).
-    pub contrast: u32,
-    /// Stochastic: full detail up to this object-space distance (metres).
-    pub d0: f32,
-    /// Stochastic: `ln ½ / ln h`.
-    pub exponent: f32,
-    /// Stochastic: fading width (fraction of λ).
-    pub fade: f32,
-    /// Padding.
-    pub pad: f32,
-    /// LODs: object-space distances where LOD 1, LOD 2 and billboards start; w unused.
-    pub lod: [f32; 4],
-}
-
-/// A material of the geometry renderer (32 bytes; `GeoMaterial`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuGeoMaterial {
-    /// Kd (linear RGB) and translucency.
-    pub kd: [f32; 4],
-    /// Texture layer (`u32::MAX`: none).
-    pub layer: u32,
-    /// Alpha tested (0/1).
-    pub alpha_tested: u32,
-    /// Padding.
-    pub pad: [u32; 2],
-}
-
-/// The light of the geometry renderer (64 bytes; `Light`), linear RGB.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuLight {
-    /// Unit vector towards the sun.
-    pub sun_dir: [f32; 4],
-    /// Sun irradiance.
-    pub sun: [f32; 4],
-    /// Sky irradiance.
-    pub sky: [f32; 4],
-    /// Ground bounce.
-    pub ground: [f32; 4],
 }

@@ -5,17 +5,16 @@
 //! per frame: set_camera (the one upload) ─► encode: cull ─► refine × (l − 1) ─► draw
 //! ```
 //! [`reference`] computes passes 1 and 2 on the CPU over the same tables; tests require the
-//! GPU's stream to equal it quad for quad. [`geometry`] holds the rival methods (full geometry,
-//! stochastic simplification, discrete LODs + billboards) and [`methods`] switches between all
-//! of them at run time.
+//! GPU's stream to equal it quad for quad. The rival methods (full geometry, stochastic
+//! simplification, discrete LODs + billboards, the hybrid) live in the `forest-baselines`
+//! crate, which builds on this one.
 
 pub mod camera;
 pub mod capacity;
 pub mod context;
-pub mod geometry;
+pub mod error;
+pub mod forms;
 pub mod gpu_types;
-pub mod hybrid;
-pub mod methods;
 pub mod passes;
 pub mod reference;
 pub mod renderer;

@@ -93,7 +93,7 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let sp = &t.species[inst.species as usize];
     let centre = to_world(inst, xyz(sp.sphere));
     // Trees drawn as geometry alone (the hybrid method) have no quads.
-    if crate::hybrid::quad_share(
+    if crate::forms::quad_share(
         cam.forms,
         xyz(cam.eye).distance(centre),
         sp.sphere[3] * inst.scale,

@@ -336,11 +336,12 @@ impl QuadStream {
         let limit = ctx.device.limits().max_storage_buffer_binding_size;
         let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
         if quad_bytes > limit {
-            return Err(RenderError::Scene(format!(
-                "a stream of {} quads needs {quad_bytes} bytes per buffer, above the device's \
-                 {limit}: lower the viewport or raise the minimum epsilon",
-                capacity.quads
-            )));
+            return Err(RenderError::DeviceLimit {
+                what: format!("a stream of {} quads (bytes per buffer)", capacity.quads),
+                needed: quad_bytes,
+                limit,
+                hint: ": lower the viewport or raise the minimum epsilon",
+            });
         }
         let device = &ctx.device;
         let shared = ComputeShared::new(device);
@@ -528,7 +529,7 @@ impl QuadStream {
             camera_set: Cell::new(false),
             debug: Cell::new(DebugView::Off),
             options: Cell::new(StreamOptions::default()),
-            forms: Cell::new(crate::hybrid::FORMS_QUADS),
+            forms: Cell::new(crate::forms::FORMS_QUADS),
             background: opts.background,
             owned,
         })
@@ -565,7 +566,7 @@ impl QuadStream {
     }
 
     /// Which trees the stream draws from the next camera write on (the camera's `forms`, see
-    /// [`crate::hybrid`]); [`crate::hybrid::FORMS_QUADS`], every tree, unless the hybrid
+    /// [`crate::hybrid`]); [`crate::forms::FORMS_QUADS`], every tree, unless the hybrid
     /// method set it.
     pub fn set_forms(&self, forms: [f32; 4]) {
         self.forms.set(forms);

@@ -62,21 +62,22 @@ impl SceneTables {
     /// Build the tables; the error says which species or instance is inconsistent.
     pub fn new(species: &[SpeciesData], forest: &Forest) -> Result<Self, RenderError> {
         if species.len() != forest.species.len() {
-            return Err(RenderError::Scene(format!(
-                "the forest names {} species but {} atlases were given",
-                forest.species.len(),
-                species.len()
-            )));
+            return Err(RenderError::SpeciesCount {
+                forest: forest.species.len(),
+                given: species.len(),
+                what: "atlases",
+            });
         }
         let mut t = SceneTables::default();
         for (k, s) in species.iter().enumerate() {
             let m = &s.atlas.manifest;
             if t.resolution != 0 && m.params.resolution != t.resolution {
-                return Err(RenderError::Scene(format!(
-                    "species {k} ({}) was baked at {} px but species 0 at {} px: bake all \
-                     species of a forest at one resolution",
-                    forest.species[k], m.params.resolution, t.resolution
-                )));
+                return Err(RenderError::MixedResolution {
+                    index: k,
+                    name: forest.species[k].clone(),
+                    resolution: m.params.resolution,
+                    first: t.resolution,
+                });
             }
             t.resolution = m.params.resolution;
             let node_base = t.nodes.len() as u32;
@@ -265,9 +266,12 @@ fn u32_texture(
     let height = texels.div_ceil(width as usize).max(1) as u32;
     let max = ctx.device.limits().max_texture_dimension_2d;
     if height > max {
-        return Err(RenderError::Scene(format!(
-            "the {label} texture needs {height} rows, the device allows {max}"
-        )));
+        return Err(RenderError::DeviceLimit {
+            what: format!("the {label} texture (rows)"),
+            needed: height.into(),
+            limit: max.into(),
+            hint: "",
+        });
     }
     let mut padded = bytes.to_vec();
     padded.resize(width as usize * height as usize * texel_bytes, 0);
@@ -312,10 +316,12 @@ impl GpuScene {
         let tables = SceneTables::new(species, forest)?;
         let limits = ctx.device.limits();
         if tables.layers > limits.max_texture_array_layers {
-            return Err(RenderError::Scene(format!(
-                "{} colour layers, the device allows {}",
-                tables.layers, limits.max_texture_array_layers
-            )));
+            return Err(RenderError::DeviceLimit {
+                what: "the colour atlas (texture array layers)".into(),
+                needed: tables.layers.into(),
+                limit: limits.max_texture_array_layers.into(),
+                hint: "",
+            });
         }
         let bc7 = ctx.use_bc7(colour_format) && tables.resolution >= 4;
         let format = if bc7 {

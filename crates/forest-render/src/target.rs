@@ -81,9 +81,10 @@ impl Target {
         format: wgpu::TextureFormat,
     ) -> Result<Self, crate::context::RenderError> {
         if !READABLE_FORMATS.contains(&format) {
-            return Err(crate::context::RenderError::Scene(format!(
-                "cannot read back a {format:?} target: use one of {READABLE_FORMATS:?}"
-            )));
+            return Err(crate::context::RenderError::UnreadableFormat {
+                format,
+                allowed: &READABLE_FORMATS,
+            });
         }
         Ok(Self::make(ctx, width, height, format))
     }

@@ -4,12 +4,12 @@
 //! eye-height cameras inside the forest.
 
 use anyhow::{Context, Result};
+use forest_baselines::geometry::{Lods, MeshMethod, Stochastic, downsample};
+use forest_baselines::hybrid::{Hybrid, Near};
+use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
 use forest_format::generate::SplitMix64;
 use forest_render::Camera;
-use forest_render::geometry::{Lods, MeshMethod, Stochastic, downsample};
-use forest_render::hybrid::{Hybrid, Near};
-use forest_render::methods::{ForestRenderer, Method};
 use forest_render::renderer::Background;
 use forest_render::target::Target;
 use glam::Vec3;

@@ -2,8 +2,8 @@
 //! given scene (viewport, nearest viewing distance, ε) needs, against the defaults.
 
 use anyhow::Result;
+use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::methods::Method;
 use forest_render::renderer::Background;
 use forest_render::target::Target;
 use glam::Vec3;
@@ -115,7 +115,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             ..Default::default()
         };
         let stream = forest_render::QuadStream::new(&b.ctx, scene, &opts)?;
-        let r = forest_render::methods::ForestRenderer::new(stream, None);
+        let r = forest_baselines::methods::ForestRenderer::new(stream, None);
         // The quads the scene needs: the most any of its views (the nearest, and the accuracy
         // suite's mid-range and bird's-eye) draws; a quarter more is the suggested capacity.
         let mut most = 0u64;
@@ -199,20 +199,20 @@ pub fn run(b: &Bench) -> Result<Section> {
     let levels = b.species[0].atlas.manifest.nodes_per_level.len();
     let mut hybrid_rows = Vec::new();
     for near in [
-        forest_render::hybrid::Near::Auto,
-        forest_render::hybrid::Near::Metres(5.0),
-        forest_render::hybrid::Near::Metres(near),
-        forest_render::hybrid::Near::Metres(near * 2.0),
+        forest_baselines::hybrid::Near::Auto,
+        forest_baselines::hybrid::Near::Metres(5.0),
+        forest_baselines::hybrid::Near::Metres(near),
+        forest_baselines::hybrid::Near::Metres(near * 2.0),
     ] {
-        let method = Method::Hybrid(forest_render::hybrid::Hybrid {
+        let method = Method::Hybrid(forest_baselines::hybrid::Hybrid {
             near,
             ..Default::default()
         });
         let (s, t) = b.measure(&r, method, &cam, &target, b.frames)?;
         let m = forest_metrics::compare(&reference, &target.read(&b.ctx))?;
         let name = match near {
-            forest_render::hybrid::Near::Auto => "hybrid near=auto".to_string(),
-            forest_render::hybrid::Near::Metres(x) => format!("hybrid near={x}m"),
+            forest_baselines::hybrid::Near::Auto => "hybrid near=auto".to_string(),
+            forest_baselines::hybrid::Near::Metres(x) => format!("hybrid near={x}m"),
         };
         println!(
             "budget: {name}: {} trees as geometry, FLIP {:.4}, {t:.2} ms",

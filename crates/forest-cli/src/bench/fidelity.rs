@@ -6,10 +6,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::{DEFAULT_PRESORT_DIRECTIONS, Forest, Instance};
 use forest_format::generate::SplitMix64;
 use forest_format::{BakeParams, ColourEncoding, PlaneFit};
-use forest_render::methods::{ForestRenderer, Method};
 use forest_render::renderer::{AspectBlend, Background, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};

@@ -18,10 +18,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
+use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::forest::Forest;
 use forest_format::generate::{GenerateParams, generate};
-use forest_render::geometry::{GeometryRenderer, PreparedGeometry};
-use forest_render::methods::{ForestRenderer, Method, MethodStats};
 use forest_render::renderer::{Background, PassTimes, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -294,8 +294,8 @@ impl Bench {
         let slow = matches!(
             method,
             Method::Mesh(
-                forest_render::geometry::MeshMethod::Full { .. }
-                    | forest_render::geometry::MeshMethod::Stochastic(_)
+                forest_baselines::geometry::MeshMethod::Full { .. }
+                    | forest_baselines::geometry::MeshMethod::Stochastic(_)
             )
         );
         if self.cpu && slow { 1 } else { self.frames }

@@ -2,9 +2,9 @@
 //! primitives per view for every method.
 
 use anyhow::Result;
+use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
+use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::geometry::{Lods, MeshMethod, Stochastic};
-use forest_render::methods::Method;
 use forest_render::renderer::Background;
 use forest_render::target::Target;
 use glam::Vec3;
@@ -54,7 +54,10 @@ pub fn run(b: &Bench) -> Result<Section> {
             stride,
         ));
         methods.push((Method::Mesh(MeshMethod::Full { depth_sort: true }), stride));
-        methods.push((Method::Hybrid(forest_render::hybrid::Hybrid::default()), 1));
+        methods.push((
+            Method::Hybrid(forest_baselines::hybrid::Hybrid::default()),
+            1,
+        ));
     }
     let mut table = Table::new(&["view", "method", "frame_ms", "primitives", "visible_trees"]);
     let mut series = Vec::new();

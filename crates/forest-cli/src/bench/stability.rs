@@ -2,10 +2,10 @@
 //! moves through hard cases.
 
 use anyhow::Result;
+use forest_baselines::geometry::{MeshMethod, Stochastic};
+use forest_baselines::methods::Method;
 use forest_format::forest::{Forest, Instance};
 use forest_render::Camera;
-use forest_render::geometry::{MeshMethod, Stochastic};
-use forest_render::methods::Method;
 use forest_render::renderer::Background;
 use forest_render::target::Target;
 use glam::Vec3;
@@ -133,7 +133,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         Method::Mesh(MeshMethod::Full { depth_sort: true }),
         Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
         Method::Mesh(MeshMethod::Lods(Default::default())),
-        Method::Hybrid(forest_render::hybrid::Hybrid::default()),
+        Method::Hybrid(forest_baselines::hybrid::Hybrid::default()),
     ];
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&["case", "method", "flip_mean", "flicker", "pops", "frame_ms"]);

@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use anyhow::Result;
+use forest_baselines::geometry::GeometryRenderer;
+use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::geometry::GeometryRenderer;
-use forest_render::methods::Method;
 use forest_render::renderer::Background;
 use forest_render::target::{TARGET_FORMAT, Target};
 

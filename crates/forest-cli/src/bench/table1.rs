@@ -2,8 +2,8 @@
 //! inside and from above; visible trees, quads and the time of each pass of the quad stream.
 
 use anyhow::Result;
+use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::methods::Method;
 use forest_render::renderer::Background;
 use forest_render::target::Target;
 use glam::Vec3;

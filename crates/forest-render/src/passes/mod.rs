@@ -9,36 +9,27 @@ pub mod draw;
 pub mod refine;
 pub mod scan;
 
+/// The WGSL every module starts with: the camera, the scene's structs, the shared helpers
+/// (other crates' shaders that read the camera, such as the baselines', start with it too).
+pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
+/// The ground plane's vertex and fragment stages (after [`COMMON_WGSL`]).
+pub const GROUND_WGSL: &str = include_str!("../../shaders/ground.wgsl");
+
 /// WGSL of the compute passes.
 pub const COMPUTE_WGSL: [&str; 6] = [
-    include_str!("../../../../shaders/common.wgsl"),
-    include_str!("../../../../shaders/bindings.wgsl"),
-    include_str!("../../../../shaders/quad_geometry.wgsl"),
-    include_str!("../../../../shaders/scan.wgsl"),
-    include_str!("../../../../shaders/cull.wgsl"),
-    include_str!("../../../../shaders/refine.wgsl"),
+    COMMON_WGSL,
+    include_str!("../../shaders/bindings.wgsl"),
+    include_str!("../../shaders/quad_geometry.wgsl"),
+    include_str!("../../shaders/scan.wgsl"),
+    include_str!("../../shaders/cull.wgsl"),
+    include_str!("../../shaders/refine.wgsl"),
 ];
 
 /// WGSL of the draw pass.
 pub const DRAW_WGSL: [&str; 3] = [
-    include_str!("../../../../shaders/common.wgsl"),
-    include_str!("../../../../shaders/draw.wgsl"),
-    include_str!("../../../../shaders/ground.wgsl"),
-];
-
-/// WGSL of the full-geometry draw.
-pub const GEOMETRY_DRAW_WGSL: [&str; 4] = [
-    include_str!("../../../../shaders/common.wgsl"),
-    include_str!("../../../../shaders/geometry_types.wgsl"),
-    include_str!("../../../../shaders/geometry_draw.wgsl"),
-    include_str!("../../../../shaders/ground.wgsl"),
-];
-
-/// WGSL of the full-geometry culling.
-pub const GEOMETRY_CULL_WGSL: [&str; 3] = [
-    include_str!("../../../../shaders/common.wgsl"),
-    include_str!("../../../../shaders/geometry_types.wgsl"),
-    include_str!("../../../../shaders/geometry.wgsl"),
+    COMMON_WGSL,
+    include_str!("../../shaders/draw.wgsl"),
+    GROUND_WGSL,
 ];
 
 /// The compute module's source.

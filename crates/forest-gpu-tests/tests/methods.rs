@@ -5,8 +5,8 @@
 mod common;
 
 use forest_bake::lod::BANDS;
+use forest_baselines::geometry::{GeometryRenderer, Lods, MeshMethod, Stochastic};
 use forest_format::forest::Forest;
-use forest_render::geometry::{GeometryRenderer, Lods, MeshMethod, Stochastic};
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
@@ -275,7 +275,7 @@ fn every_method_renders_empty_single_and_million_tree_forests() {
 
 #[test]
 fn switching_methods_at_run_time_reproduces_each_methods_own_frame() {
-    use forest_render::methods::{ForestRenderer, Method};
+    use forest_baselines::methods::{ForestRenderer, Method};
     let ctx = common::ctx();
     let forest = common::forest(300);
     let (_, cam) = common::cameras(forest.extent()).remove(0);

@@ -8,10 +8,10 @@ mod common;
 
 use std::sync::OnceLock;
 
+use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeometry, downsample};
 use forest_format::forest::{Forest, Instance};
 use forest_format::{Atlas, BakeParams, PlaneFit};
 use forest_render::Camera;
-use forest_render::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeometry, downsample};
 use forest_render::renderer::{AspectBlend, Background, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};

@@ -156,18 +156,18 @@ pub fn cameras(side: f32) -> Vec<(&'static str, Camera)> {
 }
 
 /// The geometry methods' CPU preparation of bush and pine, lit as their test atlases.
-pub fn prepared() -> &'static forest_render::geometry::PreparedGeometry {
-    static P: OnceLock<forest_render::geometry::PreparedGeometry> = OnceLock::new();
+pub fn prepared() -> &'static forest_baselines::geometry::PreparedGeometry {
+    static P: OnceLock<forest_baselines::geometry::PreparedGeometry> = OnceLock::new();
     P.get_or_init(|| {
-        let species: Vec<forest_render::geometry::GeometrySpecies> = ["bush", "pine"]
+        let species: Vec<forest_baselines::geometry::GeometrySpecies> = ["bush", "pine"]
             .iter()
             .zip(atlases())
-            .map(|(s, a)| forest_render::geometry::GeometrySpecies {
+            .map(|(s, a)| forest_baselines::geometry::GeometrySpecies {
                 mesh: forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj")))
                     .unwrap(),
                 lighting: a.manifest.lighting,
             })
             .collect();
-        forest_render::geometry::PreparedGeometry::new(&species)
+        forest_baselines::geometry::PreparedGeometry::new(&species)
     })
 }

@@ -2,7 +2,7 @@
 
 mod common;
 
-use forest_render::geometry::{GeometryRenderer, downsample};
+use forest_baselines::geometry::{GeometryRenderer, downsample};
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{GpuScene, QuadStream};

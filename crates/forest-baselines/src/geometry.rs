@@ -20,12 +20,14 @@ use forest_format::forest::Forest;
 use forest_format::shading::Lighting;
 use wgpu::util::DeviceExt;
 
-use crate::camera::{Camera, CameraError};
-use crate::context::{GpuContext, RenderError};
-use crate::gpu_types::{GpuCamera, GpuGeoMaterial, GpuGeoSpecies, GpuLight, GpuMethod};
-use crate::passes::draw::DEPTH_FORMAT;
-use crate::renderer::{Background, PassTimes};
-use crate::target::Target;
+use forest_render::camera::{Camera, CameraError};
+use forest_render::context::{GpuContext, RenderError};
+use forest_render::gpu_types::GpuCamera;
+use forest_render::passes::draw::DEPTH_FORMAT;
+use forest_render::renderer::{Background, PassTimes};
+use forest_render::target::Target;
+
+use crate::gpu_types::{GpuGeoMaterial, GpuGeoSpecies, GpuLight, GpuMethod};
 
 /// Side of every material texture layer on the GPU.
 pub const MATERIAL_TEXTURE_SIZE: u32 = 512;
@@ -105,7 +107,7 @@ impl Default for MeshMethod {
 impl MeshMethod {
     /// Check the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), RenderError> {
-        let bad = |s: String| Err(RenderError::Scene(s));
+        let bad = |s: String| Err(RenderError::Parameter(s));
         match self {
             MeshMethod::Full { .. } => Ok(()),
             MeshMethod::Stochastic(s) => {
@@ -610,22 +612,21 @@ impl GeometryRenderer {
         } = prepared;
         let l = *l;
         if geo_species.len() != forest.species.len() {
-            return Err(RenderError::Scene(format!(
-                "the forest names {} species but {} models were given",
-                forest.species.len(),
-                geo_species.len()
-            )));
+            return Err(RenderError::SpeciesCount {
+                forest: forest.species.len(),
+                given: geo_species.len(),
+                what: "models",
+            });
         }
         if !ctx
             .device
             .features()
             .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
         {
-            return Err(RenderError::Scene(
-                "the geometry renderer needs indirect draws with a first instance \
-                 (INDIRECT_FIRST_INSTANCE), which this adapter lacks"
-                    .into(),
-            ));
+            return Err(RenderError::MissingFeature {
+                method: "the geometry renderer",
+                feature: "indirect draws with a first instance (INDIRECT_FIRST_INSTANCE)",
+            });
         }
         let device = &ctx.device;
         let light = GpuLight {
@@ -634,8 +635,8 @@ impl GeometryRenderer {
             sky: l.sky.extend(0.0).to_array(),
             ground: l.ground.extend(0.0).to_array(),
         };
-        let instances = crate::scene::gpu_instances(forest);
-        let cap = crate::capacity::GeometryCapacity::new(
+        let instances = forest_render::scene::gpu_instances(forest);
+        let cap = forest_render::capacity::GeometryCapacity::new(
             instances.len() as u32,
             geo_species.len() as u32,
             BANDS,
@@ -725,15 +726,15 @@ impl GeometryRenderer {
 
         let compute = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry cull"),
-            source: wgpu::ShaderSource::Wgsl(crate::passes::GEOMETRY_CULL_WGSL.concat().into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_CULL_WGSL.concat().into()),
         });
         let draw_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry draw"),
-            source: wgpu::ShaderSource::Wgsl(crate::passes::GEOMETRY_DRAW_WGSL.concat().into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_DRAW_WGSL.concat().into()),
         });
         // One explicit layout shared by the four compute entry points (one bind group).
-        use crate::passes::Slot;
-        let entries = crate::passes::layout_entries(
+        use forest_render::passes::Slot;
+        let entries = forest_render::passes::layout_entries(
             &[
                 Slot::Uniform,   // 0 camera
                 Slot::Read,      // 1 instances
@@ -771,7 +772,7 @@ impl GeometryRenderer {
         let compute_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry cull"),
             layout: &compute_layout,
-            entries: &crate::passes::numbered(vec![
+            entries: &forest_render::passes::numbered(vec![
                 camera.as_entire_binding(),
                 inst_buf.as_entire_binding(),
                 species_buf.as_entire_binding(),
@@ -843,7 +844,7 @@ impl GeometryRenderer {
         let ground_pipeline = render_pipeline("vs_ground", "fs_ground", T::TriangleStrip, None);
         let ground_buf = init(
             "geometry ground",
-            bytemuck::bytes_of(&crate::renderer::ground_uniform(&l, &instances)),
+            bytemuck::bytes_of(&forest_render::renderer::ground_uniform(&l, &instances)),
             U::UNIFORM,
         );
         let ground_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -898,7 +899,7 @@ impl GeometryRenderer {
             camera,
             method_buf,
             method: Cell::new(method),
-            forms: Cell::new(crate::hybrid::FORMS_GEOMETRY),
+            forms: Cell::new(forest_render::forms::FORMS_GEOMETRY),
             writes: Cell::new((0, 0)),
             reset: cpl("geo_reset"),
             classify: cpl("geo_classify"),
@@ -935,7 +936,7 @@ impl GeometryRenderer {
     }
 
     /// Which trees the renderer draws from the next camera write on (the camera's `forms`, see
-    /// [`crate::hybrid`]); [`crate::hybrid::FORMS_GEOMETRY`], every tree, unless the hybrid
+    /// [`forest_render::forms`]); [`forest_render::forms::FORMS_GEOMETRY`], every tree, unless the hybrid
     /// method set it.
     pub fn set_forms(&self, forms: [f32; 4]) {
         self.forms.set(forms);
@@ -954,7 +955,7 @@ impl GeometryRenderer {
         self.set_camera(ctx, camera)?;
         self.encode_compute(encoder);
         {
-            let mut pass = crate::target::begin_pass(
+            let mut pass = forest_render::target::begin_pass(
                 encoder,
                 "geometry draw",
                 colour,
@@ -979,7 +980,7 @@ impl GeometryRenderer {
         camera.validate()?;
         let mut g = camera.to_gpu();
         g.forms = self.forms.get();
-        crate::camera::upload(&ctx.queue, &self.camera, &g, &self.writes);
+        forest_render::camera::upload(&ctx.queue, &self.camera, &g, &self.writes);
         Ok(())
     }
 

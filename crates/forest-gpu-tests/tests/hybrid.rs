@@ -6,10 +6,11 @@
 
 mod common;
 
+use forest_baselines::geometry::{GeometryRenderer, MeshMethod};
+use forest_baselines::hybrid::{Hybrid, Near};
+use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
-use forest_render::geometry::{GeometryRenderer, MeshMethod};
-use forest_render::hybrid::{self, Hybrid, Near};
-use forest_render::methods::{ForestRenderer, Method};
+use forest_render::forms as hybrid;
 use forest_render::renderer::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream, reference};

@@ -5,12 +5,14 @@
 
 use std::cell::Cell;
 
-use crate::camera::{Camera, CameraError};
-use crate::context::{GpuContext, RenderError};
+use forest_render::camera::{Camera, CameraError};
+use forest_render::context::{GpuContext, RenderError};
+use forest_render::forms::{FORMS_GEOMETRY, FORMS_QUADS};
+use forest_render::renderer::{PassTimes, QuadStream};
+use forest_render::target::Target;
+
 use crate::geometry::{GeometryRenderer, MeshMethod};
-use crate::hybrid::{FORMS_GEOMETRY, FORMS_QUADS, Hybrid};
-use crate::renderer::{PassTimes, QuadStream};
-use crate::target::Target;
+use crate::hybrid::Hybrid;
 
 /// A rendering method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,12 +91,12 @@ impl ForestRenderer {
     /// Switch the method; the geometry-based ones and the hybrid need the geometry renderer.
     pub fn set_method(&self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
         let geometry = || {
-            self.geometry.as_ref().ok_or_else(|| {
-                RenderError::Scene(format!(
-                    "the {} method needs the species' OBJ models (none were loaded)",
-                    method.name()
-                ))
-            })
+            self.geometry
+                .as_ref()
+                .ok_or_else(|| RenderError::MissingData {
+                    method: method.name(),
+                    needs: "the species' OBJ models",
+                })
         };
         match method {
             Method::Quads | Method::Impostor => self.stream.set_refine(method == Method::Quads),
@@ -145,7 +147,7 @@ impl ForestRenderer {
                 self.stream.encode_compute(encoder);
                 g.encode_compute(encoder);
                 {
-                    let mut pass = crate::target::begin_pass(
+                    let mut pass = forest_render::target::begin_pass(
                         encoder,
                         "hybrid draw",
                         colour,

@@ -1,0 +1,108 @@
+//! The geometry renderer's host and WGSL struct layouts checked against each other by
+//! reflecting the WGSL with naga (the checker is the runtime crate's, included).
+
+use std::mem::{offset_of, size_of};
+
+use forest_baselines::gpu_types::*;
+
+#[path = "../../forest-render/tests/layout_check/mod.rs"]
+#[allow(dead_code)]
+mod layout_check;
+#[allow(unused_imports)]
+use layout_check::{Expect, check, shared};
+
+#[test]
+fn geometry_structs_match_the_host() {
+    use forest_bake::RefVertex;
+    let expected: Vec<Expect> = vec![
+        (
+            "GeoVertex",
+            size_of::<RefVertex>(),
+            vec![
+                ("pos", offset_of!(RefVertex, pos)),
+                ("sun_visibility", offset_of!(RefVertex, sun_visibility)),
+                ("normal", offset_of!(RefVertex, normal)),
+                ("material", offset_of!(RefVertex, material)),
+                ("uv", offset_of!(RefVertex, uv)),
+                ("element", offset_of!(RefVertex, element)),
+                ("pad", offset_of!(RefVertex, pad)),
+            ],
+        ),
+        (
+            "GeoSpecies",
+            size_of::<GpuGeoSpecies>(),
+            vec![
+                ("sphere", offset_of!(GpuGeoSpecies, sphere)),
+                ("lod_first", offset_of!(GpuGeoSpecies, lod_first)),
+                ("lod_count", offset_of!(GpuGeoSpecies, lod_count)),
+                (
+                    "branch_vertices",
+                    offset_of!(GpuGeoSpecies, branch_vertices),
+                ),
+                ("leaves", offset_of!(GpuGeoSpecies, leaves)),
+                ("leaf_base", offset_of!(GpuGeoSpecies, leaf_base)),
+                ("r", offset_of!(GpuGeoSpecies, r)),
+                ("mean_leaf", offset_of!(GpuGeoSpecies, mean_leaf)),
+            ],
+        ),
+        (
+            "Method",
+            size_of::<GpuMethod>(),
+            vec![
+                ("mode", offset_of!(GpuMethod, mode)),
+                ("depth_sort", offset_of!(GpuMethod, depth_sort)),
+                ("area", offset_of!(GpuMethod, area)),
+                ("contrast", offset_of!(GpuMethod, contrast)),
+                ("d0", offset_of!(GpuMethod, d0)),
+                ("exponent", offset_of!(GpuMethod, exponent)),
+                ("fade", offset_of!(GpuMethod, fade)),
+                ("pad", offset_of!(GpuMethod, pad)),
+                ("lod", offset_of!(GpuMethod, lod)),
+            ],
+        ),
+        (
+            "GeoMaterial",
+            size_of::<GpuGeoMaterial>(),
+            vec![
+                ("kd", offset_of!(GpuGeoMaterial, kd)),
+                ("layer", offset_of!(GpuGeoMaterial, layer)),
+                ("alpha_tested", offset_of!(GpuGeoMaterial, alpha_tested)),
+                ("pad", offset_of!(GpuGeoMaterial, pad)),
+            ],
+        ),
+        (
+            "Light",
+            size_of::<GpuLight>(),
+            vec![
+                ("sun_dir", offset_of!(GpuLight, sun_dir)),
+                ("sun", offset_of!(GpuLight, sun)),
+                ("sky", offset_of!(GpuLight, sky)),
+                ("ground", offset_of!(GpuLight, ground)),
+            ],
+        ),
+    ];
+    check(
+        &forest_baselines::shaders::GEOMETRY_DRAW_WGSL.concat(),
+        &expected,
+    );
+    check(
+        &forest_baselines::shaders::GEOMETRY_CULL_WGSL.concat(),
+        &expected[1..3],
+    );
+}
+
+#[test]
+fn shaders_validate() {
+    for src in [
+        forest_baselines::shaders::GEOMETRY_DRAW_WGSL.concat(),
+        forest_baselines::shaders::GEOMETRY_CULL_WGSL.concat(),
+    ] {
+        let module = naga::front::wgsl::parse_str(&src).unwrap();
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    }
+}

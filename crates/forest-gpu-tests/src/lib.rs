@@ -1,0 +1,1 @@
+//! Nothing here: the GPU tests live in `tests/`.

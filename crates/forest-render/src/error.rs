@@ -1,0 +1,88 @@
+//! Why the runtime refuses: one variant per cause, so a host can match on it.
+
+/// Why the renderer cannot start, load a scene or draw a frame.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// No usable GPU adapter.
+    #[error(
+        "no GPU adapter found ({0}). Without a GPU, install a software Vulkan driver: \
+         `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu)"
+    )]
+    NoAdapter(String),
+    /// The adapter refused the device.
+    #[error("cannot open the GPU device: {0}")]
+    Device(String),
+    /// The forest names a different number of species than were given.
+    #[error("the forest names {forest} species but {given} {what} were given")]
+    SpeciesCount {
+        /// Species the forest names.
+        forest: usize,
+        /// Species given.
+        given: usize,
+        /// What was given ("atlases", "models").
+        what: &'static str,
+    },
+    /// Species of one forest baked at different resolutions.
+    #[error(
+        "species {index} ({name}) was baked at {resolution} px but species 0 at {first} px: \
+         bake all species of a forest at one resolution"
+    )]
+    MixedResolution {
+        /// Index of the species.
+        index: usize,
+        /// Its name in the forest.
+        name: String,
+        /// Its resolution (texels).
+        resolution: u32,
+        /// Species 0's resolution (texels).
+        first: u32,
+    },
+    /// Something the scene or the stream needs is larger than a limit of the device.
+    #[error("{what} needs {needed}, the device allows {limit}{hint}")]
+    DeviceLimit {
+        /// What is too large, and in which unit.
+        what: String,
+        /// What it needs.
+        needed: u64,
+        /// The device's limit.
+        limit: u64,
+        /// What to do about it (empty, or starting with ": ").
+        hint: &'static str,
+    },
+    /// The adapter lacks a feature a method needs.
+    #[error("{method} needs {feature}, which this adapter lacks")]
+    MissingFeature {
+        /// The method or pass.
+        method: &'static str,
+        /// The wgpu feature.
+        feature: &'static str,
+    },
+    /// A colour format a target cannot be read back in.
+    #[error("cannot read back a {format:?} target: use one of {allowed:?}")]
+    UnreadableFormat {
+        /// The format asked for.
+        format: wgpu::TextureFormat,
+        /// The formats that can be read back.
+        allowed: &'static [wgpu::TextureFormat],
+    },
+    /// A parameter out of its range; the message names it.
+    #[error("{0}")]
+    Parameter(String),
+    /// A method that needs data the renderer was not given (for example OBJ models).
+    #[error("the {method} method needs {needs} (none were loaded)")]
+    MissingData {
+        /// The method.
+        method: &'static str,
+        /// What it needs.
+        needs: &'static str,
+    },
+    /// The camera or frame parameters are invalid.
+    #[error(transparent)]
+    Camera(#[from] crate::camera::CameraError),
+    /// The device reported validation or out-of-memory errors.
+    #[error("the GPU reported: {}", .0.join("; "))]
+    Gpu(Vec<String>),
+    /// An atlas or forest file problem.
+    #[error(transparent)]
+    Format(#[from] forest_format::FormatError),
+}

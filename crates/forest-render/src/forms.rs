@@ -1,0 +1,127 @@
+//! Which form draws each tree: the quad stream's share of a tree, decided on the GPU every
+//! frame from the camera's `forms` vector (the camera stays the only per-frame upload).
+//!
+//! [`quad_share`] gives the quad stream's share of a tree: 0 (another form alone) nearer than
+//! the tree's switch distance, [`WEIGHT_ONE`] (quads alone) past its transition band, and in
+//! between the fraction of the tree's pixels the quads draw. Inside the band both forms draw
+//! the tree through complementary screen-door masks ([`form_threshold`]), so every pixel comes
+//! from exactly one of them and nothing pops; the band's start is jittered per instance so
+//! that a ring of trees at one distance does not change form in the same frame. The quad
+//! stream on its own uses [`FORMS_QUADS`]; the hybrid method (`forest-baselines`) sets
+//! others, and its near trees are drawn by the geometry renderer with the same functions in
+//! `shaders/common.wgsl`.
+
+use crate::gpu_types::WEIGHT_ONE;
+
+/// `forms` of the quad stream on its own: every tree as quads.
+pub const FORMS_QUADS: [f32; 4] = [0.0; 4];
+/// `forms` of a geometry method on its own: every tree as geometry.
+pub const FORMS_GEOMETRY: [f32; 4] = [f32::MAX, 0.0, 0.0, 0.0];
+/// A switch distance at or past this (metres) draws every tree as geometry (`common.wgsl`).
+pub const GEOMETRY_ALWAYS: f32 = 3.0e38;
+
+/// A per-instance number in `[0, 1)` (`instance_hash` in `shaders/common.wgsl`).
+pub fn instance_hash(instance: u32) -> f32 {
+    let mut h = instance
+        .wrapping_mul(747_796_405)
+        .wrapping_add(2_891_336_453);
+    h = ((h >> ((h >> 28) + 4)) ^ h).wrapping_mul(277_803_737);
+    (h >> 8) as f32 / 16_777_216.0
+}
+
+/// The quad stream's share of a tree, in units of 1/[`WEIGHT_ONE`] (`quad_share` in
+/// `shaders/common.wgsl`, the same operations in the same order): 0 while the eye is nearer
+/// than the tree's switch distance `s = forms.x + forms.y · radius`, [`WEIGHT_ONE`] past its
+/// band `[start, start · (1 + forms.z)]` with `start = s · (1 + forms.w · hash)`, linear in
+/// between. `distance`: eye to the bounding-sphere centre; `radius`: the crown's (metres).
+pub fn quad_share(forms: [f32; 4], distance: f32, radius: f32, instance: u32) -> u32 {
+    let s = forms[0] + forms[1] * radius;
+    if s <= 0.0 {
+        return WEIGHT_ONE;
+    }
+    if s >= GEOMETRY_ALWAYS {
+        return 0;
+    }
+    let start = s * (1.0 + forms[3] * instance_hash(instance));
+    let width = start * forms[2];
+    if width <= 0.0 {
+        return if distance >= start { WEIGHT_ONE } else { 0 };
+    }
+    ((((distance - start) / width).clamp(0.0, 1.0) * 4095.0 + 0.5).floor()) as u32
+}
+
+/// Ordered-dither threshold of pixel `(x, y)` for a tree, in `[0, WEIGHT_ONE)`
+/// (`dither_threshold` in `shaders/common.wgsl`).
+pub fn dither_threshold(x: u32, y: u32, instance: u32) -> u32 {
+    let (x, y) = (x & 7, y & 7);
+    let xy = x ^ y;
+    let b = ((xy & 1) << 5)
+        | ((y & 1) << 4)
+        | ((xy & 2) << 2)
+        | ((y & 2) << 1)
+        | ((xy & 4) >> 1)
+        | ((y & 4) >> 2);
+    let u = ((b as f32 + 0.5) / 64.0 + instance_hash(instance)).fract();
+    ((u * WEIGHT_ONE as f32) as u32).min(WEIGHT_ONE - 1)
+}
+
+/// The screen-door threshold that splits a tree in its band between the forms
+/// (`form_threshold` in `shaders/common.wgsl`): the quads draw pixel `(x, y)` when it is below
+/// the tree's [`quad_share`], the geometry otherwise.
+pub fn form_threshold(x: u32, y: u32, instance: u32) -> u32 {
+    dither_threshold(y, x, instance ^ 0x5bd1_e995)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shares_run_from_geometry_to_quads_across_the_band() {
+        let forms = [10.0, 0.0, 0.5, 0.0];
+        assert_eq!(quad_share(forms, 9.99, 3.0, 7), 0);
+        assert_eq!(quad_share(forms, 12.5, 3.0, 7), WEIGHT_ONE / 2 + 1);
+        assert_eq!(quad_share(forms, 15.0, 3.0, 7), WEIGHT_ONE);
+        assert_eq!(quad_share(FORMS_QUADS, 0.0, 3.0, 7), WEIGHT_ONE);
+        assert_eq!(quad_share(FORMS_GEOMETRY, 1e30, 3.0, 7), 0);
+        // Crown radii: 2 radii of a 3 m crown.
+        assert_eq!(quad_share([0.0, 2.0, 0.0, 0.0], 5.9, 3.0, 7), 0);
+        assert_eq!(quad_share([0.0, 2.0, 0.0, 0.0], 6.0, 3.0, 7), WEIGHT_ONE);
+    }
+
+    #[test]
+    fn jitter_spreads_the_band_start_over_instances() {
+        let forms = [10.0, 0.0, 0.0, 0.5];
+        let starts: Vec<f32> = (0..1000)
+            .map(|i| 10.0 * (1.0 + 0.5 * instance_hash(i)))
+            .collect();
+        assert!(starts.iter().all(|s| (10.0..15.0).contains(s)));
+        // At 12.5 m about half of the trees have switched.
+        let quads = (0..1000)
+            .filter(|&i| quad_share(forms, 12.5, 1.0, i) == WEIGHT_ONE)
+            .count();
+        assert!((400..600).contains(&quads), "{quads}");
+    }
+
+    #[test]
+    fn the_forms_split_every_pixel_and_cover_their_share() {
+        for share in [0, 1, 1000, 2048, 4000, WEIGHT_ONE] {
+            for inst in [0, 1, 99] {
+                let mut quads = 0;
+                for y in 0..8 {
+                    for x in 0..8 {
+                        let t = form_threshold(x, y, inst);
+                        assert!(t < WEIGHT_ONE);
+                        // The quads draw the pixel, or the geometry does: never both, never none.
+                        quads += u32::from(t < share);
+                    }
+                }
+                let want = share as f32 / WEIGHT_ONE as f32 * 64.0;
+                assert!(
+                    (quads as f32 - want).abs() <= 1.0,
+                    "share {share}: {quads}/64"
+                );
+            }
+        }
+    }
+}
