@@ -12,8 +12,6 @@
 //! rebuilding anything. Every tree is shaded with `forest_format::shading` in its object
 //! space, as the bake shades the atlases.
 
-use std::cell::Cell;
-
 use forest_bake::lod::{BANDS, LodParams};
 use forest_bake::{Mesh, RefVertex};
 use forest_format::forest::Forest;
@@ -23,8 +21,9 @@ use wgpu::util::DeviceExt;
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::gpu_types::GpuCamera;
+use forest_render::options::Background;
 use forest_render::passes::draw::DEPTH_FORMAT;
-use forest_render::renderer::{Background, PassTimes};
+use forest_render::stats::PassTimes;
 use forest_render::target::Target;
 
 use crate::gpu_types::{GpuGeoMaterial, GpuGeoSpecies, GpuLight, GpuMethod};
@@ -246,9 +245,10 @@ const BILLBOARD_SPP: u32 = 4;
 pub struct GeometryRenderer {
     camera: wgpu::Buffer,
     method_buf: wgpu::Buffer,
-    method: Cell<MeshMethod>,
-    forms: Cell<[f32; 4]>,
-    writes: Cell<(u64, u64)>,
+    method: MeshMethod,
+    forms: [f32; 4],
+    writes: (u64, u64),
+    ring: forest_render::stats::StatsRing,
     reset: wgpu::ComputePipeline,
     classify: wgpu::ComputePipeline,
     args_pipeline: wgpu::ComputePipeline,
@@ -642,7 +642,7 @@ impl GeometryRenderer {
             BANDS,
         );
         let (segments, listed) = (cap.segments as usize, cap.instances as usize);
-        let gpu_bytes = Cell::new(0u64);
+        let gpu_bytes = std::cell::Cell::new(0u64);
         use wgpu::BufferUsages as U;
         let init = |label: &str, bytes: &[u8], usage: U| {
             // Empty tables still bind one element of any of their types.
@@ -844,7 +844,7 @@ impl GeometryRenderer {
         let ground_pipeline = render_pipeline("vs_ground", "fs_ground", T::TriangleStrip, None);
         let ground_buf = init(
             "geometry ground",
-            bytemuck::bytes_of(&forest_render::renderer::ground_uniform(&l, &instances)),
+            bytemuck::bytes_of(&forest_render::options::ground_uniform(&l, &instances)),
             U::UNIFORM,
         );
         let ground_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -895,12 +895,18 @@ impl GeometryRenderer {
                 let resolve = zeros("geometry timestamps", 32, U::QUERY_RESOLVE | U::COPY_SRC);
                 (set, resolve, f64::from(ctx.queue.get_timestamp_period()))
             });
+        let mut sources = vec![(args.clone(), u64::from(cap.segments) * 16)];
+        if let Some((_, resolve, _)) = &queries {
+            sources.push((resolve.clone(), 32));
+        }
+        let ring = forest_render::stats::StatsRing::new(device, sources);
         Ok(Self {
             camera,
             method_buf,
-            method: Cell::new(method),
-            forms: Cell::new(forest_render::forms::FORMS_GEOMETRY),
-            writes: Cell::new((0, 0)),
+            method,
+            forms: forest_render::forms::FORMS_GEOMETRY,
+            writes: (0, 0),
+            ring,
             reset: cpl("geo_reset"),
             classify: cpl("geo_classify"),
             args_pipeline: cpl("geo_args"),
@@ -922,30 +928,30 @@ impl GeometryRenderer {
     }
 
     /// Switch the method (a uniform write; nothing is rebuilt).
-    pub fn set_method(&self, ctx: &GpuContext, method: MeshMethod) -> Result<(), RenderError> {
+    pub fn set_method(&mut self, ctx: &GpuContext, method: MeshMethod) -> Result<(), RenderError> {
         method.validate()?;
         ctx.queue
             .write_buffer(&self.method_buf, 0, bytemuck::bytes_of(&method.to_gpu()));
-        self.method.set(method);
+        self.method = method;
         Ok(())
     }
 
     /// The current method.
     pub fn method(&self) -> MeshMethod {
-        self.method.get()
+        self.method
     }
 
     /// Which trees the renderer draws from the next camera write on (the camera's `forms`, see
     /// [`forest_render::forms`]); [`forest_render::forms::FORMS_GEOMETRY`], every tree, unless the hybrid
     /// method set it.
-    pub fn set_forms(&self, forms: [f32; 4]) {
-        self.forms.set(forms);
+    pub fn set_forms(&mut self, forms: [f32; 4]) {
+        self.forms = forms;
     }
 
     /// Write the camera and record the frame: classify, arguments, scatter, then draw the
     /// bands nearest first into `colour` and `depth`.
     pub fn encode(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         camera: &Camera,
         encoder: &mut wgpu::CommandEncoder,
@@ -976,18 +982,18 @@ impl GeometryRenderer {
     }
 
     /// Write the camera (with the renderer's `forms`): the one upload of a frame.
-    pub fn set_camera(&self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
+    pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
         camera.validate()?;
         let mut g = camera.to_gpu();
-        g.forms = self.forms.get();
-        forest_render::camera::upload(&ctx.queue, &self.camera, &g, &self.writes);
+        g.forms = self.forms;
+        forest_render::camera::upload(&ctx.queue, &self.camera, &g, &mut self.writes);
         Ok(())
     }
 
     /// Camera writes made by this renderer since it was created: (count, bytes). The method
     /// uniform is written only by [`Self::set_method`].
     pub fn uploads(&self) -> (u64, u64) {
-        self.writes.get()
+        self.writes
     }
 
     /// The compute pass of a frame: classify, arguments, scatter (after [`Self::set_camera`]).
@@ -1023,7 +1029,7 @@ impl GeometryRenderer {
             pass.draw(0..4, 0..1);
         }
         pass.set_bind_group(0, &self.draw_bg, &[]);
-        let first_billboard = self.method.get().first_billboard_band();
+        let first_billboard = self.method.first_billboard_band();
         for band in 0..BANDS {
             if band == 0 {
                 pass.set_pipeline(&self.draw);
@@ -1047,7 +1053,7 @@ impl GeometryRenderer {
 
     /// Write the camera, record the frame into `target`, and submit.
     pub fn render_frame(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         camera: &Camera,
         target: &Target,
@@ -1075,9 +1081,25 @@ impl GeometryRenderer {
     /// Counters and pass times of the last submitted frame; waits for the GPU.
     pub fn read_stats(&self, ctx: &GpuContext) -> GeometryStats {
         let n = (BANDS * self.species) as usize;
-        let args: Vec<[u32; 4]> =
-            bytemuck::pod_collect_to_vec(&ctx.read_buffer(&self.args, (n * 16) as u64)[..n * 16]);
-        let first_billboard = self.method.get().first_billboard_band();
+        let args = ctx.read_buffer(&self.args, (n * 16) as u64);
+        let times = self
+            .queries
+            .as_ref()
+            .map(|(_, resolve, _)| ctx.read_buffer(resolve, 32));
+        self.decode(&args, times.as_deref())
+    }
+
+    /// Counters of a recent frame without waiting (a few frames late; `None` until one has
+    /// arrived): see [`forest_render::stats::StatsRing`].
+    pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<GeometryStats> {
+        let parts = self.ring.poll(device, queue)?;
+        Some(self.decode(&parts[0], parts.get(1).map(|t| t.as_slice())))
+    }
+
+    fn decode(&self, args: &[u8], times: Option<&[u8]>) -> GeometryStats {
+        let n = ((BANDS * self.species) as usize).min(args.len() / 16);
+        let args: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&args[..n * 16]);
+        let first_billboard = self.method.first_billboard_band();
         let mut stats = GeometryStats {
             per_band: vec![0; BANDS as usize],
             ..Default::default()
@@ -1091,8 +1113,9 @@ impl GeometryRenderer {
                 stats.billboards += a[1];
             }
         }
-        stats.times = self.queries.as_ref().map(|(_, resolve, period)| {
-            let t: Vec<u64> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(resolve, 32));
+        let period = self.queries.as_ref().map_or(1.0, |q| q.2);
+        stats.times = times.filter(|t| t.len() >= 32).map(|t| {
+            let t: Vec<u64> = bytemuck::pod_collect_to_vec(&t[..32]);
             let ms = |a: usize| t[a + 1].saturating_sub(t[a]) as f64 * period / 1e6;
             PassTimes {
                 cull_ms: ms(0),

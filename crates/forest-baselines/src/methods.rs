@@ -3,15 +3,16 @@
 //! discrete LODs + billboards), and the hybrid (near trees as geometry, the rest as quads). Switching is a uniform write or an iteration count: nothing is
 //! rebuilt, so a viewer or a benchmark can compare methods frame by frame.
 
-use std::cell::Cell;
-
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::forms::{FORMS_GEOMETRY, FORMS_QUADS};
-use forest_render::renderer::{PassTimes, QuadStream};
+use forest_render::stats::PassTimes;
+use forest_render::stream::QuadStream;
 use forest_render::target::Target;
 
-use crate::geometry::{GeometryRenderer, MeshMethod};
+use forest_render::stats::FrameStats;
+
+use crate::geometry::{GeometryRenderer, GeometryStats, MeshMethod};
 use crate::hybrid::Hybrid;
 
 /// A rendering method.
@@ -69,49 +70,46 @@ pub struct ForestRenderer {
     pub stream: QuadStream,
     /// The geometry-based methods, when the species' models were prepared.
     pub geometry: Option<GeometryRenderer>,
-    method: Cell<Method>,
+    method: Method,
 }
 
 impl ForestRenderer {
     /// Start with the quad stream.
-    pub fn new(stream: QuadStream, geometry: Option<GeometryRenderer>) -> Self {
+    pub fn new(mut stream: QuadStream, geometry: Option<GeometryRenderer>) -> Self {
         stream.set_refine(true);
         Self {
             stream,
             geometry,
-            method: Cell::new(Method::Quads),
+            method: Method::Quads,
         }
     }
 
     /// The current method.
     pub fn method(&self) -> Method {
-        self.method.get()
+        self.method
     }
 
     /// Switch the method; the geometry-based ones and the hybrid need the geometry renderer.
-    pub fn set_method(&self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
-        let geometry = || {
-            self.geometry
-                .as_ref()
-                .ok_or_else(|| RenderError::MissingData {
-                    method: method.name(),
-                    needs: "the species' OBJ models",
-                })
+    pub fn set_method(&mut self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
+        let missing = RenderError::MissingData {
+            method: method.name(),
+            needs: "the species' OBJ models",
         };
         match method {
             Method::Quads | Method::Impostor => self.stream.set_refine(method == Method::Quads),
-            Method::Mesh(m) => geometry()?.set_method(ctx, m)?,
+            Method::Mesh(m) => self.geometry.as_mut().ok_or(missing)?.set_method(ctx, m)?,
             Method::Hybrid(h) => {
                 h.validate()?;
-                geometry()?.set_method(ctx, h.near_form)?;
+                let g = self.geometry.as_mut().ok_or(missing)?;
+                g.set_method(ctx, h.near_form)?;
                 self.stream.set_refine(true);
             }
         }
         self.stream.set_forms(FORMS_QUADS);
-        if let Some(g) = &self.geometry {
+        if let Some(g) = &mut self.geometry {
             g.set_forms(FORMS_GEOMETRY);
         }
-        self.method.set(method);
+        self.method = method;
         Ok(())
     }
 
@@ -128,18 +126,19 @@ impl ForestRenderer {
 
     /// Write the camera and record one frame of the current method.
     pub fn encode(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         camera: &Camera,
         encoder: &mut wgpu::CommandEncoder,
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) -> Result<(), CameraError> {
-        match (self.method.get(), &self.geometry) {
+        let levels = self.coarsest_levels();
+        match (self.method, &mut self.geometry) {
             (Method::Mesh(_), Some(g)) => g.encode(ctx, camera, encoder, colour, depth),
             (Method::Hybrid(h), Some(g)) => {
                 camera.validate()?;
-                let forms = h.forms(camera, self.coarsest_levels());
+                let forms = h.forms(camera, levels);
                 self.stream.set_forms(forms);
                 g.set_forms(forms);
                 self.stream.set_camera(ctx, camera)?;
@@ -152,7 +151,7 @@ impl ForestRenderer {
                         "hybrid draw",
                         colour,
                         depth,
-                        self.stream_background(),
+                        self.stream.background().clear_colour(),
                         self.stream.draw_timestamps(),
                     );
                     // Opaque geometry first, depth written; then the quads back to front,
@@ -172,10 +171,6 @@ impl ForestRenderer {
         }
     }
 
-    fn stream_background(&self) -> wgpu::Color {
-        self.stream.background().clear_colour()
-    }
-
     /// Camera writes of both forms since they were created: (count, bytes). A hybrid frame
     /// writes the camera once for each form and nothing else.
     pub fn uploads(&self) -> (u64, u64) {
@@ -186,7 +181,7 @@ impl ForestRenderer {
 
     /// Write the camera, record the frame into `target`, and submit.
     pub fn render_frame(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         camera: &Camera,
         target: &Target,
@@ -205,10 +200,45 @@ impl ForestRenderer {
 
     /// Counters and pass times of the last submitted frame; waits for the GPU.
     pub fn read_stats(&self, ctx: &GpuContext) -> MethodStats {
-        match (self.method.get(), &self.geometry) {
+        self.combine(
+            || self.stream.read_stats(ctx),
+            |g: &GeometryRenderer| g.read_stats(ctx),
+        )
+    }
+
+    /// Counters of a recent frame without waiting (a few frames late; `None` until the
+    /// read-backs of the current method have arrived): for frame loops.
+    pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<MethodStats> {
+        let quads = || self.stream.poll_stats(device, queue);
+        let geometry = |g: &GeometryRenderer| g.poll_stats(device, queue);
+        match (self.method, &self.geometry) {
             (Method::Hybrid(_), Some(g)) => {
-                let q = self.stream.read_stats(ctx);
-                let s = g.read_stats(ctx);
+                // Both rings are polled every time, so they advance together.
+                let (q, s) = (quads(), geometry(g));
+                let (q, s) = (q?, s?);
+                Some(self.combine(|| q, |_| s))
+            }
+            (Method::Mesh(_), Some(g)) => {
+                let s = geometry(g)?;
+                Some(self.combine(FrameStats::default, |_| s))
+            }
+            _ => {
+                let q = quads()?;
+                Some(self.combine(|| q, |_| GeometryStats::default()))
+            }
+        }
+    }
+
+    /// The current method's statistics from the stream's and the geometry renderer's.
+    fn combine(
+        &self,
+        quads: impl FnOnce() -> FrameStats,
+        geometry: impl FnOnce(&GeometryRenderer) -> GeometryStats,
+    ) -> MethodStats {
+        match (self.method, &self.geometry) {
+            (Method::Hybrid(_), Some(g)) => {
+                let q = quads();
+                let s = geometry(g);
                 MethodStats {
                     visible_trees: q.visible_trees,
                     primitives: u64::from(q.quads) + s.triangles,
@@ -224,7 +254,7 @@ impl ForestRenderer {
                 }
             }
             (Method::Mesh(_), Some(g)) => {
-                let s = g.read_stats(ctx);
+                let s = geometry(g);
                 MethodStats {
                     visible_trees: s.visible_trees,
                     primitives: s.triangles,
@@ -236,7 +266,7 @@ impl ForestRenderer {
                 }
             }
             _ => {
-                let s = self.stream.read_stats(ctx);
+                let s = quads();
                 MethodStats {
                     visible_trees: s.visible_trees,
                     primitives: u64::from(s.quads),

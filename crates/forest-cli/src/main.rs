@@ -17,6 +17,17 @@ mod window;
 /// embedded so text renders the same everywhere.
 pub(crate) const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 
+/// How the front ends store colour layers on the GPU: `FOREST_COLOUR_FORMAT=bc7|rgba8`
+/// overrides the library's automatic choice (BC7 on GPUs, RGBA8 on CPU rasterisers). The
+/// library itself reads no environment: this is the command's policy.
+pub(crate) fn colour_format() -> forest_render::ColourFormat {
+    match std::env::var("FOREST_COLOUR_FORMAT").as_deref() {
+        Ok("bc7") => forest_render::ColourFormat::Bc7,
+        Ok("rgba8") => forest_render::ColourFormat::Rgba8,
+        _ => forest_render::ColourFormat::Auto,
+    }
+}
+
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
 #[command(name = "forest", version, about, long_about = None)]

@@ -10,7 +10,7 @@ use forest_baselines::geometry::{
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
-use forest_render::renderer::{AspectBlend, RendererOptions, StreamOptions};
+use forest_render::options::{AspectBlend, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
@@ -322,7 +322,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return render_geometry(args, m, &ctx, &forest, &species, &cameras);
     }
     let (sw, sh) = stream_viewport(args);
-    let stream = stream_for(args, &ctx, &species, &forest)?;
+    let mut stream = stream_for(args, &ctx, &species, &forest)?;
     stream.set_options(args.m.stream_options());
     let target = Target::new(&ctx, sw, sh);
     for (name, cam) in &cameras {
@@ -379,7 +379,7 @@ fn stream_for(
     species: &[SpeciesData],
     forest: &Forest,
 ) -> Result<QuadStream> {
-    let scene = GpuScene::new(ctx, species, forest)?;
+    let scene = GpuScene::with_format(ctx, species, forest, crate::colour_format())?;
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         min_epsilon: args.epsilon.min(8.0),
@@ -388,7 +388,7 @@ fn stream_for(
         refine: args.m.method != "impostor",
         ..Default::default()
     };
-    let stream = QuadStream::new(ctx, scene, &opts)?;
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
     stream.set_options(args.m.stream_options());
     Ok(stream)
 }
@@ -404,7 +404,7 @@ fn render_hybrid(
 ) -> Result<()> {
     let prepared = prepare_models(&args.m.models, species)?;
     let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
-    let r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
+    let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
     let (sw, sh) = stream_viewport(args);
     let target = Target::new(ctx, sw, sh);
@@ -448,11 +448,11 @@ fn render_hybrid(
     Ok(())
 }
 
-fn background(args: &RenderArgs) -> forest_render::renderer::Background {
+fn background(args: &RenderArgs) -> forest_render::options::Background {
     if args.transparent {
-        forest_render::renderer::Background::Transparent
+        forest_render::options::Background::Transparent
     } else {
-        forest_render::renderer::Background::Sky
+        forest_render::options::Background::Sky
     }
 }
 
@@ -515,7 +515,7 @@ fn render_geometry(
     cameras: &[(String, Camera)],
 ) -> Result<()> {
     let prepared = prepare_models(&args.m.models, species)?;
-    let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
+    let mut geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
     geo.set_method(ctx, method)?;
     let (sw, sh) = (
         args.size.0 * args.supersample,

@@ -11,7 +11,7 @@ use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::ForestRenderer;
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
-use forest_render::renderer::{Background, DebugView, RendererOptions};
+use forest_render::options::{Background, DebugView, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
@@ -78,8 +78,8 @@ fn quad_stream(
         ..Default::default()
     };
     Ok(QuadStream::new(
-        ctx,
-        GpuScene::new(ctx, species, forest)?,
+        &ctx.device,
+        GpuScene::with_format(ctx, species, forest, crate::colour_format())?,
         &opts,
     )?)
 }
@@ -156,7 +156,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         )?),
         None => None,
     };
-    let r = ForestRenderer::new(
+    let mut r = ForestRenderer::new(
         quad_stream(
             &ctx,
             &species,

@@ -21,8 +21,8 @@ use forest_baselines::geometry::MeshMethod;
 use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::camera_path::CameraPath;
 use forest_render::context::GpuContext;
+use forest_render::options::DebugView;
 use forest_render::passes::draw::DEPTH_FORMAT;
-use forest_render::renderer::DebugView;
 use forest_render::{Camera, QuadStream};
 use glam::Vec3;
 use winit::application::ApplicationHandler;
@@ -466,7 +466,7 @@ impl Viewer {
     }
 
     fn set_method(&mut self, i: usize) -> Result<()> {
-        if let (Some(g), Some(m)) = (&self.gfx, self.methods.get(i)) {
+        if let (Some(g), Some(m)) = (&mut self.gfx, self.methods.get(i)) {
             g.renderer.set_method(&g.ctx, *m)?;
             self.method = i;
         }
@@ -516,7 +516,7 @@ impl Viewer {
 
     fn set_debug(&mut self, v: DebugView) {
         self.debug = v;
-        if let Some(g) = &self.gfx {
+        if let Some(g) = &mut self.gfx {
             g.renderer.stream.set_debug_view(v);
         }
     }
@@ -611,8 +611,12 @@ impl Viewer {
             g.ctx.queue.submit(extra.into_iter().chain([enc.finish()]));
             g.window.pre_present_notify();
             g.ctx.queue.present(output);
-            self.stats = g.renderer.read_stats(&g.ctx);
-            g.ctx.check_errors()?;
+            // Statistics arrive a few frames late and errors as wgpu reports them: the frame
+            // loop never waits for the GPU.
+            if let Some(stats) = g.renderer.poll_stats(&g.ctx.device, &g.ctx.queue) {
+                self.stats = stats;
+            }
+            g.ctx.check_reported_errors()?;
             if self.first_frame {
                 self.first_frame = false;
                 // (Rust's stdout is line-buffered: each line reaches a pipe as it is printed.)
@@ -640,8 +644,10 @@ impl Viewer {
     /// Render the current view (without the HUD) offscreen with the window's pipelines and
     /// save it, with its camera as a one-key path beside it.
     fn screenshot(&mut self) -> Result<()> {
-        let Some(g) = &self.gfx else { return Ok(()) };
         let cam = self.camera();
+        let Some(g) = &mut self.gfx else {
+            return Ok(());
+        };
         let target = forest_render::target::Target::with_format(
             &g.ctx,
             cam.viewport.0,
@@ -741,7 +747,7 @@ fn assemble(
     stream: QuadStream,
     geometry: Option<GeometryRenderer>,
 ) -> Result<ForestRenderer> {
-    let r = ForestRenderer::new(stream, geometry);
+    let mut r = ForestRenderer::new(stream, geometry);
     r.set_method(ctx, method)?;
     r.stream.set_debug_view(debug);
     Ok(r)

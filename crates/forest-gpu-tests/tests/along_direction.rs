@@ -4,7 +4,7 @@
 mod common;
 
 use forest_format::shading::{srgb_decode_table, srgb_encode};
-use forest_render::renderer::{Background, RendererOptions};
+use forest_render::options::{Background, RendererOptions};
 use forest_render::target::Target;
 use forest_render::{GpuScene, QuadStream};
 
@@ -23,7 +23,7 @@ fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
         background: Background::Transparent,
         ..Default::default()
     };
-    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     let target = Target::new(&ctx, res, res);
     let sphere = atlas.manifest.bounding_sphere;
     let table = srgb_decode_table();

@@ -5,7 +5,7 @@
 mod common;
 
 use forest_format::shading::srgb_decode_table;
-use forest_render::renderer::{
+use forest_render::options::{
     Background, DebugView, LEVEL_COLOURS, RendererOptions, direction_colour,
 };
 use forest_render::target::Target;
@@ -30,14 +30,14 @@ fn stream(refine: bool) -> (forest_render::GpuContext, QuadStream, Target) {
         refine,
         ..Default::default()
     };
-    let s = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let s = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     let t = Target::new(&ctx, SIZE, SIZE);
     (ctx, s, t)
 }
 
 fn render(
     ctx: &forest_render::GpuContext,
-    s: &QuadStream,
+    s: &mut QuadStream,
     t: &Target,
     cam: &Camera,
     view: DebugView,
@@ -80,8 +80,8 @@ fn close_camera(epsilon: f32) -> Camera {
 
 #[test]
 fn levels_view_colours_impostors_as_level_zero() {
-    let (ctx, s, t) = stream(false);
-    let img = render(&ctx, &s, &t, &close_camera(0.5), DebugView::Levels);
+    let (ctx, mut s, t) = stream(false);
+    let img = render(&ctx, &mut s, &t, &close_camera(0.5), DebugView::Levels);
     let colours = covered_colours(&img);
     assert!(colours.len() > 200, "only {} covered pixels", colours.len());
     let off: Vec<_> = colours
@@ -99,14 +99,14 @@ fn levels_view_colours_impostors_as_level_zero() {
 
 #[test]
 fn levels_view_shows_exactly_the_levels_in_the_stream() {
-    let (ctx, s, t) = stream(true);
+    let (ctx, mut s, t) = stream(true);
     // One aspect per tree, so that no pixel mixes two levels' colours.
-    s.set_options(forest_render::renderer::StreamOptions {
-        blend: forest_render::renderer::AspectBlend::Nearest,
+    s.set_options(forest_render::options::StreamOptions {
+        blend: forest_render::options::AspectBlend::Nearest,
         ..Default::default()
     });
     // ε large enough that the tree is a mix of levels.
-    let img = render(&ctx, &s, &t, &close_camera(24.0), DebugView::Levels);
+    let img = render(&ctx, &mut s, &t, &close_camera(24.0), DebugView::Levels);
     let stats = s.read_stats(&ctx);
     let colours = covered_colours(&img);
     let present: Vec<usize> = (0..LEVEL_COLOURS.len())
@@ -137,7 +137,7 @@ fn levels_view_shows_exactly_the_levels_in_the_stream() {
 
 #[test]
 fn weights_view_shows_the_one_direction_seen_exactly_along() {
-    let (ctx, s, t) = stream(false);
+    let (ctx, mut s, t) = stream(false);
     let atlas = &common::atlases()[0];
     let sphere = atlas.manifest.bounding_sphere;
     let mut checked = 0;
@@ -146,7 +146,7 @@ fn weights_view_shows_the_one_direction_seen_exactly_along() {
             continue; // the zenith: a look-at camera has no up vector there
         }
         let cam = common::along(sphere.center, sphere.radius, frame.dir, SIZE, 0.5);
-        let colours = covered_colours(&render(&ctx, &s, &t, &cam, DebugView::Weights));
+        let colours = covered_colours(&render(&ctx, &mut s, &t, &cam, DebugView::Weights));
         assert!(
             colours.len() > 100,
             "direction {d}: {} covered pixels",
@@ -165,10 +165,10 @@ fn weights_view_shows_the_one_direction_seen_exactly_along() {
 
 #[test]
 fn wireframe_view_outlines_quads_over_the_textured_image() {
-    let (ctx, s, t) = stream(true);
+    let (ctx, mut s, t) = stream(true);
     let cam = close_camera(2.0);
-    let plain = render(&ctx, &s, &t, &cam, DebugView::Off);
-    let wire = render(&ctx, &s, &t, &cam, DebugView::Wireframe);
+    let plain = render(&ctx, &mut s, &t, &cam, DebugView::Off);
+    let wire = render(&ctx, &mut s, &t, &cam, DebugView::Wireframe);
     let line = |p: &image::Rgba<u8>| p[0] > 240 && p[1] > 230 && p[2] < 140 && p[3] == 255;
     let lines = wire.pixels().filter(|p| line(p)).count();
     let plain_lines = plain.pixels().filter(|p| line(p)).count();
@@ -188,5 +188,5 @@ fn wireframe_view_outlines_quads_over_the_textured_image() {
         "only {same} of {n} pixels unchanged off the outlines"
     );
     // Switching back restores the plain image exactly.
-    assert_eq!(render(&ctx, &s, &t, &cam, DebugView::Off), plain);
+    assert_eq!(render(&ctx, &mut s, &t, &cam, DebugView::Off), plain);
 }

@@ -12,7 +12,7 @@ use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeom
 use forest_format::forest::{Forest, Instance};
 use forest_format::{Atlas, BakeParams, PlaneFit};
 use forest_render::Camera;
-use forest_render::renderer::{AspectBlend, Background, RendererOptions, StreamOptions};
+use forest_render::options::{AspectBlend, Background, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{GpuContext, GpuScene, QuadStream};
@@ -125,7 +125,7 @@ fn render_quads(
         background: Background::Transparent,
         ..Default::default()
     };
-    let stream = QuadStream::new(ctx, scene, &opts).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     stream.set_options(options);
     let target = Target::new(ctx, SIZE.0, SIZE.1);
     stream.render_frame(ctx, cam, &target).unwrap();
@@ -135,7 +135,7 @@ fn render_quads(
 }
 
 fn reference(ctx: &GpuContext, cam: &Camera) -> image::RgbaImage {
-    let geo = GeometryRenderer::new(
+    let mut geo = GeometryRenderer::new(
         ctx,
         prepared(),
         &one_pine(),

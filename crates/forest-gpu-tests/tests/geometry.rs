@@ -3,7 +3,7 @@
 mod common;
 
 use forest_baselines::geometry::{GeometryRenderer, downsample};
-use forest_render::renderer::{Background, RendererOptions};
+use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{GpuScene, QuadStream};
 
@@ -11,7 +11,7 @@ use forest_render::{GpuScene, QuadStream};
 fn quad_stream_resembles_the_supersampled_full_geometry() {
     let ctx = common::ctx();
     let forest = common::forest(300);
-    let geo = GeometryRenderer::new(
+    let mut geo = GeometryRenderer::new(
         &ctx,
         common::prepared(),
         &forest,
@@ -27,7 +27,7 @@ fn quad_stream_resembles_the_supersampled_full_geometry() {
         background: Background::Transparent,
         ..Default::default()
     };
-    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     let (name, mut cam) = common::cameras(forest.extent()).remove(2);
     cam.epsilon = 1.0;
     let small = Target::new(&ctx, 160, 120);
@@ -90,7 +90,7 @@ fn per_vertex_sun_visibility_matches_the_bakes_lighting_better_than_none() {
     let unshadowed = traced.map_sun_visibility(|_| 1.0);
     let mut flips = [0f32; 2];
     for (k, prepared) in [traced, &unshadowed].into_iter().enumerate() {
-        let geo = GeometryRenderer::new(
+        let mut geo = GeometryRenderer::new(
             &ctx,
             prepared,
             &forest,

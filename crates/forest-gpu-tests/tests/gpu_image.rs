@@ -4,7 +4,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use forest_render::renderer::RendererOptions;
+use forest_render::options::RendererOptions;
 use forest_render::target::Target;
 use forest_render::{GpuScene, QuadStream};
 
@@ -32,7 +32,7 @@ fn renders_match_the_stored_references() {
         min_epsilon: 4.0,
         ..Default::default()
     };
-    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     let target = Target::new(&ctx, 160, 120);
     let mut failures = Vec::new();
     for (name, cam) in common::cameras(forest.extent()) {
@@ -80,8 +80,8 @@ fn a_frame_writes_only_the_camera() {
     let ctx = common::ctx();
     let forest = common::forest(100);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-    let stream = QuadStream::new(
-        &ctx,
+    let mut stream = QuadStream::new(
+        &ctx.device,
         scene,
         &RendererOptions {
             viewport: (64, 48),
@@ -117,8 +117,8 @@ fn an_empty_forest_and_bad_cameras_are_handled() {
     forest.instances.clear();
     forest.presort = forest_format::forest::Presort::new(&[], 15);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-    let stream = QuadStream::new(
-        &ctx,
+    let mut stream = QuadStream::new(
+        &ctx.device,
         scene,
         &RendererOptions {
             viewport: (32, 32),
@@ -159,7 +159,7 @@ fn bc7_colour_renders_like_rgba8() {
             min_epsilon: 4.0,
             ..Default::default()
         };
-        let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+        let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
         let target = Target::new(&ctx, 160, 120);
         stream.render_frame(&ctx, &cam, &target).unwrap();
         images.push(target.read(&ctx));
@@ -195,7 +195,7 @@ fn a_bgra_target_reads_back_like_an_rgba_one() {
             format,
             ..Default::default()
         };
-        let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+        let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
         let target = Target::with_format(&ctx, 160, 120, format).unwrap();
         stream.render_frame(&ctx, &cam, &target).unwrap();
         images.push(target.read(&ctx));

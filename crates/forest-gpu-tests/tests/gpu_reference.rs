@@ -2,8 +2,8 @@
 
 mod common;
 
+use forest_render::options::RendererOptions;
 use forest_render::reference;
-use forest_render::renderer::RendererOptions;
 use forest_render::target::Target;
 use forest_render::{GpuScene, QuadStream};
 
@@ -17,7 +17,7 @@ fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
         max_quads,
         ..Default::default()
     };
-    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     let target = Target::new(&ctx, 160, 120);
     let side = forest.extent();
     let mut summary = Vec::new();
@@ -102,7 +102,7 @@ fn static_impostors_are_the_level0_stream() {
         refine: false,
         ..Default::default()
     };
-    let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     assert_eq!(stream.iterations(), 0);
     let target = Target::new(&ctx, 160, 120);
     for (name, cam) in common::cameras(forest.extent()) {

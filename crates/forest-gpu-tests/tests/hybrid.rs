@@ -11,7 +11,7 @@ use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
 use forest_render::forms as hybrid;
-use forest_render::renderer::{Background, RendererOptions};
+use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream, reference};
 use glam::Vec3;
@@ -32,10 +32,18 @@ fn renderer(
     };
     let geometry =
         GeometryRenderer::new(ctx, common::prepared(), forest, TARGET_FORMAT, background).unwrap();
-    ForestRenderer::new(QuadStream::new(ctx, scene, &opts).unwrap(), Some(geometry))
+    ForestRenderer::new(
+        QuadStream::new(&ctx.device, scene, &opts).unwrap(),
+        Some(geometry),
+    )
 }
 
-fn frame(ctx: &GpuContext, r: &ForestRenderer, method: Method, cam: &Camera) -> image::RgbaImage {
+fn frame(
+    ctx: &GpuContext,
+    r: &mut ForestRenderer,
+    method: Method,
+    cam: &Camera,
+) -> image::RgbaImage {
     r.set_method(ctx, method).unwrap();
     let target = Target::new(ctx, cam.viewport.0, cam.viewport.1);
     r.render_frame(ctx, cam, &target).unwrap();
@@ -62,17 +70,17 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     let ctx = common::ctx();
     let forest = common::forest(300);
     for background in [Background::Transparent, Background::Sky] {
-        let r = renderer(&ctx, &forest, (160, 120), background);
+        let mut r = renderer(&ctx, &forest, (160, 120), background);
         for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
-            let quads = frame(&ctx, &r, Method::Quads, &cam);
-            let zero = frame(&ctx, &r, hybrid_at(0.0), &cam);
+            let quads = frame(&ctx, &mut r, Method::Quads, &cam);
+            let zero = frame(&ctx, &mut r, hybrid_at(0.0), &cam);
             let geometry = frame(
                 &ctx,
-                &r,
+                &mut r,
                 Method::Mesh(MeshMethod::Full { depth_sort: true }),
                 &cam,
             );
-            let infinity = frame(&ctx, &r, hybrid_at(f32::INFINITY), &cam);
+            let infinity = frame(&ctx, &mut r, hybrid_at(f32::INFINITY), &cam);
             assert_ne!(quads, geometry, "{name}: the two forms differ");
             for (what, got, want) in [
                 ("at 0", &zero, &quads),
@@ -116,11 +124,11 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
     let ctx = common::ctx();
     for species in [0, 1] {
         let forest = common::one_tree(species, 0.4);
-        let r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
+        let mut r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
         let cam = common::camera(Vec3::new(2.0, 2.0, 9.0), Vec3::new(0.0, 2.0, 0.0), 2.0);
         let (d, radius) = tree_distance(&r, &cam, 0);
-        let quads = frame(&ctx, &r, hybrid_at(0.0), &cam);
-        let geometry = frame(&ctx, &r, hybrid_at(f32::INFINITY), &cam);
+        let quads = frame(&ctx, &mut r, hybrid_at(0.0), &cam);
+        let geometry = frame(&ctx, &mut r, hybrid_at(f32::INFINITY), &cam);
         // The band [d/1.4, d/1.4 · 1.8] puts the tree half-way through.
         let method = Method::Hybrid(Hybrid {
             near: Near::Metres(d / 1.4),
@@ -128,7 +136,7 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
             jitter: 0.0,
             ..Default::default()
         });
-        let mixed = frame(&ctx, &r, method, &cam);
+        let mixed = frame(&ctx, &mut r, method, &cam);
         let Method::Hybrid(h) = method else {
             unreachable!()
         };
@@ -190,7 +198,7 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
 fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera() {
     let ctx = common::ctx();
     let forest = common::forest(2000);
-    let r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
+    let mut r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
     let target = Target::new(&ctx, 160, 120);
     let h = Hybrid {
         near: Near::Metres(10.0),
@@ -260,8 +268,8 @@ fn empty_single_and_million_tree_forests_render_without_errors() {
             common::cameras(forest.extent().max(10.0)).remove(0).1
         };
         cam.far = 40.0;
-        let r = renderer(&ctx, forest, cam.viewport, Background::Transparent);
-        let img = frame(&ctx, &r, Method::Hybrid(Hybrid::default()), &cam);
+        let mut r = renderer(&ctx, forest, cam.viewport, Background::Transparent);
+        let img = frame(&ctx, &mut r, Method::Hybrid(Hybrid::default()), &cam);
         let stats = r.read_stats(&ctx);
         assert_eq!(ctx.take_errors(), Vec::<String>::new(), "{name}");
         let covered = img.pixels().filter(|p| p[3] > 0).count();

@@ -7,7 +7,7 @@ mod common;
 use forest_bake::lod::BANDS;
 use forest_baselines::geometry::{GeometryRenderer, Lods, MeshMethod, Stochastic};
 use forest_format::forest::Forest;
-use forest_render::renderer::{Background, RendererOptions};
+use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 use glam::Vec3;
@@ -25,7 +25,7 @@ fn geometry(ctx: &GpuContext, forest: &Forest) -> GeometryRenderer {
 
 fn draw(
     ctx: &GpuContext,
-    geo: &GeometryRenderer,
+    geo: &mut GeometryRenderer,
     method: MeshMethod,
     cam: &Camera,
 ) -> image::RgbaImage {
@@ -51,20 +51,20 @@ fn save_on_failure(name: &str, images: &[(&str, &image::RgbaImage)]) {
 fn maximum_detail_draws_exactly_the_full_geometry() {
     let ctx = common::ctx();
     let forest = common::forest(300);
-    let geo = geometry(&ctx, &forest);
+    let mut geo = geometry(&ctx, &forest);
     let (_, cam) = common::cameras(forest.extent()).remove(0);
-    let full = draw(&ctx, &geo, MeshMethod::Full { depth_sort: false }, &cam);
+    let full = draw(&ctx, &mut geo, MeshMethod::Full { depth_sort: false }, &cam);
     assert!(covered(&full) > 160 * 120 / 10, "trees in view");
-    let sorted = draw(&ctx, &geo, MeshMethod::Full { depth_sort: true }, &cam);
+    let sorted = draw(&ctx, &mut geo, MeshMethod::Full { depth_sort: true }, &cam);
     let stochastic = MeshMethod::Stochastic(Stochastic {
         d0: 1e6,
         ..Default::default()
     });
-    let lambda_one = draw(&ctx, &geo, stochastic, &cam);
+    let lambda_one = draw(&ctx, &mut geo, stochastic, &cam);
     let lod0 = MeshMethod::Lods(Lods {
         distances: [1e5, 2e5, 3e5],
     });
-    let lod_zero = draw(&ctx, &geo, lod0, &cam);
+    let lod_zero = draw(&ctx, &mut geo, lod0, &cam);
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     for (name, img) in [
         ("depth-sorted", &sorted),
@@ -99,7 +99,7 @@ fn maximum_detail_draws_exactly_the_full_geometry() {
             }),
         ),
     ] {
-        let img = draw(&ctx, &geo, method, &cam);
+        let img = draw(&ctx, &mut geo, method, &cam);
         let stats = geo.read_stats(&ctx);
         let m = forest_metrics::compare(&full, &img).unwrap();
         eprintln!(
@@ -166,7 +166,7 @@ fn cpu_segments(
 fn gpu_bands_match_the_cpu_classification() {
     let ctx = common::ctx();
     let forest = common::forest(2000);
-    let geo = geometry(&ctx, &forest);
+    let mut geo = geometry(&ctx, &forest);
     let spheres: Vec<(Vec3, f32)> = ["bush", "pine"]
         .iter()
         .map(|s| {
@@ -235,10 +235,10 @@ fn every_method_renders_empty_single_and_million_tree_forests() {
             common::cameras(forest.extent().max(10.0)).remove(0).1
         };
         cam.far = 40.0;
-        let geo = geometry(&ctx, forest);
+        let mut geo = geometry(&ctx, forest);
         let mut images = Vec::new();
         for (name, method) in methods {
-            images.push((name, draw(&ctx, &geo, method, &cam)));
+            images.push((name, draw(&ctx, &mut geo, method, &cam)));
             assert_eq!(
                 ctx.take_errors(),
                 Vec::<String>::new(),
@@ -253,7 +253,7 @@ fn every_method_renders_empty_single_and_million_tree_forests() {
                 refine,
                 ..Default::default()
             };
-            let stream = QuadStream::new(&ctx, scene, &opts).unwrap();
+            let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
             let target = Target::new(&ctx, cam.viewport.0, cam.viewport.1);
             stream.render_frame(&ctx, &cam, &target).unwrap();
             images.push((name, target.read(&ctx)));
@@ -287,7 +287,7 @@ fn switching_methods_at_run_time_reproduces_each_methods_own_frame() {
     };
     let stream = || GpuScene::new(&ctx, &common::species(), &forest).unwrap();
     let alone = |refine| {
-        let s = QuadStream::new(&ctx, stream(), &opts(refine)).unwrap();
+        let mut s = QuadStream::new(&ctx.device, stream(), &opts(refine)).unwrap();
         let t = Target::new(&ctx, cam.viewport.0, cam.viewport.1);
         s.render_frame(&ctx, &cam, &t).unwrap();
         t.read(&ctx)
@@ -297,10 +297,13 @@ fn switching_methods_at_run_time_reproduces_each_methods_own_frame() {
     let lods = MeshMethod::Lods(Lods {
         distances: [4.0, 8.0, 16.0],
     });
-    let geo = geometry(&ctx, &forest);
-    let lods_alone = draw(&ctx, &geo, lods, &cam);
+    let mut geo = geometry(&ctx, &forest);
+    let lods_alone = draw(&ctx, &mut geo, lods, &cam);
 
-    let without = ForestRenderer::new(QuadStream::new(&ctx, stream(), &opts(true)).unwrap(), None);
+    let mut without = ForestRenderer::new(
+        QuadStream::new(&ctx.device, stream(), &opts(true)).unwrap(),
+        None,
+    );
     let err = without
         .set_method(&ctx, Method::Mesh(lods))
         .unwrap_err()
@@ -312,8 +315,8 @@ fn switching_methods_at_run_time_reproduces_each_methods_own_frame() {
         "a refused switch changes nothing"
     );
 
-    let all = ForestRenderer::new(
-        QuadStream::new(&ctx, stream(), &opts(false)).unwrap(),
+    let mut all = ForestRenderer::new(
+        QuadStream::new(&ctx.device, stream(), &opts(false)).unwrap(),
         Some(geometry(&ctx, &forest)),
     );
     let target = Target::new(&ctx, cam.viewport.0, cam.viewport.1);

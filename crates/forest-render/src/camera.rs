@@ -1,6 +1,8 @@
 //! A perspective camera and its GPU form (the only per-frame upload).
 
-use glam::{Mat4, Vec3, Vec4};
+#[cfg(test)]
+use glam::Vec4;
+use glam::{Mat4, Vec3};
 
 use crate::gpu_types::GpuCamera;
 
@@ -74,55 +76,51 @@ impl Camera {
         (self.target - self.eye).normalize()
     }
 
-    /// Projection × view (right-handed, depth 0..1 as wgpu expects).
-    pub fn view_proj(&self) -> Mat4 {
+    /// World → view (right-handed, +Y up).
+    pub fn view(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.eye, self.target, Vec3::Y)
+    }
+
+    /// View → clip: wgpu's clip space, y up, depth 0..1 (glam's "directx" convention).
+    pub fn proj(&self) -> Mat4 {
         let aspect = self.viewport.0 as f32 / self.viewport.1 as f32;
-        // wgpu's clip space: y up, depth 0..1 (glam's "directx" convention).
-        let proj = glam::camera::rh::proj::directx::perspective(
+        glam::camera::rh::proj::directx::perspective(
             self.fov_y_deg.to_radians(),
             aspect,
             self.near,
             self.far,
-        );
-        proj * glam::camera::rh::view::look_at_mat4(self.eye, self.target, Vec3::Y)
+        )
+    }
+
+    /// Projection × view.
+    pub fn view_proj(&self) -> Mat4 {
+        self.proj() * self.view()
     }
 
     /// The GPU form: matrix, eye and ε, forward, viewport, normalised frustum planes; every
     /// tree drawn as quads (renderers set `forms` for the method they draw).
     pub fn to_gpu(&self) -> GpuCamera {
-        let m = self.view_proj();
-        let rows = [m.row(0), m.row(1), m.row(2), m.row(3)];
-        let planes = [
-            rows[3] + rows[0],
-            rows[3] - rows[0],
-            rows[3] + rows[1],
-            rows[3] - rows[1],
-            rows[2],
-            rows[3] - rows[2],
-        ]
-        .map(|p: Vec4| (p / p.truncate().length()).to_array());
-        GpuCamera {
-            view_proj: m.to_cols_array_2d(),
-            eye: self.eye.extend(self.epsilon).to_array(),
-            forward: self.forward().extend(0.0).to_array(),
-            viewport: [self.viewport.0 as f32, self.viewport.1 as f32, 0.0, 0.0],
-            planes,
-            forms: crate::forms::FORMS_QUADS,
-        }
+        crate::frame::gpu_camera(
+            self.view_proj(),
+            self.eye,
+            self.forward(),
+            self.viewport,
+            self.epsilon,
+        )
     }
 }
 
 /// Write a renderer's camera uniform and count the write in `writes` (count, bytes): what
-/// every renderer's `set_camera` does once it has filled in its own fields.
+/// every renderer's `prepare` does once it has filled in its own fields.
 pub fn upload(
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,
     camera: &GpuCamera,
-    writes: &std::cell::Cell<(u64, u64)>,
+    writes: &mut (u64, u64),
 ) {
     queue.write_buffer(buffer, 0, bytemuck::bytes_of(camera));
-    let (n, bytes) = writes.get();
-    writes.set((n + 1, bytes + std::mem::size_of::<GpuCamera>() as u64));
+    writes.0 += 1;
+    writes.1 += std::mem::size_of::<GpuCamera>() as u64;
 }
 
 #[cfg(test)]

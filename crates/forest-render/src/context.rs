@@ -91,6 +91,17 @@ impl GpuContext {
         std::mem::take(&mut *self.errors.lock().unwrap())
     }
 
+    /// Fail with [`RenderError::Gpu`] if wgpu has reported errors since the last check
+    /// (drained), without waiting for the GPU: for frame loops.
+    pub fn check_reported_errors(&self) -> Result<(), RenderError> {
+        let errors = std::mem::take(&mut *self.errors.lock().unwrap_or_else(|e| e.into_inner()));
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            Err(RenderError::Gpu(errors))
+        }
+    }
+
     /// Fail with [`RenderError::Gpu`] if errors were reported since the last call (drained).
     pub fn check_errors(&self) -> Result<(), RenderError> {
         let errors = self.take_errors();
@@ -141,16 +152,14 @@ impl GpuContext {
     ///
     /// [`ColourFormat::Auto`]: BC7 when the device has BC textures and is not a CPU rasteriser
     /// (lavapipe decodes BC7 in software on every sample, which made drawing ~10× slower
-    /// there), unless `FOREST_COLOUR_FORMAT=bc7|rgba8` says otherwise.
+    /// there).
     pub fn use_bc7(&self, choice: ColourFormat) -> bool {
         match choice {
             ColourFormat::Bc7 => self.has_bc(),
             ColourFormat::Rgba8 => false,
-            ColourFormat::Auto => match std::env::var("FOREST_COLOUR_FORMAT").as_deref() {
-                Ok("bc7") => self.has_bc(),
-                Ok("rgba8") => false,
-                _ => self.has_bc() && self.adapter_info.device_type != wgpu::DeviceType::Cpu,
-            },
+            ColourFormat::Auto => {
+                self.has_bc() && self.adapter_info.device_type != wgpu::DeviceType::Cpu
+            }
         }
     }
 }

@@ -14,7 +14,7 @@ pub struct GpuCamera {
     /// Unit view direction (world).
     pub forward: [f32; 4],
     /// Viewport width and height in pixels; `z`: the draw pass's debug view
-    /// ([`crate::renderer::DebugView`] as a number, 0 = off); `w` unused.
+    /// ([`crate::options::DebugView`] as a number, 0 = off); `w` unused.
     pub viewport: [f32; 4],
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],

@@ -8,7 +8,7 @@ use forest_format::QuadNode;
 use forest_format::node::ERROR_BOUNDS;
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE};
-use crate::renderer::{FLAG_DEPTH_ERROR, FLAG_NEAREST};
+use crate::options::{FLAG_DEPTH_ERROR, FLAG_NEAREST};
 use crate::scene::SceneTables;
 
 /// Result of the reference: the final stream and the frame's counters.
@@ -49,7 +49,7 @@ fn unorm12(x: f32) -> u32 {
     (x.clamp(0.0, 1.0) * 4095.0 + 0.5).floor() as u32
 }
 
-/// The camera's stream flags (`viewport.w`, see [`crate::renderer::StreamOptions::flags`]).
+/// The camera's stream flags (`viewport.w`, see [`crate::options::StreamOptions::flags`]).
 fn flags(cam: &GpuCamera) -> u32 {
     cam.viewport[3] as u32
 }

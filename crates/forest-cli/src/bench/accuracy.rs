@@ -10,7 +10,7 @@ use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
 use forest_format::generate::SplitMix64;
 use forest_render::Camera;
-use forest_render::renderer::Background;
+use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
@@ -136,7 +136,7 @@ pub fn walkthrough(side: f32, viewport: (u32, u32), n: usize) -> Vec<Camera> {
 }
 
 /// The 4×4 supersampled full-geometry reference of `cam`, downsampled.
-pub fn reference(b: &Bench, r: &ForestRenderer, cam: &Camera) -> Result<image::RgbaImage> {
+pub fn reference(b: &Bench, r: &mut ForestRenderer, cam: &Camera) -> Result<image::RgbaImage> {
     let (w, h) = cam.viewport;
     let big = Target::new(&b.ctx, w * REFERENCE_SS, h * REFERENCE_SS);
     let mut c = *cam;
@@ -233,7 +233,7 @@ fn epsilon_of(param: &str) -> f32 {
 pub fn run(b: &Bench) -> Result<Section> {
     let (trees, side, viewport) = scene(b);
     let forest = b.forest(trees, side, 7)?;
-    let r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
+    let mut r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&COLUMNS);
     let walk = walk_cameras(b.quick);
@@ -245,7 +245,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     for (view, cams) in groups {
         let references = cams
             .iter()
-            .map(|c| reference(b, &r, c))
+            .map(|c| reference(b, &mut r, c))
             .collect::<Result<Vec<_>>>()?;
         for (method, param) in settings(b.quick) {
             // Means over the view's cameras (one, or the walkthrough's).
@@ -253,7 +253,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             for (cam, reference) in cams.iter().zip(&references) {
                 let mut c = *cam;
                 c.epsilon = epsilon_of(&param);
-                let (s, t) = b.measure(&r, method, &c, &target, b.frames_for(method))?;
+                let (s, t) = b.measure(&mut r, method, &c, &target, b.frames_for(method))?;
                 let m = forest_metrics::compare(reference, &target.read(&b.ctx))?;
                 frame_ms += t;
                 flip += f64::from(m.flip_mean);

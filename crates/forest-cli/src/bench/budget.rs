@@ -4,7 +4,7 @@
 use anyhow::Result;
 use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::renderer::Background;
+use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
@@ -69,8 +69,8 @@ pub fn run(b: &Bench) -> Result<Section> {
         viewport,
         epsilon,
     };
-    let geo = b.renderer(&forest, viewport, epsilon, true, Background::Transparent)?;
-    let reference = reference(b, &geo, &cam)?;
+    let mut geo = b.renderer(&forest, viewport, epsilon, true, Background::Transparent)?;
+    let reference = reference(b, &mut geo, &cam)?;
     drop(geo);
     let mut table = Table::new(&[
         "choice",
@@ -107,15 +107,15 @@ pub fn run(b: &Bench) -> Result<Section> {
             gpu += out.atlas.manifest.gpu_bytes();
             species.push(forest_render::scene::SpeciesData::load(&path)?);
         }
-        let scene = forest_render::GpuScene::new(&b.ctx, &species, &forest)?;
+        let scene = forest_render::GpuScene::with_format(&b.ctx, &species, &forest, crate::colour_format())?;
         let opts = forest_render::RendererOptions {
             viewport,
             min_epsilon: epsilon,
             background: Background::Transparent,
             ..Default::default()
         };
-        let stream = forest_render::QuadStream::new(&b.ctx, scene, &opts)?;
-        let r = forest_baselines::methods::ForestRenderer::new(stream, None);
+        let stream = forest_render::QuadStream::new(&b.ctx.device, scene, &opts)?;
+        let mut r = forest_baselines::methods::ForestRenderer::new(stream, None);
         // The quads the scene needs: the most any of its views (the nearest, and the accuracy
         // suite's mid-range and bird's-eye) draws; a quarter more is the suggested capacity.
         let mut most = 0u64;
@@ -125,9 +125,13 @@ pub fn run(b: &Bench) -> Result<Section> {
         {
             let mut v = v;
             v.epsilon = epsilon;
-            most = most.max(b.measure(&r, Method::Quads, &v, &target, 0)?.0.primitives);
+            most = most.max(
+                b.measure(&mut r, Method::Quads, &v, &target, 0)?
+                    .0
+                    .primitives,
+            );
         }
-        let (s, t) = b.measure(&r, Method::Quads, &cam, &target, b.frames)?;
+        let (s, t) = b.measure(&mut r, Method::Quads, &cam, &target, b.frames)?;
         most = most.max(s.primitives);
         let m = forest_metrics::compare(&reference, &target.read(&b.ctx))?;
         let suggested =
@@ -194,7 +198,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         .filter_map(|m| m.parent())
         .map(folder_bytes)
         .sum();
-    let r = b.renderer(&forest, viewport, epsilon, true, Background::Transparent)?;
+    let mut r = b.renderer(&forest, viewport, epsilon, true, Background::Transparent)?;
     let geometry_gpu = r.geometry.as_ref().map_or(0, |g| g.gpu_bytes);
     let levels = b.species[0].atlas.manifest.nodes_per_level.len();
     let mut hybrid_rows = Vec::new();
@@ -208,7 +212,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             near,
             ..Default::default()
         });
-        let (s, t) = b.measure(&r, method, &cam, &target, b.frames)?;
+        let (s, t) = b.measure(&mut r, method, &cam, &target, b.frames)?;
         let m = forest_metrics::compare(&reference, &target.read(&b.ctx))?;
         let name = match near {
             forest_baselines::hybrid::Near::Auto => "hybrid near=auto".to_string(),

@@ -10,7 +10,7 @@ use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::{DEFAULT_PRESORT_DIRECTIONS, Forest, Instance};
 use forest_format::generate::SplitMix64;
 use forest_format::{BakeParams, ColourEncoding, PlaneFit};
-use forest_render::renderer::{AspectBlend, Background, StreamOptions};
+use forest_render::options::{AspectBlend, Background, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuScene, QuadStream, RendererOptions};
@@ -227,7 +227,7 @@ fn scratch_renderer(
     let species = vec![SpeciesData::load(path)?];
     let gpu = species[0].atlas.manifest.gpu_bytes();
     let forest = one_tree(vec![path.display().to_string()], 0);
-    let scene = GpuScene::new(&b.ctx, &species, &forest)?;
+    let scene = GpuScene::with_format(&b.ctx, &species, &forest, crate::colour_format())?;
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         viewport,
@@ -235,7 +235,7 @@ fn scratch_renderer(
         background: Background::Transparent,
         ..Default::default()
     };
-    let stream = QuadStream::new(&b.ctx, scene, &opts)?;
+    let stream = QuadStream::new(&b.ctx.device, scene, &opts)?;
     Ok((ForestRenderer::new(stream, None), gpu))
 }
 
@@ -293,11 +293,11 @@ pub fn run(b: &Bench) -> Result<Section> {
                 .unwrap_or_else(|| format!("species{k}"));
             let views = views(data, n, viewport, SEED.wrapping_add(k as u64));
             let forest = one_tree(names.clone(), k as u32);
-            let r0 = b.renderer(&forest, viewport, EPS, true, Background::Transparent)?;
+            let mut r0 = b.renderer(&forest, viewport, EPS, true, Background::Transparent)?;
             eprintln!("fidelity: {species}: {n} references (4x4 supersampled full geometry)");
             let refs = views
                 .iter()
-                .map(|v| reference(b, &r0, &v.cam))
+                .map(|v| reference(b, &mut r0, &v.cam))
                 .collect::<Result<Vec<_>>>()?;
             let mut base = data.atlas.manifest.params;
             if quick {
@@ -307,11 +307,11 @@ pub fn run(b: &Bench) -> Result<Section> {
             for (vi, v) in variants.iter().enumerate() {
                 let start = std::time::Instant::now();
                 // The renderer of this variant: the one given, or a scratch re-bake.
-                let scratch_r;
+                let mut scratch_r;
                 let r = match v.bake {
                     None => {
                         gpu_bytes[vi] += data.atlas.manifest.gpu_bytes();
-                        &r0
+                        &mut r0
                     }
                     Some(change) => {
                         let params = change(base);
@@ -338,7 +338,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                                 bake_resolutions.push(params.resolution);
                                 gpu_bytes[vi] += gpu;
                                 scratch_r = r;
-                                &scratch_r
+                                &mut scratch_r
                             }
                             Err(e) => {
                                 eprintln!("fidelity: {species} {}: FAILED: {e:#}", v.name);

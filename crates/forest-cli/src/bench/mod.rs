@@ -22,8 +22,9 @@ use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::forest::Forest;
 use forest_format::generate::{GenerateParams, generate};
-use forest_render::renderer::{Background, PassTimes, RendererOptions};
+use forest_render::options::{Background, RendererOptions};
 use forest_render::scene::SpeciesData;
+use forest_render::stats::PassTimes;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
@@ -214,7 +215,7 @@ impl Bench {
         geometry: bool,
         background: Background,
     ) -> Result<ForestRenderer> {
-        let scene = GpuScene::new(&self.ctx, &self.species, forest)?;
+        let scene = GpuScene::with_format(&self.ctx, &self.species, forest, crate::colour_format())?;
         let opts = RendererOptions {
             format: TARGET_FORMAT,
             viewport,
@@ -222,7 +223,7 @@ impl Bench {
             background,
             ..Default::default()
         };
-        let stream = QuadStream::new(&self.ctx, scene, &opts)?;
+        let stream = QuadStream::new(&self.ctx.device, scene, &opts)?;
         let geo = if geometry {
             Some(GeometryRenderer::new(
                 &self.ctx,
@@ -242,7 +243,7 @@ impl Bench {
     /// median GPU frame time (cull + refine + draw).
     pub fn measure(
         &self,
-        r: &ForestRenderer,
+        r: &mut ForestRenderer,
         method: Method,
         cam: &Camera,
         target: &Target,
@@ -256,7 +257,7 @@ impl Bench {
     /// median frame total).
     pub fn measure_passes(
         &self,
-        r: &ForestRenderer,
+        r: &mut ForestRenderer,
         method: Method,
         cam: &Camera,
         target: &Target,

@@ -5,7 +5,7 @@ use anyhow::Result;
 use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
 use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::renderer::Background;
+use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
@@ -41,7 +41,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     };
     let geometry = !b.models.is_empty();
     let forest = b.forest(trees, side, 11)?;
-    let r = b.renderer(&forest, viewport, 16.0, geometry, Background::Sky)?;
+    let mut r = b.renderer(&forest, viewport, 16.0, geometry, Background::Sky)?;
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut methods = vec![(Method::Quads, 1), (Method::Impostor, 1)];
     if geometry {
@@ -71,7 +71,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         for i in (0..views).step_by(stride) {
             let cam = view(i, views, side, viewport);
             // One measured frame per view: the hundred views are the samples.
-            let (st, t) = b.measure(&r, method, &cam, &target, 1)?;
+            let (st, t) = b.measure(&mut r, method, &cam, &target, 1)?;
             s.points.push((f64::from(i), t));
             table.push(vec![
                 i.to_string(),

@@ -6,7 +6,7 @@ use forest_baselines::geometry::{MeshMethod, Stochastic};
 use forest_baselines::methods::Method;
 use forest_format::forest::{Forest, Instance};
 use forest_render::Camera;
-use forest_render::renderer::Background;
+use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
@@ -123,7 +123,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     let frames = if b.quick { 2 } else { 6 };
     let forest = b.forest(trees, side, 7)?;
     let dense = cluster(b);
-    let renderers = [
+    let mut renderers = [
         b.renderer(&forest, viewport, 4.0, true, Background::Transparent)?,
         b.renderer(&dense, viewport, 4.0, true, Background::Transparent)?,
     ];
@@ -146,7 +146,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         })
         .collect();
     for (ci, (case, in_cluster, camera)) in cases(&forest, side, viewport).into_iter().enumerate() {
-        let r = &renderers[usize::from(in_cluster)];
+        let r = &mut renderers[usize::from(in_cluster)];
         let cams: Vec<Camera> = (0..frames)
             .map(|f| camera(f as f32 / (frames - 1).max(1) as f32))
             .collect();

@@ -8,7 +8,7 @@ use anyhow::Result;
 use forest_baselines::geometry::GeometryRenderer;
 use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::renderer::Background;
+use forest_render::options::Background;
 use forest_render::target::{TARGET_FORMAT, Target};
 
 use super::chart::{Chart, Series};
@@ -183,7 +183,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     let side = if b.quick { 100.0 } else { 1000.0 };
     for &n in &sizes {
         let forest = b.forest(n, side, 1)?;
-        let r = b.renderer(&forest, viewport, 16.0, false, Background::Sky)?;
+        let mut r = b.renderer(&forest, viewport, 16.0, false, Background::Sky)?;
         for (view, eye, t) in super::table1::views(side) {
             let cam = Camera {
                 eye,
@@ -194,7 +194,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 viewport,
                 epsilon: 16.0,
             };
-            let (s, _) = b.measure(&r, Method::Quads, &cam, &target, 1)?;
+            let (s, _) = b.measure(&mut r, Method::Quads, &cam, &target, 1)?;
             let need = s.primitives * 16 * 2;
             let alloc = r.stream.capacity.bytes();
             needed

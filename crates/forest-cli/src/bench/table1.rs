@@ -4,7 +4,7 @@
 use anyhow::Result;
 use forest_baselines::methods::Method;
 use forest_render::Camera;
-use forest_render::renderer::Background;
+use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
@@ -65,7 +65,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         .collect();
     for &trees in &sizes {
         let forest = b.forest(trees, side, 1)?;
-        let r = b.renderer(&forest, viewport, 16.0, false, Background::Sky)?;
+        let mut r = b.renderer(&forest, viewport, 16.0, false, Background::Sky)?;
         for (k, (view, eye, target_pt)) in views(side).into_iter().enumerate() {
             let cam = Camera {
                 eye,
@@ -76,7 +76,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 viewport,
                 epsilon: 16.0,
             };
-            let (s, p, _) = b.measure_passes(&r, Method::Quads, &cam, &target, b.frames)?;
+            let (s, p, _) = b.measure_passes(&mut r, Method::Quads, &cam, &target, b.frames)?;
             let (c, rf, d) = (p.cull_ms, p.refine_ms, p.draw_ms);
             series[k].points.push((f64::from(trees), c + rf + d));
             table.push(vec![

@@ -3,7 +3,8 @@
 
 use super::{args, draw_source};
 
-/// Depth format of the target the renderer draws into.
+/// Depth format of the targets the crate's own front ends draw into ([`crate::target`]);
+/// a host chooses its own in [`crate::options::RendererOptions`].
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// The draw pass's pipelines.
@@ -15,8 +16,10 @@ pub struct DrawPass {
 }
 
 impl DrawPass {
-    /// Create the pipelines for a colour target of `format`.
-    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+    /// Create the pipelines for the host's targets: colour and depth formats, sample count
+    /// and depth test from `opts`.
+    pub fn new(device: &wgpu::Device, opts: &crate::options::RendererOptions) -> Self {
+        let format = opts.format;
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -100,13 +103,16 @@ impl DrawPass {
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
+                    format: opts.depth_format,
                     depth_write_enabled: Some(depth_write),
-                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                    depth_compare: Some(opts.depth_compare()),
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
-                multisample: Default::default(),
+                multisample: wgpu::MultisampleState {
+                    count: opts.sample_count,
+                    ..Default::default()
+                },
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(fs),

@@ -1,0 +1,679 @@
+//! The quad stream of one view: the per-view buffers (camera, stream, scan, counters), the
+//! bind groups over a shared scene, and the frame function that records the three passes.
+//!
+//! The shape is that of wgpu middleware: build once from the device and the host's target
+//! formats; per frame, [`QuadStream::prepare`] writes the one camera buffer (the only upload),
+//! then [`QuadStream::encode_compute`] records cull and refine and [`QuadStream::render`] draws
+//! into the host's render pass, or [`QuadStream::encode_into`] does both into targets with the
+//! host's load operations. The scene is shared ([`Arc<GpuScene>`]): several views (split
+//! screen, shadow maps) are several streams over one upload, and [`QuadStream::resize`]
+//! rebuilds only the view's own buffers.
+
+use std::sync::Arc;
+
+use wgpu::util::DeviceExt;
+
+use crate::camera::{Camera, CameraError};
+use crate::capacity::{Capacity, CapacityInput};
+use crate::context::{GpuContext, RenderError};
+use crate::frame::{FrameParams, Targets};
+use crate::gpu_types::{GpuArgs, GpuCamera, GpuState, Quad, SceneConsts};
+use crate::options::{Background, DebugView, RendererOptions, StreamOptions, ground_uniform};
+use crate::passes::ComputeShared;
+use crate::passes::cull::CullPass;
+use crate::passes::draw::DrawPass;
+use crate::passes::refine::RefinePass;
+use crate::passes::scan::ScanPass;
+use crate::scene::GpuScene;
+use crate::stats::{FrameStats, PassTimes, StatsRing};
+
+/// Bytes of the resolved timestamps (six queries).
+const TIMESTAMP_BYTES: u64 = 48;
+
+/// The pipelines (built once per stream).
+struct Passes {
+    shared: ComputeShared,
+    cull: CullPass,
+    scan: ScanPass,
+    refine: RefinePass,
+    draw: DrawPass,
+}
+
+/// Everything whose size follows the capacity: rebuilt by [`QuadStream::resize`].
+struct Sized {
+    state: wgpu::Buffer,
+    args: wgpu::Buffer,
+    quads: [wgpu::Buffer; 2],
+    bg_cull: wgpu::BindGroup,
+    bg_ab: wgpu::BindGroup,
+    bg_ba: wgpu::BindGroup,
+    bg_draw: [wgpu::BindGroup; 2],
+    args_group: wgpu::BindGroup,
+    ring: StatsRing,
+    owned: Vec<(&'static str, wgpu::Buffer)>,
+}
+
+/// The quad stream of one view over a shared scene.
+pub struct QuadStream {
+    /// The uploaded scene (shared, immutable).
+    pub scene: Arc<GpuScene>,
+    /// Buffer sizes.
+    pub capacity: Capacity,
+    opts: RendererOptions,
+    passes: Passes,
+    camera: wgpu::Buffer,
+    ground: wgpu::Buffer,
+    sized: Sized,
+    levels: u32,
+    iterations: u32,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    writes: (u64, u64),
+    prepared: bool,
+    debug: DebugView,
+    options: StreamOptions,
+    forms: [f32; 4],
+}
+
+fn buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage,
+        mapped_at_creation: false,
+    })
+}
+
+fn capacity(scene: &GpuScene, opts: &RendererOptions) -> Capacity {
+    let t = &scene.tables;
+    Capacity::new(&CapacityInput {
+        instances: t.instances.len() as u32,
+        quads_per_tree: t.quads_per_tree.max(1),
+        viewport: opts.viewport,
+        min_epsilon: opts.min_epsilon,
+        overdraw: opts.overdraw,
+        max_quads: opts.max_quads,
+    })
+}
+
+impl QuadStream {
+    /// Build the stream of one view over `scene` for the host's targets (`opts`: colour and
+    /// depth formats, sample count, depth convention, and the largest viewport and smallest ε
+    /// that size the stream). Nothing is drawn until the first [`Self::prepare`].
+    pub fn new(
+        device: &wgpu::Device,
+        scene: impl Into<Arc<GpuScene>>,
+        opts: &RendererOptions,
+    ) -> Result<Self, RenderError> {
+        let scene = scene.into();
+        if !(1..=32).contains(&opts.sample_count) || !opts.sample_count.is_power_of_two() {
+            return Err(RenderError::Parameter(format!(
+                "sample count {} must be 1, 2, 4, 8, 16 or 32",
+                opts.sample_count
+            )));
+        }
+        if !opts.depth_format.is_depth_stencil_format() {
+            return Err(RenderError::Parameter(format!(
+                "{:?} is not a depth format",
+                opts.depth_format
+            )));
+        }
+        let capacity = capacity(&scene, opts);
+        let shared = ComputeShared::new(device);
+        let passes = Passes {
+            cull: CullPass::new(device, &shared),
+            scan: ScanPass::new(device, &shared),
+            refine: RefinePass::new(device, &shared),
+            draw: DrawPass::new(device, opts),
+            shared,
+        };
+        use wgpu::BufferUsages as U;
+        let camera = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("camera"),
+            contents: bytemuck::bytes_of(&crate::frame::nothing_visible()),
+            usage: U::UNIFORM | U::COPY_DST,
+        });
+        let ground = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("ground"),
+            contents: bytemuck::bytes_of(&ground_uniform(&opts.lighting, &scene.tables.instances)),
+            usage: U::UNIFORM,
+        });
+        let queries = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| {
+                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass times"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 6,
+                });
+                let resolve = buffer(
+                    device,
+                    "timestamps",
+                    TIMESTAMP_BYTES,
+                    U::QUERY_RESOLVE | U::COPY_SRC,
+                );
+                (set, resolve)
+            });
+        let sized = Self::build_sized(
+            device,
+            &scene,
+            &passes,
+            &camera,
+            &ground,
+            &capacity,
+            queries.as_ref().map(|q| &q.1),
+        )?;
+        let levels = scene.tables.max_levels;
+        Ok(Self {
+            iterations: if opts.refine {
+                levels.saturating_sub(1)
+            } else {
+                0
+            },
+            levels,
+            scene,
+            capacity,
+            opts: opts.clone(),
+            passes,
+            camera,
+            ground,
+            sized,
+            queries,
+            writes: (0, 0),
+            prepared: false,
+            debug: DebugView::Off,
+            options: StreamOptions::default(),
+            forms: crate::forms::FORMS_QUADS,
+        })
+    }
+
+    /// The per-view buffers and bind groups for `capacity`, checked against the device's
+    /// limits before anything is allocated.
+    fn build_sized(
+        device: &wgpu::Device,
+        scene: &GpuScene,
+        passes: &Passes,
+        camera: &wgpu::Buffer,
+        ground: &wgpu::Buffer,
+        capacity: &Capacity,
+        timestamps: Option<&wgpu::Buffer>,
+    ) -> Result<Sized, RenderError> {
+        let limit = device.limits().max_storage_buffer_binding_size;
+        let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
+        if quad_bytes > limit {
+            return Err(RenderError::DeviceLimit {
+                what: format!("a stream of {} quads (bytes per buffer)", capacity.quads),
+                needed: quad_bytes,
+                limit,
+                hint: ": lower the viewport or raise the minimum epsilon",
+            });
+        }
+        let t = &scene.tables;
+        use wgpu::BufferUsages as U;
+        let consts = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene constants"),
+            contents: bytemuck::bytes_of(&SceneConsts {
+                instances: t.instances.len() as u32,
+                presort_dirs: t.presort_dirs.len() as u32,
+                capacity: capacity.quads,
+                species: t.species.len() as u32,
+            }),
+            usage: U::UNIFORM,
+        });
+        let state = buffer(
+            device,
+            "state",
+            std::mem::size_of::<GpuState>() as u64,
+            U::STORAGE | U::COPY_SRC,
+        );
+        let args = buffer(
+            device,
+            "args",
+            std::mem::size_of::<GpuArgs>() as u64,
+            U::STORAGE | U::INDIRECT,
+        );
+        let spare = buffer(device, "spare", 16, U::STORAGE);
+        let args_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("indirect arguments"),
+            layout: &passes.shared.args_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: args.as_entire_binding(),
+            }],
+        });
+        let data = buffer(
+            device,
+            "scan data",
+            u64::from(capacity.items) * 4,
+            U::STORAGE,
+        );
+        let want = buffer(device, "want", u64::from(capacity.items) * 4, U::STORAGE);
+        let sums = buffer(
+            device,
+            "block sums",
+            u64::from(capacity.sums) * 4,
+            U::STORAGE,
+        );
+        let quads = [0, 1].map(|k| {
+            buffer(
+                device,
+                if k == 0 { "stream A" } else { "stream B" },
+                quad_bytes,
+                U::STORAGE | U::COPY_SRC,
+            )
+        });
+        let presort_view = scene.presort.create_view(&Default::default());
+        let nodes_view = scene.nodes.create_view(&Default::default());
+        let compute_bg = |label: &str, q_in: &wgpu::Buffer, q_out: &wgpu::Buffer| {
+            let res: [wgpu::BindingResource; 17] = [
+                camera.as_entire_binding(),
+                consts.as_entire_binding(),
+                scene.instances.as_entire_binding(),
+                scene.species.as_entire_binding(),
+                scene.frames.as_entire_binding(),
+                scene.tris.as_entire_binding(),
+                scene.roots.as_entire_binding(),
+                scene.presort_dirs.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&presort_view),
+                wgpu::BindingResource::TextureView(&nodes_view),
+                state.as_entire_binding(),
+                spare.as_entire_binding(),
+                data.as_entire_binding(),
+                sums.as_entire_binding(),
+                want.as_entire_binding(),
+                q_in.as_entire_binding(),
+                q_out.as_entire_binding(),
+            ];
+            let entries = crate::passes::numbered(res.into());
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &passes.shared.bind_layout,
+                entries: &entries,
+            })
+        };
+        let bg_cull = compute_bg("cull", &quads[1], &quads[0]);
+        let bg_ab = compute_bg("refine A->B", &quads[0], &quads[1]);
+        let bg_ba = compute_bg("refine B->A", &quads[1], &quads[0]);
+        let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("colour"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        // One draw group per stream buffer: the final stream is A after an even number of
+        // refinement iterations, B after an odd one (refinement can be switched at run time).
+        let bg_draw = [&quads[0], &quads[1]].map(|final_quads| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("draw"),
+                layout: &passes.draw.bind_layout,
+                entries: &crate::passes::numbered(vec![
+                    camera.as_entire_binding(),
+                    scene.instances.as_entire_binding(),
+                    scene.species.as_entire_binding(),
+                    scene.frames.as_entire_binding(),
+                    final_quads.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&nodes_view),
+                    wgpu::BindingResource::TextureView(&colour_view),
+                    wgpu::BindingResource::Sampler(&sampler),
+                    ground.as_entire_binding(),
+                ]),
+            })
+        });
+        let mut sources = vec![(state.clone(), std::mem::size_of::<GpuState>() as u64)];
+        if let Some(ts) = timestamps {
+            sources.push((ts.clone(), TIMESTAMP_BYTES));
+        }
+        let ring = StatsRing::new(device, sources);
+        let owned: Vec<(&'static str, wgpu::Buffer)> = [
+            ("camera", camera),
+            ("scene constants", &consts),
+            ("ground", ground),
+            ("state", &state),
+            ("args", &args),
+            ("spare", &spare),
+            ("scan data", &data),
+            ("want", &want),
+            ("block sums", &sums),
+            ("stream A", &quads[0]),
+            ("stream B", &quads[1]),
+            ("instances", &scene.instances),
+            ("species", &scene.species),
+            ("frames", &scene.frames),
+            ("direction triangles", &scene.tris),
+            ("roots", &scene.roots),
+            ("presort directions", &scene.presort_dirs),
+        ]
+        .into_iter()
+        .map(|(l, b)| (l, b.clone()))
+        .collect();
+        Ok(Sized {
+            state,
+            args,
+            quads,
+            bg_cull,
+            bg_ab,
+            bg_ba,
+            bg_draw,
+            args_group,
+            ring,
+            owned,
+        })
+    }
+
+    /// Resize for a new largest viewport: the stream, scan and counter buffers are rebuilt
+    /// for the new capacity; the scene (atlas textures, tables) is kept as it is, never
+    /// uploaded again. Nothing is rebuilt when the capacity does not change.
+    pub fn resize(
+        &mut self,
+        device: &wgpu::Device,
+        viewport: (u32, u32),
+    ) -> Result<(), RenderError> {
+        let opts = RendererOptions {
+            viewport,
+            ..self.opts.clone()
+        };
+        let capacity = capacity(&self.scene, &opts);
+        if capacity != self.capacity {
+            self.sized = Self::build_sized(
+                device,
+                &self.scene,
+                &self.passes,
+                &self.camera,
+                &self.ground,
+                &capacity,
+                self.queries.as_ref().map(|q| &q.1),
+            )?;
+            self.capacity = capacity;
+        }
+        self.opts = opts;
+        Ok(())
+    }
+
+    /// The options the stream was built with (viewport: the last [`Self::resize`]).
+    pub fn options_built(&self) -> &RendererOptions {
+        &self.opts
+    }
+
+    /// Number of refinement iterations per frame (`max levels − 1`; 0 without refinement).
+    pub fn iterations(&self) -> u32 {
+        self.iterations
+    }
+
+    /// Choose what the draw pass shows from the next [`Self::prepare`] on.
+    pub fn set_debug_view(&mut self, view: DebugView) {
+        self.debug = view;
+    }
+
+    /// The debug view in use.
+    pub fn debug_view(&self) -> DebugView {
+        self.debug
+    }
+
+    /// Choose the stream's run-time options from the next [`Self::prepare`] on.
+    pub fn set_options(&mut self, options: StreamOptions) {
+        self.options = options;
+    }
+
+    /// The run-time options in use.
+    pub fn options(&self) -> StreamOptions {
+        self.options
+    }
+
+    /// What the trees are drawn over when the stream clears the targets itself.
+    pub fn background(&self) -> Background {
+        self.opts.background
+    }
+
+    /// Which trees the stream draws from the next [`Self::prepare`] on (the camera's
+    /// `forms`, see [`crate::forms`]); [`crate::forms::FORMS_QUADS`], every tree, unless a
+    /// hybrid method set it.
+    pub fn set_forms(&mut self, forms: [f32; 4]) {
+        self.forms = forms;
+    }
+
+    /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
+    pub fn set_refine(&mut self, refine: bool) {
+        self.iterations = if refine {
+            self.levels.saturating_sub(1)
+        } else {
+            0
+        };
+    }
+
+    fn bindings(&self) -> crate::passes::StreamBindings<'_> {
+        crate::passes::StreamBindings {
+            cull: &self.sized.bg_cull,
+            ping: &self.sized.bg_ab,
+            pong: &self.sized.bg_ba,
+            args_group: &self.sized.args_group,
+            args_buf: &self.sized.args,
+        }
+    }
+
+    /// Write the frame's camera from the host's matrices: the one upload of a frame.
+    pub fn prepare(&mut self, queue: &wgpu::Queue, frame: &FrameParams) -> Result<(), RenderError> {
+        frame.validate()?;
+        self.write_camera(queue, frame.to_gpu());
+        Ok(())
+    }
+
+    /// [`Self::prepare`] from an eye/target [`Camera`] (the crate's front ends).
+    pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
+        camera.validate()?;
+        self.write_camera(&ctx.queue, camera.to_gpu());
+        Ok(())
+    }
+
+    fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
+        g.viewport[2] = self.debug as u32 as f32;
+        g.viewport[3] = self.options.flags() as f32;
+        g.forms = self.forms;
+        crate::camera::upload(queue, &self.camera, &g, &mut self.writes);
+        self.prepared = true;
+    }
+
+    /// Whether a camera was written (before that, frames draw nothing).
+    pub fn is_prepared(&self) -> bool {
+        self.prepared
+    }
+
+    /// Queue writes made by this stream since it was created: (count, bytes).
+    pub fn uploads(&self) -> (u64, u64) {
+        self.writes
+    }
+
+    /// Write the camera, record a frame into `target` (cleared to the background) and submit.
+    pub fn render_frame(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        target: &crate::target::Target,
+    ) -> Result<(), CameraError> {
+        self.set_camera(ctx, camera)?;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        self.encode(&mut enc, &target.colour_view, &target.depth_view);
+        ctx.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
+    /// The crate's own frame: cull, refine, then the ground (with the sky background) and the
+    /// quads into `colour` and `depth`, both cleared first (to the background and the far
+    /// depth).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        let targets = Targets::cleared(
+            colour,
+            depth,
+            self.opts.background.clear_colour(),
+            self.opts.depth_clear(),
+        );
+        self.encode_compute(encoder);
+        {
+            let mut pass = targets.begin(encoder, "draw", self.draw_timestamps());
+            self.record_draw(&mut pass, true);
+        }
+        self.resolve_times(encoder);
+    }
+
+    /// A host's frame: cull and refine, then the quads drawn into `targets` with its load
+    /// operations (no ground, nothing cleared unless `targets` says so).
+    pub fn encode_into(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
+        self.encode_compute(encoder);
+        {
+            let mut pass = targets.begin(encoder, "forest", self.draw_timestamps());
+            self.render(&mut pass);
+        }
+        self.resolve_times(encoder);
+    }
+
+    /// The compute passes of a frame: cull and refine (before the render pass that draws).
+    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        let ts = |b: u32| {
+            self.queries
+                .as_ref()
+                .map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(b),
+                    end_of_pass_write_index: Some(b + 1),
+                })
+        };
+        let p = &self.passes;
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cull"),
+                timestamp_writes: ts(0),
+            });
+            p.cull.record(&mut pass, &self.bindings(), &p.scan);
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("refine"),
+                timestamp_writes: ts(2),
+            });
+            p.refine
+                .record(&mut pass, self.iterations, &self.bindings(), &p.scan);
+        }
+    }
+
+    /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
+    /// or an earlier encoder of the submission): back to front, blended, depth-tested, no
+    /// depth written.
+    pub fn render(&self, pass: &mut wgpu::RenderPass) {
+        self.record_draw(pass, false);
+    }
+
+    /// Timestamp writes for the render pass that draws the stream (its draw time).
+    pub fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.queries
+            .as_ref()
+            .map(|(set, _)| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(4),
+                end_of_pass_write_index: Some(5),
+            })
+    }
+
+    /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
+    /// `ground` and the background is the sky), then the quads.
+    pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
+        self.passes.draw.record(
+            pass,
+            &self.sized.bg_draw[(self.iterations % 2) as usize],
+            &self.sized.args,
+            ground && self.opts.background == Background::Sky,
+        );
+    }
+
+    /// Resolve the frame's pass times (after the render pass that used
+    /// [`Self::draw_timestamps`]).
+    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some((set, resolve)) = &self.queries {
+            encoder.resolve_query_set(set, 0..6, resolve, 0);
+        }
+    }
+
+    fn decode(&self, state: &[u8], times: Option<&[u8]>, period: f32) -> FrameStats {
+        let mut s = GpuState::default();
+        let n = state.len().min(std::mem::size_of::<GpuState>());
+        bytemuck::bytes_of_mut(&mut s)[..n].copy_from_slice(&state[..n]);
+        let levels = self
+            .scene
+            .tables
+            .max_levels
+            .clamp(1, s.per_level.len() as u32) as usize;
+        let times = times
+            .filter(|t| t.len() >= TIMESTAMP_BYTES as usize)
+            .map(|t| {
+                let t: Vec<u64> = bytemuck::pod_collect_to_vec(&t[..TIMESTAMP_BYTES as usize]);
+                let ms = |a: usize| t[a + 1].saturating_sub(t[a]) as f64 * f64::from(period) / 1e6;
+                PassTimes {
+                    cull_ms: ms(0),
+                    refine_ms: ms(2),
+                    draw_ms: ms(4),
+                }
+            });
+        FrameStats {
+            presort: s.presort,
+            visible_trees: s.visible,
+            quads: s.quads,
+            per_level: s.per_level[..levels].to_vec(),
+            overflow_cull: s.overflow_cull,
+            overflow_refine: s.overflow_refine,
+            times,
+        }
+    }
+
+    /// Counters (and pass times) of the last submitted frame; waits for the GPU (tests,
+    /// benchmarks, screenshots). A frame loop uses [`Self::poll_stats`].
+    pub fn read_stats(&self, ctx: &GpuContext) -> FrameStats {
+        let state = ctx.read_buffer(&self.sized.state, std::mem::size_of::<GpuState>() as u64);
+        let times = self
+            .queries
+            .as_ref()
+            .map(|(_, resolve)| ctx.read_buffer(resolve, TIMESTAMP_BYTES));
+        self.decode(&state, times.as_deref(), ctx.queue.get_timestamp_period())
+    }
+
+    /// Counters of a recent frame without waiting: `None` until a read-back has arrived
+    /// (a few frames late; see [`crate::stats::StatsRing`]).
+    pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<FrameStats> {
+        let parts = self.sized.ring.poll(device, queue)?;
+        Some(self.decode(
+            &parts[0],
+            parts.get(1).map(|t| t.as_slice()),
+            queue.get_timestamp_period(),
+        ))
+    }
+
+    /// The final quad stream of the last submitted frame; waits for the GPU.
+    pub fn read_quads(&self, ctx: &GpuContext) -> Vec<Quad> {
+        let n = self.read_stats(ctx).quads as usize;
+        let buf = &self.sized.quads[(self.iterations % 2) as usize];
+        let bytes = ctx.read_buffer(buf, (n * std::mem::size_of::<Quad>()) as u64);
+        bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<Quad>()])
+    }
+
+    /// Labels of the stream's buffers that accept queue writes or copies (only the camera).
+    pub fn writable_buffers(&self) -> Vec<&'static str> {
+        self.sized
+            .owned
+            .iter()
+            .filter(|(_, b)| b.usage().contains(wgpu::BufferUsages::COPY_DST))
+            .map(|(l, _)| *l)
+            .collect()
+    }
+}
