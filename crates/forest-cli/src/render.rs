@@ -28,10 +28,10 @@ pub struct RenderArgs {
     #[arg(long = "view", value_parser = ["inside", "birds-eye"])]
     pub views: Vec<String>,
     /// Eye position x,y,z in metres (with --target, instead of --view).
-    #[arg(long, value_parser = parse_vec3, requires = "target")]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, requires = "target")]
     pub eye: Option<Vec3>,
     /// Point looked at, x,y,z.
-    #[arg(long, value_parser = parse_vec3, requires = "eye")]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, requires = "eye")]
     pub target: Option<Vec3>,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600", value_parser = parse_size)]

@@ -107,7 +107,12 @@ pub fn run(b: &Bench) -> Result<Section> {
             gpu += out.atlas.manifest.gpu_bytes();
             species.push(forest_render::scene::SpeciesData::load(&path)?);
         }
-        let scene = forest_render::GpuScene::with_format(&b.ctx, &species, &forest, crate::colour_format())?;
+        let scene = forest_render::GpuScene::with_format(
+            &b.ctx,
+            &species,
+            &forest,
+            crate::colour_format(),
+        )?;
         let opts = forest_render::RendererOptions {
             viewport,
             min_epsilon: epsilon,

@@ -215,7 +215,8 @@ impl Bench {
         geometry: bool,
         background: Background,
     ) -> Result<ForestRenderer> {
-        let scene = GpuScene::with_format(&self.ctx, &self.species, forest, crate::colour_format())?;
+        let scene =
+            GpuScene::with_format(&self.ctx, &self.species, forest, crate::colour_format())?;
         let opts = RendererOptions {
             format: TARGET_FORMAT,
             viewport,

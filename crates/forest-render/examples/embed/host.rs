@@ -1,0 +1,227 @@
+//! The host side of the embedding example: a renderer with its own sky and ground that draws a
+//! forest through `forest-render`'s public API, into targets it owns and clears itself. It uses
+//! reverse-Z with an infinite far plane, as many engines do.
+//!
+//! Per frame: the host writes its own uniform, `QuadStream::prepare` writes the forest's camera
+//! (its one upload), `encode_compute` records cull and refine, and the host's own render pass
+//! draws the ground and then `render`s the trees into it.
+
+use std::sync::Arc;
+
+use forest_render::options::{RendererOptions, SKY, ground_uniform};
+use forest_render::{FrameParams, GpuScene, QuadStream, RenderError};
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+/// Depth format of the host's targets.
+pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+const GROUND_WGSL: &str = r#"
+struct Host { view_proj: mat4x4<f32>, colour: vec4<f32>, eye: vec4<f32> }
+@group(0) @binding(0) var<uniform> host: Host;
+
+@vertex
+fn vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let s = host.colour.w;
+    let x = select(-s, s, (vi & 1u) == 1u) + host.eye.x;
+    let z = select(-s, s, (vi >> 1u) == 1u) + host.eye.z;
+    return host.view_proj * vec4<f32>(x, 0.0, z, 1.0);
+}
+
+@fragment
+fn fs() -> @location(0) vec4<f32> { return vec4<f32>(host.colour.xyz, 1.0); }
+"#;
+
+/// The host's uniform: its view-projection, the ground's colour and half side, the eye.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct HostUniform {
+    view_proj: [[f32; 4]; 4],
+    colour: [f32; 4],
+    eye: [f32; 4],
+}
+
+/// A host renderer: sky (its clear colour), ground (its own pipeline), then the forest.
+pub struct Host {
+    ground: wgpu::RenderPipeline,
+    uniform: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+    ground_colour: [f32; 4],
+    depth: wgpu::TextureView,
+    /// The forest of this view.
+    pub forest: QuadStream,
+}
+
+/// A reverse-Z perspective with an infinite far plane (60° vertical field of view, 0.1 m near).
+pub fn projection(size: (u32, u32)) -> Mat4 {
+    let aspect = size.0 as f32 / size.1 as f32;
+    glam::camera::rh::proj::directx::perspective_infinite_reverse(60f32.to_radians(), aspect, 0.1)
+}
+
+/// The frame parameters of a camera at `eye` looking at `target`.
+pub fn frame(eye: Vec3, target: Vec3, size: (u32, u32), epsilon: f32) -> FrameParams {
+    FrameParams {
+        view: glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y),
+        proj: projection(size),
+        viewport: size,
+        epsilon,
+    }
+}
+
+fn depth_view(device: &wgpu::Device, size: (u32, u32)) -> wgpu::TextureView {
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("host depth"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+impl Host {
+    /// The host's pipelines and a forest stream over `scene` for `format` targets of `size`.
+    pub fn new(
+        device: &wgpu::Device,
+        scene: Arc<GpuScene>,
+        format: wgpu::TextureFormat,
+        size: (u32, u32),
+    ) -> Result<Self, RenderError> {
+        let opts = RendererOptions {
+            format,
+            depth_format: DEPTH,
+            reverse_z: true,
+            viewport: size,
+            min_epsilon: 1.0,
+            ..Default::default()
+        };
+        // The ground colour `forest render` uses, so that the two frames can be compared.
+        let ground_colour = ground_uniform(&opts.lighting, &scene.tables.instances).colour;
+        let forest = QuadStream::new(device, scene, &opts)?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("host ground"),
+            source: wgpu::ShaderSource::Wgsl(GROUND_WGSL.into()),
+        });
+        let ground = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("host ground"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("host uniform"),
+            contents: bytemuck::bytes_of(&HostUniform {
+                view_proj: Mat4::IDENTITY.to_cols_array_2d(),
+                colour: ground_colour,
+                eye: [0.0; 4],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("host"),
+            layout: &ground.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            }],
+        });
+        Ok(Self {
+            ground,
+            uniform,
+            bind,
+            ground_colour,
+            depth: depth_view(device, size),
+            forest,
+        })
+    }
+
+    /// A new window size: the host's depth target and the forest's per-view buffers (the
+    /// scene is kept).
+    pub fn resize(&mut self, device: &wgpu::Device, size: (u32, u32)) -> Result<(), RenderError> {
+        self.depth = depth_view(device, size);
+        self.forest.resize(device, size)
+    }
+
+    /// Draw one frame into `colour` and submit it.
+    pub fn draw(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        colour: &wgpu::TextureView,
+        frame: &FrameParams,
+    ) -> Result<(), RenderError> {
+        let eye = frame.eye();
+        let host = HostUniform {
+            view_proj: (frame.proj * frame.view).to_cols_array_2d(),
+            colour: self.ground_colour,
+            eye: eye.extend(1.0).to_array(),
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&host));
+        self.forest.prepare(queue, frame)?;
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.forest.encode_compute(&mut encoder);
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("host frame"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: colour,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(SKY),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.ground);
+            pass.set_bind_group(0, &self.bind, &[]);
+            pass.draw(0..4, 0..1);
+            self.forest.render(&mut pass);
+        }
+        queue.submit([encoder.finish()]);
+        Ok(())
+    }
+}

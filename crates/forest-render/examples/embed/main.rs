@@ -1,0 +1,228 @@
+//! Embedding the forest in a host's own wgpu renderer: a plain winit + wgpu program that draws
+//! its sky and ground and then the trees through `forest-render`'s public API (see `host.rs`).
+//!
+//! ```sh
+//! cargo run --release -p forest-render --example embed -- out/demo.forest
+//! cargo run --release -p forest-render --example embed -- out/demo.forest --headless shot.png
+//! ```
+//! Options: `--eye X,Y,Z`, `--target X,Y,Z`, `--size WxH`, `--epsilon PX`. The window slowly
+//! circles the eye around the target; Escape quits.
+
+mod host;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use forest_format::forest::Forest;
+use forest_render::target::Target;
+use forest_render::{GpuContext, GpuScene, SpeciesData};
+use glam::Vec3;
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Window, WindowId};
+
+type Error = Box<dyn std::error::Error>;
+
+/// A forest and its species' atlases (named relative to the forest's folder), on the GPU.
+fn load(ctx: &GpuContext, path: &Path) -> Result<Arc<GpuScene>, Error> {
+    let forest = Forest::load(path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let species = forest
+        .species
+        .iter()
+        .map(|s| SpeciesData::load(&dir.join(s)))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Arc::new(GpuScene::new(ctx, &species, &forest)?))
+}
+
+/// Render one frame offscreen into a target the host clears itself, and read it back.
+pub fn headless(
+    forest: &Path,
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    epsilon: f32,
+) -> Result<image::RgbaImage, Error> {
+    let ctx = GpuContext::headless()?;
+    let scene = load(&ctx, forest)?;
+    let out = Target::new(&ctx, size.0, size.1);
+    let mut host = host::Host::new(&ctx.device, scene, out.format, size)?;
+    let frame = host::frame(eye, target, size, epsilon);
+    host.draw(&ctx.device, &ctx.queue, &out.colour_view, &frame)?;
+    let img = out.read(&ctx);
+    ctx.check_errors()?;
+    Ok(img)
+}
+
+struct App {
+    forest: PathBuf,
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    epsilon: f32,
+    start: std::time::Instant,
+    gfx: Option<(
+        Arc<Window>,
+        wgpu::Surface<'static>,
+        wgpu::SurfaceConfiguration,
+        GpuContext,
+        host::Host,
+    )>,
+    error: Option<Error>,
+}
+
+impl App {
+    fn init(&mut self, event_loop: &ActiveEventLoop) -> Result<(), Error> {
+        let attrs = Window::default_attributes()
+            .with_title("forest-render embedded")
+            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
+        let window = Arc::new(event_loop.create_window(attrs)?);
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+                Box::new(event_loop.owned_display_handle()),
+            ));
+        let surface = instance.create_surface(window.clone())?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))?;
+        let ctx = GpuContext::from_adapter(&adapter)?;
+        let inner = window.inner_size();
+        let config = surface
+            .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
+            .ok_or("the window's surface is not supported by the adapter")?;
+        surface.configure(&ctx.device, &config);
+        let scene = load(&ctx, &self.forest)?;
+        let host = host::Host::new(
+            &ctx.device,
+            scene,
+            config.format,
+            (config.width, config.height),
+        )?;
+        self.gfx = Some((window, surface, config, ctx, host));
+        Ok(())
+    }
+
+    fn redraw(&mut self) -> Result<(), Error> {
+        let Some((window, surface, config, ctx, host)) = &mut self.gfx else {
+            return Ok(());
+        };
+        let texture = match surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            _ => {
+                surface.configure(&ctx.device, config);
+                return Ok(());
+            }
+        };
+        let view = texture.texture.create_view(&Default::default());
+        let angle = self.start.elapsed().as_secs_f32() * 0.1;
+        let offset = self.eye - self.target;
+        let eye = self.target + glam::Quat::from_rotation_y(angle) * offset;
+        let frame = host::frame(
+            eye,
+            self.target,
+            (config.width, config.height),
+            self.epsilon,
+        );
+        host.draw(&ctx.device, &ctx.queue, &view, &frame)?;
+        window.pre_present_notify();
+        ctx.queue.present(texture);
+        ctx.check_reported_errors()?;
+        window.request_redraw();
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_none()
+            && let Err(e) = self.init(event_loop)
+        {
+            self.error = Some(e);
+            event_loop.exit();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. }
+                if event.logical_key
+                    == winit::keyboard::Key::Named(winit::keyboard::NamedKey::Escape) =>
+            {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => match &mut self.gfx {
+                Some((_, surface, config, ctx, host)) => {
+                    config.width = size.width.max(1);
+                    config.height = size.height.max(1);
+                    surface.configure(&ctx.device, config);
+                    host.resize(&ctx.device, (config.width, config.height))
+                        .map_err(Error::from)
+                }
+                None => Ok(()),
+            },
+            WindowEvent::RedrawRequested => self.redraw(),
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.error = Some(e);
+            event_loop.exit();
+        }
+    }
+}
+
+fn vec3(s: &str) -> Result<Vec3, Error> {
+    let v: Vec<f32> = s.split(',').map(str::parse).collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, z] => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("{s:?} is not X,Y,Z").into()),
+    }
+}
+
+fn main() -> Result<(), Error> {
+    let mut args = std::env::args().skip(1);
+    let mut forest = None;
+    let (mut eye, mut target) = (Vec3::new(0.0, 30.0, 60.0), Vec3::ZERO);
+    let (mut size, mut epsilon, mut headless_out) = ((960, 540), 2.0, None);
+    while let Some(a) = args.next() {
+        let mut value = || args.next().ok_or(format!("{a} needs a value"));
+        match a.as_str() {
+            "--eye" => eye = vec3(&value()?)?,
+            "--target" => target = vec3(&value()?)?,
+            "--epsilon" => epsilon = value()?.parse()?,
+            "--headless" => headless_out = Some(PathBuf::from(value()?)),
+            "--size" => {
+                let v = value()?;
+                let (w, h) = v.split_once('x').ok_or(format!("{v:?} is not WxH"))?;
+                size = (w.parse()?, h.parse()?);
+            }
+            _ if forest.is_none() && !a.starts_with("--") => forest = Some(PathBuf::from(a)),
+            _ => return Err(format!("unexpected argument {a:?}").into()),
+        }
+    }
+    let forest = forest.ok_or("usage: embed FOREST [--headless OUT.png] [--eye X,Y,Z] …")?;
+    if let Some(out) = headless_out {
+        headless(&forest, eye, target, size, epsilon)?.save(&out)?;
+        println!("wrote {}", out.display());
+        return Ok(());
+    }
+    let mut app = App {
+        forest,
+        eye,
+        target,
+        size,
+        epsilon,
+        start: std::time::Instant::now(),
+        gfx: None,
+        error: None,
+    };
+    EventLoop::new()?.run_app(&mut app)?;
+    app.error.map_or(Ok(()), Err)
+}
