@@ -109,6 +109,8 @@ fn drawing_over_a_host_frame_keeps_its_pixels_where_no_tree_is() {
         empty > 500 && full > 500,
         "{empty} empty, {full} covered pixels"
     );
+    let mean = diff / f64::from(full);
+    assert!(mean < 1.5, "covered pixels differ by {mean} sRGB steps on average");
 }
 
 #[test]
