@@ -106,3 +106,33 @@ fn shaders_validate() {
         .unwrap_or_else(|e| panic!("{e:?}"));
     }
 }
+
+#[test]
+fn bind_group_layouts_and_constants_match_the_wgsl() {
+    use forest_baselines::geometry::{RESET_WG, compute_entries, draw_entries};
+    use forest_baselines::shaders::{GEOMETRY_CULL_WGSL, GEOMETRY_DRAW_WGSL};
+    let cull = GEOMETRY_CULL_WGSL.concat();
+    let draw = GEOMETRY_DRAW_WGSL.concat();
+    assert_eq!(
+        layout_check::reflected_bindings(&cull),
+        layout_check::layout_bindings(0, &compute_entries())
+    );
+    // The ground's stages have a group of their own.
+    layout_check::check_layout(
+        &draw,
+        &layout_check::layout_bindings(0, &draw_entries()),
+        |e| !e.contains("ground"),
+    );
+    assert_eq!(
+        layout_check::wgsl_const(&cull, "BANDS"),
+        f64::from(forest_bake::lod::BANDS)
+    );
+    for (entry, size) in layout_check::workgroup_sizes(&cull) {
+        let want = match entry.as_str() {
+            "geo_reset" => RESET_WG,
+            "geo_args" => 1,
+            _ => forest_render::capacity::WG,
+        };
+        assert_eq!(size, want, "{entry}");
+    }
+}

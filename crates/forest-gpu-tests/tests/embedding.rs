@@ -110,7 +110,10 @@ fn drawing_over_a_host_frame_keeps_its_pixels_where_no_tree_is() {
         "{empty} empty, {full} covered pixels"
     );
     let mean = diff / f64::from(full);
-    assert!(mean < 1.5, "covered pixels differ by {mean} sRGB steps on average");
+    assert!(
+        mean < 1.5,
+        "covered pixels differ by {mean} sRGB steps on average"
+    );
 }
 
 #[test]

@@ -138,3 +138,191 @@ pub fn state_members() -> Vec<(&'static str, usize)> {
         ("per_level", offset_of!(GpuState, per_level)),
     ]
 }
+
+/// Every resource binding a WGSL module declares, as `(group, binding) → kind`, from naga's
+/// reflection: "uniform", "storage read", "storage read_write", "texture <sample> <dim>
+/// [multisampled]", "sampler", "sampler comparison".
+pub fn reflected_bindings(source: &str) -> std::collections::BTreeMap<(u32, u32), String> {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+    let mut out = std::collections::BTreeMap::new();
+    for (_, g) in module.global_variables.iter() {
+        let Some(b) = &g.binding else { continue };
+        let kind = match g.space {
+            naga::AddressSpace::Uniform => "uniform".to_string(),
+            naga::AddressSpace::Storage { access } => {
+                if access.contains(naga::StorageAccess::STORE) {
+                    "storage read_write".into()
+                } else {
+                    "storage read".into()
+                }
+            }
+            naga::AddressSpace::Handle => match &module.types[g.ty].inner {
+                naga::TypeInner::Image {
+                    dim,
+                    arrayed,
+                    class,
+                } => {
+                    let (sample, multi) = match class {
+                        naga::ImageClass::Sampled { kind, multi } => (
+                            match kind {
+                                naga::ScalarKind::Float => "float",
+                                naga::ScalarKind::Uint => "uint",
+                                naga::ScalarKind::Sint => "sint",
+                                _ => "other",
+                            },
+                            *multi,
+                        ),
+                        naga::ImageClass::Depth { multi } => ("depth", *multi),
+                        _ => ("storage", false),
+                    };
+                    let dim = match (dim, arrayed) {
+                        (naga::ImageDimension::D2, false) => "2d",
+                        (naga::ImageDimension::D2, true) => "2d_array",
+                        (naga::ImageDimension::D3, _) => "3d",
+                        _ => "other",
+                    };
+                    format!(
+                        "texture {sample} {dim}{}",
+                        if multi { " multisampled" } else { "" }
+                    )
+                }
+                naga::TypeInner::Sampler { comparison } => if *comparison {
+                    "sampler comparison"
+                } else {
+                    "sampler"
+                }
+                .into(),
+                other => format!("{other:?}"),
+            },
+            other => format!("{other:?}"),
+        };
+        out.insert((b.group, b.binding), kind);
+    }
+    out
+}
+
+/// The same description of a Rust bind-group layout used as group `group`.
+pub fn layout_bindings(
+    group: u32,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> std::collections::BTreeMap<(u32, u32), String> {
+    entries
+        .iter()
+        .map(|e| {
+            let kind = match e.ty {
+                wgpu::BindingType::Buffer { ty, .. } => match ty {
+                    wgpu::BufferBindingType::Uniform => "uniform".to_string(),
+                    wgpu::BufferBindingType::Storage { read_only: true } => "storage read".into(),
+                    wgpu::BufferBindingType::Storage { read_only: false } => {
+                        "storage read_write".into()
+                    }
+                },
+                wgpu::BindingType::Texture {
+                    sample_type,
+                    view_dimension,
+                    multisampled,
+                } => {
+                    let sample = match sample_type {
+                        wgpu::TextureSampleType::Float { .. } => "float",
+                        wgpu::TextureSampleType::Uint => "uint",
+                        wgpu::TextureSampleType::Sint => "sint",
+                        wgpu::TextureSampleType::Depth => "depth",
+                    };
+                    let dim = match view_dimension {
+                        wgpu::TextureViewDimension::D2 => "2d",
+                        wgpu::TextureViewDimension::D2Array => "2d_array",
+                        wgpu::TextureViewDimension::D3 => "3d",
+                        _ => "other",
+                    };
+                    format!(
+                        "texture {sample} {dim}{}",
+                        if multisampled { " multisampled" } else { "" }
+                    )
+                }
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison) => {
+                    "sampler comparison".into()
+                }
+                wgpu::BindingType::Sampler(_) => "sampler".into(),
+                other => format!("{other:?}"),
+            };
+            ((group, e.binding), kind)
+        })
+        .collect()
+}
+
+/// The value of a WGSL `const` (u32, i32 or f32 literal) in a module, as f64.
+pub fn wgsl_const(source: &str, name: &str) -> f64 {
+    let module = naga::front::wgsl::parse_str(source).unwrap();
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no WGSL const {name}"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => f64::from(v),
+        naga::Expression::Literal(naga::Literal::I32(v)) => f64::from(v),
+        naga::Expression::Literal(naga::Literal::F32(v)) => f64::from(v),
+        ref e => panic!("{name} is not a literal: {e:?}"),
+    }
+}
+
+/// `(entry point, workgroup size x)` of every compute entry point of a module.
+pub fn workgroup_sizes(source: &str) -> Vec<(String, u32)> {
+    let module = naga::front::wgsl::parse_str(source).unwrap();
+    module
+        .entry_points
+        .iter()
+        .filter(|e| e.stage == naga::ShaderStage::Compute)
+        .map(|e| {
+            assert_eq!(e.workgroup_size[1..], [1, 1], "{}: 1-D workgroups", e.name);
+            (e.name.clone(), e.workgroup_size[0])
+        })
+        .collect()
+}
+
+/// Bindings used (read or written) by the entry points of a module that `entry` selects, from
+/// naga's validation info.
+pub fn used_bindings(source: &str, entry: impl Fn(&str) -> bool) -> Vec<(u32, u32)> {
+    let module = naga::front::wgsl::parse_str(source).unwrap();
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .unwrap();
+    let mut used = std::collections::BTreeSet::new();
+    for (i, ep) in module.entry_points.iter().enumerate() {
+        if !entry(&ep.name) {
+            continue;
+        }
+        let ep_info = info.get_entry_point(i);
+        for (h, g) in module.global_variables.iter() {
+            if let Some(b) = &g.binding
+                && !ep_info[h].is_empty()
+            {
+                used.insert((b.group, b.binding));
+            }
+        }
+    }
+    used.into_iter().collect()
+}
+
+/// A layout matches a module when every binding it lists is declared there with the same
+/// kind, and every binding the selected entry points use is in it.
+pub fn check_layout(
+    source: &str,
+    layout: &std::collections::BTreeMap<(u32, u32), String>,
+    entry: impl Fn(&str) -> bool,
+) {
+    let declared = reflected_bindings(source);
+    for (b, kind) in layout {
+        assert_eq!(declared.get(b), Some(kind), "binding {b:?}: WGSL vs layout");
+    }
+    for b in used_bindings(source, entry) {
+        assert!(
+            layout.contains_key(&b),
+            "binding {b:?} is used but not in the layout"
+        );
+    }
+}
