@@ -5,7 +5,7 @@ use std::path::Path;
 use forest_format::atlas::Layers;
 use forest_format::shading::{srgb_decode_table, srgb_encode};
 
-use crate::{BakeError, finish_tmp, tmp_name};
+use crate::BakeError;
 
 /// Largest tile side on the sheet; larger layers are box-filtered down by a power of two.
 pub const MAX_TILE: u32 = 256;
@@ -62,9 +62,7 @@ pub fn compose(layers: &Layers, columns: u32) -> image::RgbImage {
 /// Write the sheet as PNG (temporary name, then rename).
 pub fn write(path: &Path, layers: &Layers, columns: u32) -> Result<(), BakeError> {
     let img = compose(layers, columns);
-    let tmp = tmp_name(path);
-    let result = img
-        .save_with_format(&tmp, image::ImageFormat::Png)
-        .map_err(|e| e.to_string());
-    finish_tmp(result, &tmp, path)
+    Ok(forest_format::atomic::write_with(path, |tmp| {
+        img.save_with_format(tmp, image::ImageFormat::Png)
+    })?)
 }

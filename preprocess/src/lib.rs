@@ -228,46 +228,19 @@ pub fn write_depth_exr(path: &Path, out: &BakeOutput) -> Result<(), BakeError> {
     let (cols, res) = (p.mosaic_columns(), p.resolution as usize);
     let (w, h) = (cols as usize * res, p.mosaic_rows() as usize * res);
     let images = &out.images;
-    let tmp = tmp_name(path);
-    let result = exr::prelude::write_rgba_file(&tmp, w, h, |x, y| {
-        let (tx, ty) = (x / res, y / res);
-        let layer = ty * cols as usize + tx;
-        if layer >= images.layers as usize {
-            return (0.0f32, 0.0f32, 0.0f32, 0.0f32);
-        }
-        let i = (layer * res + y % res) * res + x % res;
-        let d = images.depth[i];
-        (d, d, d, f32::from(images.rgba[i * 4 + 3]) / 255.0)
-    });
-    finish_tmp(result.map_err(|e| e.to_string()), &tmp, path)
-}
-
-/// A sibling temporary name for atomic writes.
-pub fn tmp_name(path: &Path) -> std::path::PathBuf {
-    let name = path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
-}
-
-/// Rename a finished temporary file into place, or remove it on error.
-pub fn finish_tmp(result: Result<(), String>, tmp: &Path, path: &Path) -> Result<(), BakeError> {
-    let result = result
-        .map_err(|e| FormatError::Image {
-            path: path.into(),
-            what: e,
+    let write = |tmp: &Path| {
+        exr::prelude::write_rgba_file(tmp, w, h, |x, y| {
+            let (tx, ty) = (x / res, y / res);
+            let layer = ty * cols as usize + tx;
+            if layer >= images.layers as usize {
+                return (0.0f32, 0.0f32, 0.0f32, 0.0f32);
+            }
+            let i = (layer * res + y % res) * res + x % res;
+            let d = images.depth[i];
+            (d, d, d, f32::from(images.rgba[i * 4 + 3]) / 255.0)
         })
-        .and_then(|()| {
-            std::fs::rename(tmp, path).map_err(|source| FormatError::Io {
-                path: path.into(),
-                source,
-            })
-        });
-    if result.is_err() {
-        let _ = std::fs::remove_file(tmp);
-    }
-    Ok(result?)
+    };
+    Ok(forest_format::atomic::write_with(path, write)?)
 }
 
 /// One vertex of the full-geometry reference (48 bytes, as `GeoVertex` in

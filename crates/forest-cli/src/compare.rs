@@ -31,10 +31,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let m = forest_metrics::compare(&a, &b)?;
     if let Some(p) = &args.flip_map {
         let (_, map) = forest_metrics::flip(&a, &b)?;
-        let tmp = forest_bake::tmp_name(p);
-        map.save_with_format(&tmp, image::ImageFormat::Png)
-            .with_context(|| format!("writing {}", p.display()))?;
-        std::fs::rename(&tmp, p).with_context(|| format!("writing {}", p.display()))?;
+        forest_format::atomic::write_with(p, |tmp| {
+            map.save_with_format(tmp, image::ImageFormat::Png)
+        })?;
     }
     if args.json {
         println!("{}", serde_json::to_string(&m)?);

@@ -288,7 +288,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let cameras: Vec<(String, Camera)> = views
         .into_iter()
         .map(|(name, eye, target)| {
-            let far = (forest.extent() * 3.0 + 100.0).max(eye.length() * 2.0 + 100.0);
+            let far = forest.far_plane(eye);
             let cam = Camera {
                 eye,
                 target,
@@ -481,10 +481,9 @@ fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Resu
 
 /// Write a PNG atomically (temporary name, then rename).
 pub fn write_png(img: &image::RgbaImage, out: &Path) -> Result<()> {
-    let tmp = forest_bake::tmp_name(out);
-    img.save_with_format(&tmp, image::ImageFormat::Png)
-        .with_context(|| format!("writing {}", out.display()))?;
-    std::fs::rename(&tmp, out).with_context(|| format!("writing {}", out.display()))?;
+    forest_format::atomic::write_with(out, |tmp| {
+        img.save_with_format(tmp, image::ImageFormat::Png)
+    })?;
     Ok(())
 }
 

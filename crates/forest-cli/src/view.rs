@@ -101,10 +101,6 @@ fn geometry(
 }
 
 /// Far plane (metres): beyond the farthest tree from anywhere in the forest.
-fn far_plane(forest: &Forest) -> f32 {
-    (forest.extent() * 3.0 + 100.0).max(1000.0)
-}
-
 /// Run `forest view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
     let mut args_models = args.m.clone();
@@ -172,7 +168,6 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let method = args_models.chosen(mesh_method)?;
     r.set_method(&ctx, method)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
-    let far = far_plane(&forest);
     let mut total_ms = 0.0;
     for (i, key) in path.keys.iter().enumerate() {
         let cam = Camera {
@@ -180,7 +175,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             target: Vec3::from_array(key.target),
             fov_y_deg: path.fov_deg,
             near: 0.1,
-            far,
+            far: forest.far_plane(Vec3::from_array(key.eye)),
             viewport: args.size,
             epsilon: args.epsilon,
         };
@@ -216,12 +211,12 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
         Some(prepare_models(&m.models, &species)?)
     };
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
-    let far = far_plane(&forest);
     let chosen = m.chosen(mesh_method)?;
     let methods = crate::window::offered(chosen, prepared.is_some());
     let start = methods.iter().position(|x| *x == chosen).unwrap_or(0);
     let (size, epsilon) = (args.size, args.epsilon);
-    // Both builders hold the forest: the stream's is called again when it must grow.
+    // Both builders hold the forest (the window calls them once, when it has a device).
+    let extent = forest.extent();
     let forest = Rc::new(forest);
     let f = forest.clone();
     let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
@@ -238,7 +233,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
         build_geometry,
         size,
         epsilon,
-        far,
+        extent,
         methods,
         method: start,
         debug_view: args.debug_view,

@@ -150,8 +150,8 @@ pub struct Settings {
     pub size: (u32, u32),
     /// Starting ε in pixels.
     pub epsilon: f32,
-    /// Far plane (metres).
-    pub far: f32,
+    /// The forest's extent (metres from the origin), for the far plane.
+    pub extent: f32,
     /// The methods offered (see [`offered`]).
     pub methods: Vec<Method>,
     /// Index of the starting method in `methods`.
@@ -177,7 +177,7 @@ pub struct Viewer {
     size: (u32, u32),
     walker: Walker,
     epsilon: f32,
-    far: f32,
+    extent: f32,
     fov_deg: f32,
     methods: Vec<Method>,
     method: usize,
@@ -226,7 +226,7 @@ impl Viewer {
             size: st.size,
             walker,
             epsilon: st.epsilon,
-            far: st.far,
+            extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),
             method: st.method.min(st.methods.len().saturating_sub(1)),
             methods: st.methods,
@@ -281,7 +281,7 @@ impl Viewer {
             target,
             fov_y_deg: self.fov_deg,
             near: 0.1,
-            far: self.far,
+            far: forest_format::forest::far_plane(self.extent, eye),
             viewport: size,
             epsilon: self.epsilon,
         }
@@ -474,7 +474,7 @@ impl Viewer {
     }
 
     /// The stream overflowed: when the window is larger or ε smaller than its buffers were
-    /// sized for, build a larger stream (the geometry renderer is kept). If that fails (the
+    /// sized for, resize the stream's buffers (the scene and the geometry renderer are kept). If that fails (the
     /// device's limits), the HUD says so and the overflow counter stays the only effect.
     fn grow_stream(&mut self, viewport: (u32, u32)) -> Result<()> {
         let ((w, h), eps) = self.sized;
@@ -488,12 +488,10 @@ impl Viewer {
         let Some(g) = &mut self.gfx else {
             return Ok(());
         };
-        match (self.build_stream)(&g.ctx, g.config.format, wish.0, wish.1) {
-            Ok(stream) => {
-                let quads = stream.capacity.quads;
-                let geometry = g.renderer.geometry.take();
-                let method = self.methods[self.method];
-                g.renderer = assemble(&g.ctx, method, self.debug, stream, geometry)?;
+        // The stream's own buffers grow; the scene on the GPU is kept as it is.
+        match g.renderer.stream.resize_for(&g.ctx.device, wish.0, wish.1) {
+            Ok(()) => {
+                let quads = g.renderer.stream.capacity.quads;
                 self.sized = wish;
                 let ((w, h), eps) = wish;
                 self.say(format!(

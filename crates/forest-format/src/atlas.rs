@@ -735,7 +735,7 @@ impl Atlas {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+        let tmp = crate::atomic::tmp_name(&parent.join(&name));
         let _ = std::fs::remove_dir_all(&tmp);
         let result = (|| {
             std::fs::create_dir_all(&tmp).map_err(|e| FormatError::io(&tmp, e))?;

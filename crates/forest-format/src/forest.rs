@@ -9,7 +9,6 @@
 //!
 //! Writers go through a temporary name and a rename; readers check every count and value.
 
-use std::io::Write;
 use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
@@ -319,6 +318,18 @@ impl Forest {
             .map(|i| Vec3::from_array(i.position).length())
             .fold(0.0, f32::max)
     }
+
+    /// The far-plane distance (metres) every front end uses for a camera at `eye`: three
+    /// extents plus 100 m, or twice the eye's distance from the origin plus 100 m when that is
+    /// farther, so that every tree and the ground around it are inside the frustum.
+    pub fn far_plane(&self, eye: Vec3) -> f32 {
+        far_plane(self.extent(), eye)
+    }
+}
+
+/// [`Forest::far_plane`] for a forest of extent `extent` (metres from the origin).
+pub fn far_plane(extent: f32, eye: Vec3) -> f32 {
+    (extent * 3.0 + 100.0).max(eye.length() * 2.0 + 100.0)
 }
 
 struct Reader<'a> {
@@ -347,23 +358,7 @@ impl Reader<'_> {
 
 /// Write `bytes` to `path` through a temporary sibling and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| FormatError::invalid(path, "not a file name"))?
-        .to_string_lossy()
-        .into_owned();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(FormatError::io(path, e));
-    }
-    Ok(())
+    crate::atomic::write_bytes(path, bytes)
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 //! - [`camera_path`]: recorded camera paths for the viewer.
 
 pub mod atlas;
+pub mod atomic;
 pub mod camera_path;
 pub mod directions;
 pub mod error;

@@ -378,8 +378,19 @@ impl QuadStream {
         device: &wgpu::Device,
         viewport: (u32, u32),
     ) -> Result<(), RenderError> {
+        self.resize_for(device, viewport, self.opts.min_epsilon)
+    }
+
+    /// [`Self::resize`] for a new largest viewport and a new smallest ε (pixels).
+    pub fn resize_for(
+        &mut self,
+        device: &wgpu::Device,
+        viewport: (u32, u32),
+        min_epsilon: f32,
+    ) -> Result<(), RenderError> {
         let opts = RendererOptions {
             viewport,
+            min_epsilon,
             ..self.opts.clone()
         };
         let capacity = capacity(&self.scene, &opts);

@@ -216,20 +216,20 @@ where
 pub fn save(c: &Chart, stem: &Path) -> Result<()> {
     register_font();
     let svg = stem.with_extension("svg");
-    let tmp = forest_bake::tmp_name(&svg);
-    draw(SVGBackend::new(&tmp, SIZE).into_drawing_area(), c)?;
-    std::fs::rename(&tmp, &svg)?;
+    forest_format::atomic::write_with(&svg, |tmp| {
+        draw(SVGBackend::new(tmp, SIZE).into_drawing_area(), c)
+    })?;
     let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
     draw(
         BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area(),
         c,
     )?;
     let png = stem.with_extension("png");
-    let tmp = forest_bake::tmp_name(&png);
-    image::RgbImage::from_raw(SIZE.0, SIZE.1, buf)
-        .ok_or_else(|| anyhow!("chart buffer size"))?
-        .save_with_format(&tmp, image::ImageFormat::Png)?;
-    std::fs::rename(&tmp, &png)?;
+    let img = image::RgbImage::from_raw(SIZE.0, SIZE.1, buf)
+        .ok_or_else(|| anyhow!("chart buffer size"))?;
+    forest_format::atomic::write_with(&png, |tmp| {
+        img.save_with_format(tmp, image::ImageFormat::Png)
+    })?;
     Ok(())
 }
 

@@ -306,9 +306,7 @@ impl Bench {
     /// Write `name` in the results folder atomically.
     pub fn write(&self, name: &str, contents: &str) -> Result<PathBuf> {
         let path = self.out.join(name);
-        let tmp = forest_bake::tmp_name(&path);
-        std::fs::write(&tmp, contents).with_context(|| format!("writing {}", path.display()))?;
-        std::fs::rename(&tmp, &path).with_context(|| format!("writing {}", path.display()))?;
+        forest_format::atomic::write_bytes(&path, contents.as_bytes())?;
         println!("wrote {}", path.display());
         Ok(path)
     }
