@@ -88,19 +88,21 @@ fn depth_view(device: &wgpu::Device, size: (u32, u32)) -> wgpu::TextureView {
 }
 
 impl Host {
-    /// The host's pipelines and a forest stream over `scene` for `format` targets of `size`.
+    /// The host's pipelines and a forest stream over `scene` for `format` targets of `size`,
+    /// refined down to `min_epsilon` pixels at most (both size the stream).
     pub fn new(
         device: &wgpu::Device,
         scene: Arc<GpuScene>,
         format: wgpu::TextureFormat,
         size: (u32, u32),
+        min_epsilon: f32,
     ) -> Result<Self, RenderError> {
         let opts = RendererOptions {
             format,
             depth_format: DEPTH,
             reverse_z: true,
             viewport: size,
-            min_epsilon: 1.0,
+            min_epsilon,
             ..Default::default()
         };
         // The ground colour `forest render` uses, so that the two frames can be compared.

@@ -47,7 +47,7 @@ pub fn headless(
     let ctx = GpuContext::headless()?;
     let scene = load(&ctx, forest)?;
     let out = Target::new(&ctx, size.0, size.1);
-    let mut host = host::Host::new(&ctx.device, scene, out.format, size)?;
+    let mut host = host::Host::new(&ctx.device, scene, out.format, size, epsilon)?;
     let frame = host::frame(eye, target, size, epsilon);
     host.draw(&ctx.device, &ctx.queue, &out.colour_view, &frame)?;
     let img = out.read(&ctx);
@@ -99,6 +99,7 @@ impl App {
             scene,
             config.format,
             (config.width, config.height),
+            self.epsilon,
         )?;
         self.gfx = Some((window, surface, config, ctx, host));
         Ok(())
@@ -186,11 +187,11 @@ fn vec3(s: &str) -> Result<Vec3, Error> {
     }
 }
 
-fn main() -> Result<(), Error> {
+fn run() -> Result<(), Error> {
     let mut args = std::env::args().skip(1);
     let mut forest = None;
     let (mut eye, mut target) = (Vec3::new(0.0, 30.0, 60.0), Vec3::ZERO);
-    let (mut size, mut epsilon, mut headless_out) = ((960, 540), 2.0, None);
+    let (mut size, mut epsilon, mut headless_out) = ((960, 540), 4.0, None);
     while let Some(a) = args.next() {
         let mut value = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
@@ -225,4 +226,14 @@ fn main() -> Result<(), Error> {
     };
     EventLoop::new()?.run_app(&mut app)?;
     app.error.map_or(Ok(()), Err)
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("embed: error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
 }
