@@ -1,0 +1,131 @@
+//! One frame of the viewer: step the camera, record the forest into the surface texture, the
+//! HUD over it, present, and poll the counters (never waiting for the GPU).
+
+use std::time::Instant;
+
+use anyhow::Result;
+use forest_render::options::DebugView;
+
+use super::{Viewer, Walker};
+
+impl Viewer {
+    pub(super) fn frame(&mut self) -> Result<()> {
+        let now = Instant::now();
+        let elapsed = (now - self.last).as_secs_f32();
+        self.frame_ms = f64::from(elapsed) * 1000.0;
+        // Slow frames move the walker at most 0.1 s's worth (no leaps after a stall).
+        let dt = elapsed.min(0.1);
+        self.last = now;
+        self.walker.step(&self.keys, dt);
+        let cam = self.camera();
+        if let (Some(p), Some(i)) = (&self.path, self.playing) {
+            // One key per frame; at the end, control returns at the last key.
+            if i + 1 >= p.keys.len() {
+                self.playing = None;
+                self.walker = Walker::looking_at(cam.eye, cam.target, self.walker.speed);
+            } else {
+                self.playing = Some(i + 1);
+            }
+        }
+        if let Some(p) = &mut self.recording {
+            p.push(cam.eye, cam.target);
+        }
+        let Some(mut g) = self.gfx.take() else {
+            return Ok(());
+        };
+        let result = (|| -> Result<(Option<usize>, Option<DebugView>)> {
+            let output = match g.surface.get_current_texture() {
+                wgpu::CurrentSurfaceTexture::Success(t)
+                | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+                _ => {
+                    g.surface.configure(&g.ctx.device, &g.config);
+                    return Ok((None, None));
+                }
+            };
+            let view = output.texture.create_view(&Default::default());
+            let mut enc = g.ctx.device.create_command_encoder(&Default::default());
+            g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
+            let raw = g.egui_state.take_egui_input(&g.window);
+            let ui_ctx = g.egui.clone();
+            let mut choice = (None, None);
+            let mut out = ui_ctx.run_pass(raw, |c| choice = self.hud(c));
+            // egui insists that texture updates are consumed: take them out now.
+            let set: Vec<_> = out.textures_delta.set.drain().collect();
+            let free: Vec<_> = out.textures_delta.free.drain().collect();
+            g.egui_state
+                .handle_platform_output(&g.window, out.platform_output);
+            let jobs = g.egui.tessellate(out.shapes, out.pixels_per_point);
+            let screen = egui_wgpu::ScreenDescriptor {
+                size_in_pixels: [g.config.width, g.config.height],
+                pixels_per_point: out.pixels_per_point,
+            };
+            for (id, deltas) in &set {
+                for delta in deltas {
+                    g.egui_renderer
+                        .update_texture(&g.ctx.device, &g.ctx.queue, *id, delta);
+                }
+            }
+            let extra = g.egui_renderer.update_buffers(
+                &g.ctx.device,
+                &g.ctx.queue,
+                &mut enc,
+                &jobs,
+                &screen,
+            );
+            {
+                let mut pass = enc
+                    .begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("hud"),
+                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                            view: &view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load: wgpu::LoadOp::Load,
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })],
+                        depth_stencil_attachment: None,
+                        timestamp_writes: None,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    })
+                    .forget_lifetime();
+                g.egui_renderer.render(&mut pass, &jobs, &screen);
+            }
+            for id in &free {
+                g.egui_renderer.free_texture(id);
+            }
+            g.ctx.queue.submit(extra.into_iter().chain([enc.finish()]));
+            g.window.pre_present_notify();
+            g.ctx.queue.present(output);
+            // Statistics arrive a few frames late and errors as wgpu reports them: the frame
+            // loop never waits for the GPU.
+            if let Some(stats) = g.renderer.poll_stats(&g.ctx.device, &g.ctx.queue) {
+                self.stats = stats;
+            }
+            g.ctx.check_reported_errors()?;
+            if self.first_frame {
+                self.first_frame = false;
+                // (Rust's stdout is line-buffered: each line reaches a pipe as it is printed.)
+                println!(
+                    "forest view: first frame on screen ({}, {:?}, {}x{})",
+                    g.ctx.adapter_info.name, g.config.format, g.config.width, g.config.height
+                );
+            }
+            Ok(choice)
+        })();
+        self.gfx = Some(g);
+        let (method, debug) = result?;
+        if let Some(i) = method {
+            self.set_method(i)?;
+        }
+        if self.stats.overflow > 0 {
+            self.grow_stream(cam.viewport)?;
+        }
+        if let Some(v) = debug {
+            self.set_debug(v);
+        }
+        Ok(())
+    }
+}

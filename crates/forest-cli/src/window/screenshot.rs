@@ -1,0 +1,43 @@
+//! F12: the current view rendered offscreen with the window's pipelines, saved as PNG with
+//! its camera as a one-key path beside it.
+
+use anyhow::Result;
+use forest_format::camera_path::CameraPath;
+
+use super::Viewer;
+
+impl Viewer {
+    /// Render the current view (without the HUD) offscreen with the window's pipelines and
+    /// save it, with its camera as a one-key path beside it.
+    pub(super) fn screenshot(&mut self) -> Result<()> {
+        let cam = self.camera();
+        let Some(g) = &mut self.gfx else {
+            return Ok(());
+        };
+        let target = forest_render::target::Target::with_format(
+            &g.ctx,
+            cam.viewport.0,
+            cam.viewport.1,
+            g.config.format,
+        )?;
+        g.renderer.render_frame(&g.ctx, &cam, &target)?;
+        let img = target.read(&g.ctx);
+        g.ctx.check_errors()?;
+        let base = self
+            .screenshots
+            .join(format!("screenshot-{:03}", self.shots));
+        let png = base.with_extension("png");
+        crate::render::write_png(&img, &png)?;
+        let mut key = CameraPath::new(cam.fov_y_deg);
+        key.push(cam.eye, cam.target);
+        key.save(&base.with_extension("json"))?;
+        self.shots += 1;
+        self.say(format!(
+            "saved {} ({}, debug view {})",
+            png.display(),
+            self.methods[self.method].name(),
+            self.debug.name()
+        ));
+        Ok(())
+    }
+}
