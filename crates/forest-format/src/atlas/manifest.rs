@@ -1,0 +1,230 @@
+//! The manifest (`manifest.json`): what was baked, how, and the counts the loader checks.
+
+use std::path::Path;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::directions;
+use crate::error::FormatError;
+use crate::node::{MAX_NODES, QuadNode};
+use crate::shading::Lighting;
+use crate::slab::{DirectionFrame, Sphere};
+
+use super::*;
+
+/// Where the baked model came from.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SourceInfo {
+    /// File name of the OBJ (no folder, so that bakes are reproducible anywhere).
+    pub file: String,
+    /// FNV-1a 64 hash (hex) of the OBJ, MTL and texture bytes: a cache key.
+    pub hash: String,
+    /// Triangles used (after triangulating polygons and skipping degenerate ones).
+    pub triangles: u64,
+    /// Degenerate (zero-area) triangles skipped.
+    pub degenerate_triangles: u64,
+    /// Material names.
+    pub materials: Vec<String>,
+}
+
+/// The manifest of an atlas (`manifest.json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AtlasManifest {
+    /// Always [`ATLAS_FORMAT`].
+    pub format: String,
+    /// Always [`ATLAS_VERSION`] for this crate.
+    pub version: u32,
+    /// The model baked.
+    pub source: SourceInfo,
+    /// Bake parameters.
+    pub params: BakeParams,
+    /// The lighting baked into the colours.
+    pub lighting: Lighting,
+    /// The sphere every slab image frames (object space, metres).
+    pub bounding_sphere: Sphere,
+    /// Sampling directions with their image frames (`params.directions` of them).
+    pub directions: Vec<DirectionFrame>,
+    /// Triangulation of the directions seen from above the horizon (see [`crate::directions`]).
+    pub direction_triangles: Vec<[u32; 3]>,
+    /// Triangulation of the directions seen from below the horizon (empty when `below` is 0).
+    pub lower_triangles: Vec<[u32; 3]>,
+    /// Quad levels per slab image.
+    pub levels: u32,
+    /// Root node index of each layer (`direction·slabs + slab`); `None` for a blank layer.
+    pub layer_roots: Vec<Option<u32>>,
+    /// Nodes per level, summed over all layers (`levels` entries).
+    pub nodes_per_level: Vec<u64>,
+    /// Total nodes.
+    pub node_count: u64,
+}
+
+impl AtlasManifest {
+    /// Bytes the runtime puts in GPU textures for this atlas: the colour layers as BC7 (16
+    /// bytes per 4×4 block) with mips down to 4×4, plus the node texture (8 bytes per texel,
+    /// [`NODE_TEXTURE_WIDTH`] wide, rows rounded up).
+    pub fn gpu_bytes(&self) -> u64 {
+        let mut per_layer = 0u64;
+        let mut side = u64::from(self.params.resolution);
+        loop {
+            let blocks = side.div_ceil(4);
+            per_layer += blocks * blocks * 16;
+            if side <= 4 {
+                break;
+            }
+            side /= 2;
+        }
+        let rows = self
+            .node_count
+            .div_ceil(u64::from(NODE_TEXTURE_WIDTH))
+            .max(1);
+        per_layer * u64::from(self.params.layers()) + rows * u64::from(NODE_TEXTURE_WIDTH) * 8
+    }
+
+    /// Sampling directions as vectors.
+    pub fn direction_vectors(&self) -> Vec<Vec3> {
+        self.directions.iter().map(|f| f.dir).collect()
+    }
+
+    /// Check the manifest's own consistency (counts, ranges, finite numbers).
+    pub(super) fn check(&self, path: &Path) -> Result<(), FormatError> {
+        let bad = |what: String| Err(FormatError::invalid(path, what));
+        if self.format != ATLAS_FORMAT {
+            return Err(FormatError::Version {
+                path: path.into(),
+                what: format!("format is {:?}, expected {ATLAS_FORMAT:?}", self.format),
+            });
+        }
+        if self.version != ATLAS_VERSION {
+            return Err(FormatError::Version {
+                path: path.into(),
+                what: format!(
+                    "atlas version {} but this program reads version {ATLAS_VERSION}: bake \
+                     the model again",
+                    self.version
+                ),
+            });
+        }
+        self.params
+            .validate()
+            .or_else(|e| bad(format!("params: {e}")))?;
+        if self.levels != self.params.levels() {
+            return bad(format!(
+                "levels = {}, but resolution {} and min_quad {} give {}",
+                self.levels,
+                self.params.resolution,
+                self.params.min_quad,
+                self.params.levels()
+            ));
+        }
+        let total = self.params.total_directions();
+        if self.directions.len() != total as usize {
+            return bad(format!(
+                "{} direction frames for {} directions",
+                self.directions.len(),
+                total
+            ));
+        }
+        for (i, f) in self.directions.iter().enumerate() {
+            let ok = [f.dir, f.right, f.up]
+                .iter()
+                .all(|v| v.is_finite() && (v.length() - 1.0).abs() < 1e-3);
+            if !ok {
+                return bad(format!("direction {i} is not a unit frame"));
+            }
+        }
+        if let Some(t) = self
+            .direction_triangles
+            .iter()
+            .chain(&self.lower_triangles)
+            .find(|t| t.iter().any(|&i| i >= total))
+        {
+            return bad(format!(
+                "direction triangle {t:?} names a direction beyond {total}"
+            ));
+        }
+        let s = &self.bounding_sphere;
+        if !(s.center.is_finite() && s.radius.is_finite() && s.radius > 0.0) {
+            return bad(format!("bounding sphere {s:?} is not finite and positive"));
+        }
+        if self.layer_roots.len() != self.params.layers() as usize {
+            return bad(format!(
+                "{} layer roots for {} layers",
+                self.layer_roots.len(),
+                self.params.layers()
+            ));
+        }
+        if self.nodes_per_level.len() != self.levels as usize {
+            return bad(format!(
+                "{} per-level counts for {} levels",
+                self.nodes_per_level.len(),
+                self.levels
+            ));
+        }
+        let sum: u64 = self.nodes_per_level.iter().sum();
+        if sum != self.node_count || self.node_count > MAX_NODES {
+            return bad(format!(
+                "node_count = {} but the per-level counts add up to {sum} (at most {MAX_NODES})",
+                self.node_count
+            ));
+        }
+        let lighting_ok = [
+            self.lighting.sun_dir,
+            self.lighting.sun,
+            self.lighting.sky,
+            self.lighting.ground,
+        ]
+        .iter()
+        .all(|v| v.is_finite());
+        if !lighting_ok {
+            return bad("lighting has a non-finite value".into());
+        }
+        Ok(())
+    }
+}
+
+/// Count nodes per level from the structure, or `None` when a node lies deeper than `levels`.
+pub fn nodes_per_level(nodes: &[QuadNode], roots: usize, levels: u32) -> Option<Vec<u64>> {
+    let mut level = vec![0u32; nodes.len()];
+    let mut counts = vec![0u64; levels as usize];
+    for (i, n) in nodes.iter().enumerate() {
+        if i >= roots && level[i] == 0 {
+            return None; // not reached from a root
+        }
+        *counts.get_mut(level[i] as usize)? += 1;
+        for c in 0..4 {
+            if let Some(k) = n.child_index(c) {
+                *level.get_mut(k as usize)? = level[i] + 1;
+            }
+        }
+    }
+    Some(counts)
+}
+
+/// Build the manifest of a bake from its parts (directions from [`directions`]).
+pub fn manifest_for(
+    params: BakeParams,
+    source: SourceInfo,
+    bounding_sphere: Sphere,
+    layer_roots: Vec<Option<u32>>,
+    nodes_per_level: Vec<u64>,
+) -> AtlasManifest {
+    let dirs = directions::sampling_directions(params.directions, params.below);
+    let (upper, lower) = directions::triangulate_sphere(&dirs);
+    AtlasManifest {
+        format: ATLAS_FORMAT.into(),
+        version: ATLAS_VERSION,
+        source,
+        lighting: params.lighting(),
+        levels: params.levels(),
+        bounding_sphere,
+        direction_triangles: upper,
+        lower_triangles: lower,
+        directions: dirs.into_iter().map(DirectionFrame::new).collect(),
+        layer_roots,
+        node_count: nodes_per_level.iter().sum(),
+        nodes_per_level,
+        params,
+    }
+}

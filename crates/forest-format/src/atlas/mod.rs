@@ -1,0 +1,320 @@
+//! The baked atlas of one tree model: a folder `NAME.atlas/` holding
+//!
+//! - `manifest.json`: format name and version, every bake parameter, the bounding sphere, the
+//!   sampling directions with their frames and triangulation, per-level node counts;
+//! - `colour.jpg` (or `colour.png` when baked lossless): every slab image's premultiplied,
+//!   sRGB-encoded RGB, tiled into one mosaic (layer `L = direction·slabs + slab` at column
+//!   `L mod mosaic_columns`, row `L div mosaic_columns`);
+//! - `alpha.png`: the coverage (alpha) mosaic, 8-bit, lossless;
+//! - `nodes.bin`: the quad hierarchies of all layers (see [`crate::nodes_codec`]).
+//!
+//! [`Atlas::save`] writes to a temporary folder and renames it into place, so a reader never
+//! sees half an atlas; [`Atlas::load`] checks the version and every size and count.
+
+mod codecs;
+mod manifest;
+mod params;
+
+pub use codecs::*;
+pub use manifest::*;
+pub use params::*;
+
+use std::path::{Path, PathBuf};
+
+use crate::error::FormatError;
+use crate::node::QuadNode;
+use crate::nodes_codec;
+use crate::shading::srgb_encode;
+
+/// The `format` field of every atlas manifest.
+pub const ATLAS_FORMAT: &str = "forest-atlas";
+/// The atlas format version this crate reads and writes.
+pub const ATLAS_VERSION: u32 = 2;
+/// Manifest file name inside an atlas folder.
+pub const MANIFEST_FILE: &str = "manifest.json";
+/// Alpha mosaic file name.
+pub const ALPHA_FILE: &str = "alpha.png";
+/// Node file name.
+pub const NODES_FILE: &str = "nodes.bin";
+/// Width in texels of the node texture the runtime uploads (`Rg32Uint`, one node per texel).
+pub const NODE_TEXTURE_WIDTH: u32 = 4096;
+/// The largest mosaic side JPEG allows.
+const MAX_MOSAIC_SIDE: u64 = 65_535;
+
+/// A baked atlas in memory: the manifest, the encoded colour and alpha mosaics (exactly the
+/// bytes on disk) and the decoded nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Atlas {
+    /// The manifest.
+    pub manifest: AtlasManifest,
+    /// The colour mosaic file's bytes (JPEG or PNG, per `manifest.params.colour`).
+    pub colour_file: Vec<u8>,
+    /// The alpha mosaic file's bytes (8-bit grey PNG).
+    pub alpha_file: Vec<u8>,
+    /// All nodes, level by level; the roots are the first ones, in layer order.
+    pub nodes: Vec<QuadNode>,
+}
+
+impl Atlas {
+    /// Encode decoded layers and nodes into an atlas. `layers` must hold
+    /// `manifest.params.layers()` layers of `resolution²` pixels.
+    pub fn from_layers(
+        manifest: AtlasManifest,
+        layers: &Layers,
+        nodes: Vec<QuadNode>,
+    ) -> Result<Self, FormatError> {
+        let p = &manifest.params;
+        assert_eq!(layers.count, p.layers(), "one layer per direction and slab");
+        assert_eq!(layers.resolution, p.resolution);
+        let cols = p.mosaic_columns();
+        let (w, h, mut rgb) = layers.mosaic(cols, &[0, 1, 2]);
+        let (_, _, alpha) = layers.mosaic(cols, &[3]);
+        if matches!(p.colour, ColourEncoding::Jpeg { .. }) {
+            fill_blank(w, h, &mut rgb, &alpha);
+        }
+        let colour_file = match p.colour {
+            ColourEncoding::Png => encode_png(w, h, &rgb, image::ExtendedColorType::Rgb8),
+            ColourEncoding::Jpeg { quality } => {
+                let mut out = Vec::new();
+                let mut enc = jpeg_encoder::Encoder::new(&mut out, quality);
+                // Optimised Huffman tables with 4:2:0 decode wrongly in zune-jpeg 0.5 (the
+                // image crate's decoder): colours come out green. The standard tables cost ~3%.
+                enc.set_optimized_huffman_tables(false);
+                enc.set_sampling_factor(jpeg_encoder::SamplingFactor::R_4_2_0);
+                enc.encode(&rgb, w as u16, h as u16, jpeg_encoder::ColorType::Rgb)
+                    .map_err(|e| FormatError::Image {
+                        path: p.colour.file_name().into(),
+                        what: e.to_string(),
+                    })?;
+                out
+            }
+        };
+        let alpha_file = encode_alpha_png(w, h, &alpha);
+        Ok(Self {
+            manifest,
+            colour_file,
+            alpha_file,
+            nodes,
+        })
+    }
+
+    /// Decode the colour and alpha mosaics into layers. Colour is clamped to the alpha
+    /// (premultiplied: linear colour ≤ alpha, so fully transparent pixels are black), which
+    /// undoes lossy-codec ringing outside the coverage.
+    pub fn decode_layers(&self, path: &Path) -> Result<Layers, FormatError> {
+        let p = &self.manifest.params;
+        let colour_path = path.join(p.colour.file_name());
+        let alpha_path = path.join(ALPHA_FILE);
+        let img_err = |path: &Path, e: image::ImageError| FormatError::Image {
+            path: path.into(),
+            what: e.to_string(),
+        };
+        let format = match p.colour {
+            ColourEncoding::Jpeg { .. } => image::ImageFormat::Jpeg,
+            ColourEncoding::Png => image::ImageFormat::Png,
+        };
+        let colour = image::load_from_memory_with_format(&self.colour_file, format)
+            .map_err(|e| img_err(&colour_path, e))?
+            .to_rgb8();
+        let alpha = image::load_from_memory_with_format(&self.alpha_file, image::ImageFormat::Png)
+            .map_err(|e| img_err(&alpha_path, e))?;
+        // 8-bit grey, or a grey palette (which decodes to RGB with equal channels).
+        let alpha = match alpha {
+            image::DynamicImage::ImageLuma8(a) => a,
+            image::DynamicImage::ImageRgb8(rgb)
+                if rgb.pixels().all(|p| p[0] == p[1] && p[1] == p[2]) =>
+            {
+                image::GrayImage::from_fn(rgb.width(), rgb.height(), |x, y| {
+                    image::Luma([rgb.get_pixel(x, y)[0]])
+                })
+            }
+            other => {
+                return Err(FormatError::invalid(
+                    &alpha_path,
+                    format!("alpha mosaic is {:?}, expected grey", other.color()),
+                ));
+            }
+        };
+        let (cols, rows) = (p.mosaic_columns(), p.mosaic_rows());
+        let (w, h) = (cols * p.resolution, rows * p.resolution);
+        for (file, dims) in [
+            (&colour_path, colour.dimensions()),
+            (&alpha_path, alpha.dimensions()),
+        ] {
+            if dims != (w, h) {
+                return Err(FormatError::invalid(
+                    file,
+                    format!(
+                        "mosaic is {}×{} pixels, expected {w}×{h} ({cols}×{rows} tiles of {})",
+                        dims.0, dims.1, p.resolution
+                    ),
+                ));
+            }
+        }
+        // Largest encoded colour allowed for each alpha: srgb_encode(alpha), the encoded form
+        // of `srgb_decode(c) ≤ a`.
+        let limit: [u8; 256] = std::array::from_fn(|a| {
+            (srgb_encode(a as f32 / 255.0) * 255.0)
+                .floor()
+                .clamp(0.0, 255.0) as u8
+        });
+        let r = p.resolution as usize;
+        let mut rgba = vec![0u8; p.layers() as usize * r * r * 4];
+        for l in 0..p.layers() {
+            let (tx, ty) = ((l % cols) * p.resolution, (l / cols) * p.resolution);
+            let base = l as usize * r * r * 4;
+            for y in 0..r {
+                for x in 0..r {
+                    let (mx, my) = (tx + x as u32, ty + y as u32);
+                    let a = alpha.get_pixel(mx, my).0[0];
+                    let c = colour.get_pixel(mx, my).0;
+                    let d = base + (y * r + x) * 4;
+                    let m = limit[a as usize];
+                    rgba[d..d + 4].copy_from_slice(&[c[0].min(m), c[1].min(m), c[2].min(m), a]);
+                }
+            }
+        }
+        Ok(Layers {
+            resolution: p.resolution,
+            count: p.layers(),
+            rgba,
+        })
+    }
+
+    /// Write the atlas folder atomically: into a temporary sibling folder, then renamed onto
+    /// `path`. An existing atlas at `path` is replaced; any other existing file or folder there
+    /// is left alone and reported as an error.
+    pub fn save(&self, path: &Path) -> Result<u64, FormatError> {
+        if path.exists() && !path.join(MANIFEST_FILE).is_file() {
+            return Err(FormatError::invalid(
+                path,
+                "exists and is not an atlas folder: refusing to overwrite it",
+            ));
+        }
+        let name = path
+            .file_name()
+            .ok_or_else(|| FormatError::invalid(path, "not a folder name"))?
+            .to_string_lossy()
+            .into_owned();
+        let parent = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let tmp = crate::atomic::tmp_name(&parent.join(&name));
+        let _ = std::fs::remove_dir_all(&tmp);
+        let result = (|| {
+            std::fs::create_dir_all(&tmp).map_err(|e| FormatError::io(&tmp, e))?;
+            let manifest =
+                serde_json::to_vec_pretty(&self.manifest).expect("the manifest serialises to JSON");
+            let files: [(&str, &[u8]); 4] = [
+                (MANIFEST_FILE, &manifest),
+                (self.manifest.params.colour.file_name(), &self.colour_file),
+                (ALPHA_FILE, &self.alpha_file),
+                (
+                    NODES_FILE,
+                    &nodes_codec::encode(&self.nodes, self.root_count()),
+                ),
+            ];
+            let mut total = 0u64;
+            for (file, bytes) in files {
+                let f = tmp.join(file);
+                std::fs::write(&f, bytes).map_err(|e| FormatError::io(&f, e))?;
+                total += bytes.len() as u64;
+            }
+            if path.exists() {
+                let old = parent.join(format!(".{name}.old-{}", std::process::id()));
+                std::fs::rename(path, &old).map_err(|e| FormatError::io(path, e))?;
+                std::fs::rename(&tmp, path).map_err(|e| FormatError::io(path, e))?;
+                let _ = std::fs::remove_dir_all(&old);
+            } else {
+                std::fs::rename(&tmp, path).map_err(|e| FormatError::io(path, e))?;
+            }
+            Ok(total)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_dir_all(&tmp);
+        }
+        result
+    }
+
+    /// Number of non-blank layers, whose roots are the first nodes.
+    pub fn root_count(&self) -> usize {
+        self.manifest.layer_roots.iter().flatten().count()
+    }
+
+    /// Read and check an atlas folder. Every error names the file and what is wrong.
+    pub fn load(path: &Path) -> Result<Self, FormatError> {
+        if !path.is_dir() {
+            return Err(FormatError::invalid(
+                path,
+                if path.exists() {
+                    "is not an atlas folder (bake one with `forest bake MODEL.obj -o NAME.atlas`)"
+                } else {
+                    "no such atlas (bake one with `forest bake MODEL.obj -o NAME.atlas`)"
+                },
+            ));
+        }
+        let read = |file: &str| {
+            let f = path.join(file);
+            std::fs::read(&f).map_err(|e| FormatError::io(&f, e))
+        };
+        let mpath = path.join(MANIFEST_FILE);
+        let manifest: AtlasManifest =
+            serde_json::from_slice(&read(MANIFEST_FILE)?).map_err(|source| FormatError::Json {
+                path: mpath.clone(),
+                source,
+            })?;
+        manifest.check(&mpath)?;
+        let colour_file = read(manifest.params.colour.file_name())?;
+        let alpha_file = read(ALPHA_FILE)?;
+        let npath = path.join(NODES_FILE);
+        let (nodes, roots) =
+            nodes_codec::decode(&read(NODES_FILE)?).map_err(|e| FormatError::invalid(&npath, e))?;
+        if nodes.len() as u64 != manifest.node_count {
+            return Err(FormatError::invalid(
+                &npath,
+                format!(
+                    "holds {} nodes, the manifest says {}",
+                    nodes.len(),
+                    manifest.node_count
+                ),
+            ));
+        }
+        // Roots are the first nodes, in layer order.
+        let expected: Vec<u32> = manifest.layer_roots.iter().flatten().copied().collect();
+        if expected != (0..roots as u32).collect::<Vec<_>>() {
+            return Err(FormatError::invalid(
+                &mpath,
+                format!(
+                    "layer_roots {:?} do not number the {roots} roots of {NODES_FILE} in order",
+                    manifest.layer_roots
+                ),
+            ));
+        }
+        let per_level = nodes_per_level(&nodes, roots, manifest.levels);
+        match per_level {
+            Some(counts) if counts == manifest.nodes_per_level => {}
+            other => {
+                return Err(FormatError::invalid(
+                    &npath,
+                    format!(
+                        "nodes per level {:?} do not match the manifest's {:?} ({} levels)",
+                        other, manifest.nodes_per_level, manifest.levels
+                    ),
+                ));
+            }
+        }
+        let atlas = Self {
+            manifest,
+            colour_file,
+            alpha_file,
+            nodes,
+        };
+        // Decoding checks the image sizes too.
+        atlas.decode_layers(path)?;
+        Ok(atlas)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,135 @@
+//! The atlas format on a synthetic atlas (no bake needed): save → load round trip, atomic
+//! replacement, and a loader that names what is wrong.
+
+use super::*;
+use crate::slab::Sphere;
+
+/// 5 directions × 2 slabs of 8×8 pixels, two levels, every layer a single root node with no
+/// children.
+fn synthetic(colour: ColourEncoding) -> (Atlas, Layers) {
+    let params = BakeParams {
+        directions: 5,
+        below: 0,
+        slabs: 2,
+        resolution: 8,
+        min_quad: 4,
+        colour,
+        ..BakeParams::default()
+    };
+    params.validate().unwrap();
+    let n = params.layers();
+    let rgba = (0..n * 64)
+        .flat_map(|i| {
+            let a = if i % 3 == 0 { 0u8 } else { 255 };
+            let v = if a == 0 { 0 } else { (i % 251) as u8 };
+            [v, v / 2, 255 - v, a].map(|c| c.min(a))
+        })
+        .collect();
+    let layers = Layers {
+        resolution: 8,
+        count: n,
+        rgba,
+    };
+    let nodes: Vec<QuadNode> = (0..n)
+        .map(|l| QuadNode::new(0, 0, [l as u8, 10, 20, 30]))
+        .collect();
+    let manifest = manifest_for(
+        params,
+        SourceInfo {
+            file: "synthetic.obj".into(),
+            hash: "0".into(),
+            triangles: 1,
+            degenerate_triangles: 0,
+            materials: vec!["leaf".into()],
+        },
+        Sphere {
+            center: glam::Vec3::Y,
+            radius: 1.0,
+        },
+        (0..n).map(Some).collect(),
+        vec![u64::from(n), 0],
+    );
+    (
+        Atlas::from_layers(manifest, &layers, nodes).unwrap(),
+        layers,
+    )
+}
+
+#[test]
+fn save_then_load_round_trips_and_replaces_atomically() {
+    let (atlas, layers) = synthetic(ColourEncoding::Png);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.atlas");
+    atlas.save(&path).unwrap();
+    let back = Atlas::load(&path).unwrap();
+    assert_eq!(back, atlas);
+    // Lossless colour decodes to the layers, within one step (the decoder's rounding).
+    let decoded = back.decode_layers(&path).unwrap();
+    assert_eq!(
+        (decoded.resolution, decoded.count),
+        (layers.resolution, layers.count)
+    );
+    let worst = decoded
+        .rgba
+        .iter()
+        .zip(&layers.rgba)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max();
+    assert_eq!(worst.map(|w| w <= 1), Some(true), "{worst:?}");
+    atlas.save(&path).unwrap();
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("s.atlas")]);
+}
+
+#[test]
+fn the_loader_names_what_is_wrong() {
+    let (atlas, _) = synthetic(ColourEncoding::Png);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.atlas");
+    let reset = || atlas.save(&path).unwrap();
+    let err = |p: &Path| Atlas::load(p).unwrap_err().to_string();
+    reset();
+    let manifest = path.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 2", "\"version\": 7")).unwrap();
+    assert!(err(&path).contains("atlas version 7"), "{}", err(&path));
+    reset();
+    std::fs::write(&manifest, &text[..text.len() / 2]).unwrap();
+    assert!(
+        err(&path).contains("not a valid atlas manifest"),
+        "{}",
+        err(&path)
+    );
+    reset();
+    let nodes = path.join(NODES_FILE);
+    let bytes = std::fs::read(&nodes).unwrap();
+    std::fs::write(&nodes, &bytes[..bytes.len() - 3]).unwrap();
+    assert!(err(&path).contains(NODES_FILE), "{}", err(&path));
+    reset();
+    std::fs::remove_file(path.join(ALPHA_FILE)).unwrap();
+    assert!(err(&path).contains(ALPHA_FILE), "{}", err(&path));
+    assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
+}
+
+#[test]
+fn blank_pixels_are_filled_and_alpha_is_packed() {
+    // 4×1: two covered pixels, two blank: the blanks take the covered pixels' colour.
+    let mut rgb = vec![200, 100, 50, 0, 0, 0, 0, 0, 0, 100, 50, 200];
+    let alpha = [255, 0, 0, 255];
+    fill_blank(4, 1, &mut rgb, &alpha);
+    assert!(rgb[3..9].iter().all(|&c| c > 0), "{rgb:?}");
+    assert_eq!(
+        (&rgb[..3], &rgb[9..]),
+        (&[200, 100, 50][..], &[100, 50, 200][..])
+    );
+    // Two distinct values: a 1-bit indexed PNG (IHDR bit depth 1, colour type 3) that decodes
+    // to the same coverage.
+    let a: Vec<u8> = (0..64).map(|i| if i % 2 == 0 { 0 } else { 255 }).collect();
+    let png = encode_alpha_png(8, 8, &a);
+    let back = image::load_from_memory(&png).unwrap().to_luma8();
+    assert_eq!(back.into_raw(), a);
+    assert_eq!((png[24], png[25]), (1, 3));
+}
