@@ -262,38 +262,16 @@ fn the_loader_says_what_is_wrong() {
     };
     let err = |path: &Path| Atlas::load(path).unwrap_err().to_string();
 
+    // (Version, truncated files and missing files: the format crate's own tests.) On a real
+    // bake: a level count that disagrees with the parameters, an alpha mosaic of another size.
     reset();
     let manifest = path.join("manifest.json");
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("\"version\": 2", "\"version\": 99")).unwrap();
-    assert!(err(&path).contains("atlas version 99"), "{}", err(&path));
-
-    reset();
     std::fs::write(&manifest, text.replace("\"levels\": 5", "\"levels\": 6")).unwrap();
     assert!(err(&path).contains("levels = 6"), "{}", err(&path));
-
-    reset();
-    std::fs::write(&manifest, &text[..text.len() / 2]).unwrap();
-    assert!(
-        err(&path).contains("not a valid atlas manifest"),
-        "{}",
-        err(&path)
-    );
-
-    reset();
-    let nodes = path.join("nodes.bin");
-    let bytes = std::fs::read(&nodes).unwrap();
-    std::fs::write(&nodes, &bytes[..bytes.len() - 10]).unwrap();
-    assert!(err(&path).contains("nodes.bin"), "{}", err(&path));
-
-    reset();
-    std::fs::remove_file(path.join("alpha.png")).unwrap();
-    assert!(err(&path).contains("alpha.png"), "{}", err(&path));
 
     reset();
     let small = image::GrayImage::new(8, 8);
     small.save(path.join("alpha.png")).unwrap();
     assert!(err(&path).contains("expected"), "{}", err(&path));
-
-    assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
 }
