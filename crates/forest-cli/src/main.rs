@@ -28,6 +28,14 @@ pub(crate) fn colour_format() -> forest_render::ColourFormat {
     }
 }
 
+/// The headless GPU context of the sub-commands, with wgpu's environment variables
+/// (`WGPU_BACKEND`, ...) honoured: the command's policy, not the library's.
+pub(crate) fn gpu_context() -> Result<forest_render::GpuContext, forest_render::RenderError> {
+    forest_render::GpuContext::headless_with(
+        wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
+    )
+}
+
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
 #[command(name = "forest", version, about, long_about = None)]

@@ -314,7 +314,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("supersample = {}: must be 1 to 8", args.supersample);
     }
     let mesh_method = args.m.checked_method(forest.species.len())?;
-    let ctx = GpuContext::headless()?;
+    let ctx = crate::gpu_context()?;
     if let Method::Hybrid(h) = args.m.chosen(mesh_method)? {
         return render_hybrid(args, h, &ctx, &forest, &species, &cameras);
     }

@@ -142,7 +142,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     }
     let (forest, species) = load_scene(&forest_file)?;
     let mesh_method = args_models.checked_method(forest.species.len())?;
-    let ctx = GpuContext::headless()?;
+    let ctx = crate::gpu_context()?;
     let geometry = match mesh_method {
         Some(_) => Some(geometry(
             &ctx,

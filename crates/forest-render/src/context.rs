@@ -28,12 +28,18 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// Open the first adapter that `WGPU_BACKEND` (default: all) offers, preferring a
-    /// high-performance one, with timestamp queries and BC textures where available and the
-    /// adapter's own limits.
+    /// Open the first adapter wgpu's default instance offers, preferring a high-performance
+    /// one, with timestamp queries and BC textures where available and the adapter's own
+    /// limits. Reads no environment variable; a front end that wants wgpu's (`WGPU_BACKEND`,
+    /// ...) passes `InstanceDescriptor::new_without_display_handle_from_env()` to
+    /// [`Self::headless_with`].
     pub fn headless() -> Result<Self, RenderError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::headless_with(wgpu::InstanceDescriptor::new_without_display_handle())
+    }
+
+    /// [`Self::headless`] with the host's instance options.
+    pub fn headless_with(desc: wgpu::InstanceDescriptor) -> Result<Self, RenderError> {
+        let instance = wgpu::Instance::new(desc);
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             ..Default::default()

@@ -139,7 +139,7 @@ impl Bench {
         };
         std::fs::create_dir_all(&args.out)
             .with_context(|| format!("creating {}", args.out.display()))?;
-        let ctx = GpuContext::headless()?;
+        let ctx = crate::gpu_context()?;
         if !ctx
             .device
             .features()
