@@ -146,14 +146,15 @@ impl ForestRenderer {
                 self.stream.encode_compute(encoder);
                 g.encode_compute(encoder);
                 {
-                    let mut pass = forest_render::target::begin_pass(
-                        encoder,
-                        "hybrid draw",
+                    let opts = self.stream.options_built();
+                    let targets = forest_render::Targets::cleared(
                         colour,
                         depth,
-                        self.stream.background().clear_colour(),
-                        self.stream.draw_timestamps(),
+                        opts.background.clear_colour(),
+                        opts.depth_clear(),
                     );
+                    let mut pass =
+                        targets.begin(encoder, "hybrid draw", self.stream.draw_timestamps());
                     // Opaque geometry first, depth written; then the quads back to front,
                     // depth-tested against it.
                     g.record_draw(&mut pass, true);

@@ -4,11 +4,12 @@
 
 use forest_bake::lod::BANDS;
 use forest_format::forest::Forest;
+use forest_render::Targets;
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::gpu_types::GpuCamera;
 use forest_render::options::Background;
-use forest_render::passes::draw::DEPTH_FORMAT;
+use forest_render::options::RendererOptions;
 use forest_render::stats::PassTimes;
 use forest_render::target::Target;
 use wgpu::util::DeviceExt;
@@ -46,6 +47,7 @@ pub struct GeometryRenderer {
     species: u32,
     instances: u32,
     background: Background,
+    depth_clear: f32,
     /// Per-species figures, in the forest's species order.
     pub figures: Vec<SpeciesFigures>,
     /// Bytes of GPU memory the renderer allocated (buffers and textures).
@@ -53,8 +55,9 @@ pub struct GeometryRenderer {
 }
 
 impl GeometryRenderer {
-    /// Upload prepared species with the forest's instances (their species order must match).
-    /// The method starts as [`MeshMethod::default`].
+    /// Upload prepared species with the forest's instances (their species order must match),
+    /// for `format` colour targets with the crate's own depth target (Depth32Float, standard
+    /// depth, one sample). The method starts as [`MeshMethod::default`].
     pub fn new(
         ctx: &GpuContext,
         prepared: &PreparedGeometry,
@@ -62,6 +65,24 @@ impl GeometryRenderer {
         format: wgpu::TextureFormat,
         background: Background,
     ) -> Result<Self, RenderError> {
+        let opts = RendererOptions {
+            format,
+            background,
+            ..Default::default()
+        };
+        Self::with_targets(ctx, prepared, forest, &opts)
+    }
+
+    /// [`Self::new`] for the host's targets: colour and depth formats, sample count, depth
+    /// convention and background from `opts` (the same options a quad stream takes, so that
+    /// the hybrid can draw both forms into one pass).
+    pub fn with_targets(
+        ctx: &GpuContext,
+        prepared: &PreparedGeometry,
+        forest: &Forest,
+        opts: &RendererOptions,
+    ) -> Result<Self, RenderError> {
+        let (format, background) = (opts.format, opts.background);
         let PreparedGeometry {
             vertices,
             geo_species,
@@ -259,13 +280,16 @@ impl GeometryRenderer {
                         ..Default::default()
                     },
                     depth_stencil: Some(wgpu::DepthStencilState {
-                        format: DEPTH_FORMAT,
+                        format: opts.depth_format,
                         depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                        depth_compare: Some(opts.depth_compare()),
                         stencil: Default::default(),
                         bias: Default::default(),
                     }),
-                    multisample: Default::default(),
+                    multisample: wgpu::MultisampleState {
+                        count: opts.sample_count,
+                        ..Default::default()
+                    },
                     fragment: Some(wgpu::FragmentState {
                         module: &draw_module,
                         entry_point: Some(fs),
@@ -369,6 +393,7 @@ impl GeometryRenderer {
             species: geo_species.len() as u32,
             instances: instances.len() as u32,
             background,
+            depth_clear: opts.depth_clear(),
             figures: figures.clone(),
             gpu_bytes: gpu_bytes.get(),
         })
@@ -408,12 +433,15 @@ impl GeometryRenderer {
         self.set_camera(ctx, camera)?;
         self.encode_compute(encoder);
         {
-            let mut pass = forest_render::target::begin_pass(
-                encoder,
-                "geometry draw",
+            let targets = Targets::cleared(
                 colour,
                 depth,
                 self.background.clear_colour(),
+                self.depth_clear,
+            );
+            let mut pass = targets.begin(
+                encoder,
+                "geometry draw",
                 self.queries
                     .as_ref()
                     .map(|(query_set, _, _)| wgpu::RenderPassTimestampWrites {
@@ -434,6 +462,20 @@ impl GeometryRenderer {
         let mut g = camera.to_gpu();
         g.forms = self.forms;
         forest_render::camera::upload(&ctx.queue, &self.camera, &g, &mut self.writes);
+        Ok(())
+    }
+
+    /// Write the camera from the host's matrices (as `QuadStream::prepare`); then
+    /// [`Self::encode_compute`] and [`Self::record_draw`] into the host's pass.
+    pub fn prepare(
+        &mut self,
+        queue: &wgpu::Queue,
+        frame: &forest_render::FrameParams,
+    ) -> Result<(), RenderError> {
+        frame.validate()?;
+        let mut g = frame.to_gpu();
+        g.forms = self.forms;
+        forest_render::camera::upload(queue, &self.camera, &g, &mut self.writes);
         Ok(())
     }
 
