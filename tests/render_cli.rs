@@ -282,3 +282,113 @@ fn compare_reports_metrics_and_refuses_mismatched_images() {
 fn d_exists(p: &str) -> bool {
     Path::new(p).is_file()
 }
+
+/// Every byte of every file under `dir`, by path: what a refused command must leave as it was.
+fn snapshot(dir: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push((p.clone(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    // A copy of a bundled model, so that its own files can be targeted.
+    let m = d.join("model");
+    std::fs::create_dir(&m).unwrap();
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/trees/bush");
+    for f in std::fs::read_dir(&src).unwrap() {
+        let f = f.unwrap().path();
+        std::fs::copy(&f, m.join(f.file_name().unwrap())).unwrap();
+    }
+    let obj = m.join("bush.obj").display().to_string();
+    bake_small("bush", &d.join("bush.atlas"), 32, 5);
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "20",
+        "--species",
+        &p("bush.atlas"),
+        "-o",
+        &p("f.forest"),
+    ]));
+    ok(&forest(&[
+        "render",
+        &p("f.forest"),
+        "--view",
+        "inside",
+        "--size",
+        "32x24",
+        "-o",
+        &p("a.png"),
+    ]));
+    std::fs::copy(d.join("a.png"), d.join("b.png")).unwrap();
+    let before = snapshot(d);
+    let (f, a, b, n, x) = (
+        p("f.forest"),
+        p("a.png"),
+        p("b.png"),
+        p("n.atlas"),
+        p("x.jpg"),
+    );
+    let atlas = p("bush.atlas");
+    let sheet_in_output = format!("{n}/sheet.png");
+    let texture = m.join("leaves_aspen.png").display().to_string();
+    let inside = format!("{}/manifest.json", p("bush.atlas"));
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["render", &f, "--view", "inside", "-o", &f],
+            "is the input",
+        ),
+        (
+            vec!["render", &f, "--view", "inside", "-o", &inside],
+            "inside the input",
+        ),
+        (
+            vec!["render", &f, "--view", "inside", "-o", &x],
+            ".png name",
+        ),
+        (vec!["compare", &a, &b, "--flip-map", &a], "is the input"),
+        (
+            vec!["scene", "--trees", "5", "--species", &atlas, "-o", &inside],
+            "inside the input",
+        ),
+        (
+            vec!["bake", &obj, "-o", &n, "--contact-sheet", &texture],
+            "is the input",
+        ),
+        (
+            vec!["bake", &obj, "-o", &n, "--depth-exr", &obj],
+            "is the input",
+        ),
+        (
+            vec!["bake", &obj, "-o", &n, "--contact-sheet", &sheet_in_output],
+            "inside the output atlas",
+        ),
+        (vec!["bake", &obj, "-o", &n, "--depth-exr", &b], ".exr name"),
+    ];
+    for (args, why) in cases {
+        let e = err(&forest(&args));
+        assert!(e.contains(why), "{args:?}: {e}");
+        assert!(snapshot(d) == before, "{args:?} changed a file");
+    }
+    // No temporary files were left either (the snapshot holds every file there is).
+    assert!(
+        !before
+            .iter()
+            .any(|(f, _)| f.to_string_lossy().contains(".tmp-"))
+    );
+}

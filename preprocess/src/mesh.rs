@@ -275,3 +275,40 @@ impl Mesh {
         }
     }
 }
+
+/// The files a model is read from, without decoding any of them: the OBJ, its material
+/// libraries (`mtllib`) and every texture they name (`map_*`, `bump`, `disp`, `decal`, `refl`).
+/// Front ends use it to refuse outputs that would overwrite the model's own files. Unreadable
+/// libraries are skipped here (the loader reports them).
+pub fn source_files(obj: &Path) -> Result<Vec<PathBuf>, BakeError> {
+    let bytes = std::fs::read(obj).map_err(|source| BakeError::Io {
+        path: obj.into(),
+        source,
+    })?;
+    let dir = obj.parent().unwrap_or(Path::new("."));
+    let mut files = vec![obj.to_path_buf()];
+    for line in String::from_utf8_lossy(&bytes).lines() {
+        let Some(rest) = line.trim_start().strip_prefix("mtllib") else {
+            continue;
+        };
+        for lib in rest.split_whitespace() {
+            let mtl = dir.join(lib);
+            if let Ok(text) = std::fs::read_to_string(&mtl) {
+                for l in text.lines() {
+                    let l = l.trim_start();
+                    let key = l.split_whitespace().next().unwrap_or("");
+                    if key.starts_with("map_") || ["bump", "disp", "decal", "refl"].contains(&key) {
+                        let spec = l[key.len()..].trim();
+                        if !spec.is_empty() {
+                            files.push(texture_path(dir, spec));
+                        }
+                    }
+                }
+            }
+            files.push(mtl);
+        }
+    }
+    files.sort();
+    files.dedup();
+    Ok(files)
+}

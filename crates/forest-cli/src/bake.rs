@@ -150,10 +150,23 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     {
         bail!("output folder {} does not exist", p.display());
     }
+    // The model's own files (OBJ, material libraries, textures) are never overwritten, and
+    // the outputs never overwrite each other.
+    let inputs = forest_bake::mesh::source_files(&args.model)?;
+    crate::guard::not_an_input(&args.output, "output atlas", &inputs)?;
     if let Some(p) = &args.contact_sheet {
+        crate::guard::not_an_input(p, "contact sheet", &inputs)?;
+        crate::guard::apart_from(p, "contact sheet", &args.output, "output atlas")?;
+        crate::guard::extension(p, "contact sheet", "PNG", &["png"])?;
         check_output_file(p, "contact sheet")?;
     }
     if let Some(p) = &args.depth_exr {
+        crate::guard::not_an_input(p, "depth EXR", &inputs)?;
+        crate::guard::apart_from(p, "depth EXR", &args.output, "output atlas")?;
+        if let Some(c) = &args.contact_sheet {
+            crate::guard::apart_from(p, "depth EXR", c, "contact sheet")?;
+        }
+        crate::guard::extension(p, "depth EXR", "OpenEXR", &["exr"])?;
         check_output_file(p, "depth EXR")?;
     }
 

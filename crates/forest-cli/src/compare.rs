@@ -22,6 +22,11 @@ pub struct CompareArgs {
 
 /// Run `forest compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
+    if let Some(p) = &args.flip_map {
+        let inputs = [args.reference.clone(), args.test.clone()];
+        crate::guard::not_an_input(p, "FLIP map", &inputs)?;
+        crate::guard::extension(p, "FLIP map", "PNG", &["png"])?;
+    }
     let open = |p: &PathBuf| {
         image::open(p)
             .with_context(|| format!("reading {}", p.display()))

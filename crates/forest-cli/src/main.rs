@@ -8,6 +8,7 @@ mod bake;
 mod bench;
 mod compare;
 mod demo;
+mod guard;
 mod render;
 mod scene;
 mod view;

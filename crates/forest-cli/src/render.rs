@@ -301,8 +301,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             cam.validate().map(|()| (name, cam))
         })
         .collect::<Result<_, _>>()?;
+    // Nothing the command reads may be overwritten: the forest, its atlases, the models.
+    let dir = args.forest.parent().unwrap_or(Path::new("."));
+    let mut inputs = vec![args.forest.clone()];
+    inputs.extend(forest.species.iter().map(|s| dir.join(s)));
+    for m in &args.m.models {
+        inputs.extend(forest_bake::mesh::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
+    }
     for (name, _) in &cameras {
         let out = output_for(&args.output, name, cameras.len());
+        crate::guard::not_an_input(&out, "output", &inputs)?;
+        crate::guard::extension(&out, "output", "PNG", &["png"])?;
         let parent = out.parent().filter(|p| !p.as_os_str().is_empty());
         if let Some(p) = parent
             && !p.is_dir()

@@ -50,6 +50,7 @@ fn stored_path(atlas: &Path, forest: &Path) -> Result<String> {
 
 /// Run `forest scene`.
 pub fn run(args: &SceneArgs) -> Result<()> {
+    crate::guard::not_an_input(&args.output, "output", &args.species)?;
     let mut species = Vec::new();
     for s in &args.species {
         if !s.join(forest_format::atlas::MANIFEST_FILE).is_file() {
