@@ -385,6 +385,20 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
         assert!(e.contains(why), "{args:?}: {e}");
         assert!(snapshot(d) == before, "{args:?} changed a file");
     }
+    // A scene `render` would refuse is refused by `scene`, and nothing is written.
+    let e = err(&forest(&[
+        "scene",
+        "--trees",
+        "20",
+        "--species",
+        &atlas,
+        "--area-per-tree",
+        "1e38",
+        "-o",
+        &p("far.forest"),
+    ]));
+    assert!(e.contains("may span"), "{e}");
+    assert!(snapshot(d) == before);
     // No temporary files were left either (the snapshot holds every file there is).
     assert!(
         !before

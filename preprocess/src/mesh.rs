@@ -9,6 +9,8 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use forest_format::bounded;
+
 use forest_format::shading::{LEAF_TRANSLUCENCY, srgb_decode};
 use glam::{Vec2, Vec3};
 
@@ -81,26 +83,38 @@ fn texture_path(obj_dir: &Path, spec: &str) -> PathBuf {
 impl Mesh {
     /// Load an OBJ file with its materials and textures.
     pub fn load(path: &Path) -> Result<Self, BakeError> {
-        let obj_bytes = std::fs::read(path).map_err(|source| BakeError::Io {
-            path: path.into(),
-            source,
-        })?;
+        let obj_bytes = bounded::read(path, bounded::limit::DATA)?;
         let mut hash = fnv1a(FNV_OFFSET, &obj_bytes);
         let obj_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        // Hash the material libraries too (tobj does not expose their bytes).
-        for line in String::from_utf8_lossy(&obj_bytes).lines() {
-            if let Some(rest) = line.trim_start().strip_prefix("mtllib")
-                && let Ok(b) = std::fs::read(obj_dir.join(rest.trim()))
-            {
-                hash = fnv1a(hash, &b);
-            }
-        }
-        let (models, materials) = tobj::load_obj_buf(
+        // Material libraries are read bounded (a `mtllib` naming a device or a huge file is
+        // refused, not read until memory runs out) and hashed too.
+        let mtl_hash = std::cell::Cell::new(hash);
+        let mtl_error = std::cell::RefCell::new(None);
+        let loaded = tobj::load_obj_buf(
             &mut std::io::Cursor::new(&obj_bytes),
             &tobj::GPU_LOAD_OPTIONS,
-            |p| tobj::load_mtl(obj_dir.join(p)),
-        )
-        .map_err(|e| BakeError::Parse {
+            |p| {
+                let file = obj_dir.join(p);
+                match bounded::read(&file, bounded::limit::TEXT) {
+                    Ok(b) => {
+                        mtl_hash.set(fnv1a(mtl_hash.get(), &b));
+                        tobj::load_mtl_buf(&mut std::io::Cursor::new(b))
+                    }
+                    // A missing library is tobj's to report; a refused one is ours.
+                    Err(e) => {
+                        if file.exists() {
+                            *mtl_error.borrow_mut() = Some(e);
+                        }
+                        Err(tobj::LoadError::OpenFileFailed)
+                    }
+                }
+            },
+        );
+        hash = mtl_hash.get();
+        if let Some(e) = mtl_error.into_inner() {
+            return Err(e.into());
+        }
+        let (models, materials) = loaded.map_err(|e| BakeError::Parse {
             path: path.into(),
             what: "OBJ",
             reason: e.to_string(),
@@ -124,7 +138,8 @@ impl Mesh {
                 texture: file.clone(),
                 reason,
             };
-            let bytes = std::fs::read(&file).map_err(|e| err(e.to_string()))?;
+            let bytes =
+                bounded::read(&file, bounded::limit::TEXTURE).map_err(|e| err(e.to_string()))?;
             *hash = fnv1a(*hash, &bytes);
             let img = image::load_from_memory(&bytes).map_err(|e| err(e.to_string()))?;
             let img = img.to_rgba8();
@@ -281,10 +296,7 @@ impl Mesh {
 /// Front ends use it to refuse outputs that would overwrite the model's own files. Unreadable
 /// libraries are skipped here (the loader reports them).
 pub fn source_files(obj: &Path) -> Result<Vec<PathBuf>, BakeError> {
-    let bytes = std::fs::read(obj).map_err(|source| BakeError::Io {
-        path: obj.into(),
-        source,
-    })?;
+    let bytes = bounded::read(obj, bounded::limit::DATA)?;
     let dir = obj.parent().unwrap_or(Path::new("."));
     let mut files = vec![obj.to_path_buf()];
     for line in String::from_utf8_lossy(&bytes).lines() {
@@ -293,7 +305,7 @@ pub fn source_files(obj: &Path) -> Result<Vec<PathBuf>, BakeError> {
         };
         for lib in rest.split_whitespace() {
             let mtl = dir.join(lib);
-            if let Ok(text) = std::fs::read_to_string(&mtl) {
+            if let Ok(text) = bounded::read_text(&mtl, bounded::limit::TEXT) {
                 for l in text.lines() {
                     let l = l.trim_start();
                     let key = l.split_whitespace().next().unwrap_or("");

@@ -27,10 +27,11 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         crate::guard::not_an_input(p, "FLIP map", &inputs)?;
         crate::guard::extension(p, "FLIP map", "PNG", &["png"])?;
     }
-    let open = |p: &PathBuf| {
-        image::open(p)
-            .with_context(|| format!("reading {}", p.display()))
-            .map(|i| i.to_rgba8())
+    let open = |p: &PathBuf| -> Result<image::RgbaImage> {
+        let bytes = forest_format::bounded::read(p, forest_format::bounded::limit::DATA)?;
+        Ok(image::load_from_memory(&bytes)
+            .with_context(|| format!("reading {}", p.display()))?
+            .to_rgba8())
     };
     let (a, b) = (open(&args.reference)?, open(&args.test)?);
     let m = forest_metrics::compare(&a, &b)?;

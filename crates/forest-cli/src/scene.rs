@@ -71,6 +71,8 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         ..GenerateParams::default()
     })
     .map_err(anyhow::Error::msg)?;
+    // What `render` would refuse is refused here, before anything is written.
+    forest.check(&args.output)?;
     forest.save(&args.output)?;
     println!(
         "{} trees of {} species, {:.0} m across, {} presort directions -> {}",

@@ -95,10 +95,7 @@ impl CameraPath {
 
     /// Load and check a path file.
     pub fn load(path: &Path) -> Result<Self, FormatError> {
-        let bytes = std::fs::read(path).map_err(|source| FormatError::Io {
-            path: path.into(),
-            source,
-        })?;
+        let bytes = crate::bounded::read(path, crate::bounded::limit::TEXT)?;
         let p: CameraPath = serde_json::from_slice(&bytes)
             .map_err(|e| FormatError::invalid(path, format!("not a valid camera path: {e}")))?;
         p.check(path)?;

@@ -85,6 +85,10 @@ impl Presort {
     }
 }
 
+/// Largest coordinate of a tree (metres from the origin on any axis): far enough for any
+/// forest, near enough that far planes and camera matrices stay finite in single precision.
+pub const MAX_COORDINATE: f32 = 1.0e7;
+
 /// A forest: species (atlas names), instances and presorts.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Forest {
@@ -131,7 +135,8 @@ impl Forest {
     }
 
     /// Check values: species indices in range, finite positions, positive finite scales,
-    /// presort orders that are permutations.
+    /// presort orders that are permutations sorted along finite unit directions, and trees
+    /// within [`MAX_COORDINATE`] of the origin.
     pub fn check(&self, path: &Path) -> Result<(), FormatError> {
         let bad = |what: String| Err(FormatError::invalid(path, what));
         if self.species.is_empty() && !self.instances.is_empty() {
@@ -156,6 +161,13 @@ impl Forest {
                     "instance {k} has a non-finite position or rotation"
                 ));
             }
+            if i.position.iter().any(|x| x.abs() > MAX_COORDINATE) {
+                return bad(format!(
+                    "instance {k} lies at {:?}, farther than {MAX_COORDINATE} m from the origin \
+                     (cameras and far planes in single precision need a forest within that)",
+                    i.position
+                ));
+            }
             if !(i.scale.is_finite() && i.scale > 0.0) {
                 return bad(format!("instance {k} has scale {}, not positive", i.scale));
             }
@@ -167,6 +179,13 @@ impl Forest {
                 p.directions.len(),
                 p.orders.len()
             ));
+        }
+        for (k, d) in p.directions.iter().enumerate() {
+            if !(d.is_finite() && (d.length() - 1.0).abs() < 1e-3) {
+                return bad(format!(
+                    "presort direction {k} {d} is not a finite unit vector"
+                ));
+            }
         }
         let n = self.instances.len();
         for (k, order) in p.orders.iter().enumerate() {
@@ -180,13 +199,23 @@ impl Forest {
                     "presort order {k} is not a permutation of the {n} instances"
                 ));
             }
+            // Sorted along its direction (back to front for a viewer on that side), as the
+            // draw order needs it: a reversed order would draw front to back without a word.
+            let d = p.directions[k];
+            let key = |i: u32| Vec3::from_array(self.instances[i as usize].position).dot(d);
+            if let Some(w) = order.windows(2).position(|w| key(w[0]) > key(w[1])) {
+                return bad(format!(
+                    "presort order {k} is not sorted along its direction {d} (entries {w} and {})",
+                    w + 1
+                ));
+            }
         }
         Ok(())
     }
 
     /// Read a forest: JSON when the name ends in `.json`, else binary.
     pub fn load(path: &Path) -> Result<Self, FormatError> {
-        let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+        let bytes = crate::bounded::read(path, crate::bounded::limit::DATA)?;
         let forest = if path.extension().is_some_and(|e| e == "json") {
             let j: JsonForest = serde_json::from_slice(&bytes)
                 .map_err(|e| FormatError::invalid(path, format!("not a valid forest JSON: {e}")))?;
@@ -442,6 +471,19 @@ mod tests {
                 .to_string()
                 .contains("permutation")
         );
+        let err = |g: &Forest| g.check(Path::new("x")).unwrap_err().to_string();
+        let mut g = f.clone();
+        g.presort.orders[0].reverse();
+        assert!(err(&g).contains("not sorted"), "{}", err(&g));
+        let mut g = f.clone();
+        g.presort.directions[1] *= 2.0;
+        assert!(err(&g).contains("unit vector"), "{}", err(&g));
+        let mut g = f.clone();
+        g.presort.directions[1].x = f32::NAN;
+        assert!(err(&g).contains("unit vector"), "{}", err(&g));
+        let mut g = f.clone();
+        g.instances[2].position[0] = 1e20;
+        assert!(err(&g).contains("farther than"), "{}", err(&g));
         let mut g = f;
         g.instances[0].position[1] = f32::NAN;
         assert!(g.check(Path::new("x")).is_err());

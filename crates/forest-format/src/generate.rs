@@ -71,8 +71,11 @@ pub fn value_noise(x: f32, y: f32, seed: u64) -> f32 {
     let (ix, iy) = (fx as i32, fy as i32);
     let s = |t: f32| t * t * (3.0 - 2.0 * t);
     let (tx, ty) = (s(x - fx), s(y - fy));
-    let a = lattice(ix, iy, seed) * (1.0 - tx) + lattice(ix + 1, iy, seed) * tx;
-    let b = lattice(ix, iy + 1, seed) * (1.0 - tx) + lattice(ix + 1, iy + 1, seed) * tx;
+    // Lattice coordinates wrap (and `as` saturates) far from the origin: the noise repeats
+    // there instead of overflowing.
+    let (jx, jy) = (ix.wrapping_add(1), iy.wrapping_add(1));
+    let a = lattice(ix, iy, seed) * (1.0 - tx) + lattice(jx, iy, seed) * tx;
+    let b = lattice(ix, jy, seed) * (1.0 - tx) + lattice(jx, jy, seed) * tx;
     a * (1.0 - ty) + b * ty
 }
 
@@ -104,6 +107,16 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         return Err(format!(
             "area per tree = {}: must be positive",
             p.area_per_tree
+        ));
+    }
+    let side = (f64::from(p.trees) * f64::from(p.area_per_tree)).sqrt();
+    if side > 2.0 * f64::from(crate::forest::MAX_COORDINATE) {
+        return Err(format!(
+            "area per tree = {}: {} trees would cover a square {side:.3e} m across, more than \
+             the {:.0e} m a forest may span",
+            p.area_per_tree,
+            p.trees,
+            2.0 * crate::forest::MAX_COORDINATE
         ));
     }
     if !(p.clump_size.is_finite() && p.clump_size > 0.0) {

@@ -13,6 +13,7 @@
 
 pub mod atlas;
 pub mod atomic;
+pub mod bounded;
 pub mod camera_path;
 pub mod directions;
 pub mod error;

@@ -87,8 +87,10 @@ pub fn encode(nodes: &[QuadNode], roots: usize) -> Vec<u8> {
     z.finish().expect("writing to a Vec cannot fail")
 }
 
-/// Decode `nodes.bin`; the error says what is wrong.
-pub fn decode(bytes: &[u8]) -> Result<(Vec<QuadNode>, usize), String> {
+/// The node and root counts a node file's header claims, checked against the format's
+/// limits only: callers compare them with the counts that must agree (the manifest's) before
+/// [`decode`] allocates anything.
+pub fn header(bytes: &[u8]) -> Result<(usize, usize), String> {
     if bytes.len() < 12 || &bytes[..4] != MAGIC {
         return Err("not a node file of this version (missing the FQN2 header)".into());
     }
@@ -97,6 +99,15 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<QuadNode>, usize), String> {
     if n as u64 > MAX_NODES {
         return Err(format!("{n} nodes, more than the format's {MAX_NODES}"));
     }
+    if roots > n {
+        return Err(format!("{roots} roots but only {n} nodes"));
+    }
+    Ok((n, roots))
+}
+
+/// Decode `nodes.bin`; the error says what is wrong.
+pub fn decode(bytes: &[u8]) -> Result<(Vec<QuadNode>, usize), String> {
+    let (n, roots) = header(bytes)?;
     let mut payload = Vec::new();
     flate2::read::DeflateDecoder::new(&bytes[12..])
         .take(5 * n as u64 + 1)

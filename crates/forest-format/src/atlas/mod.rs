@@ -255,8 +255,12 @@ impl Atlas {
             ));
         }
         let read = |file: &str| {
-            let f = path.join(file);
-            std::fs::read(&f).map_err(|e| FormatError::io(&f, e))
+            let limit = if file == MANIFEST_FILE {
+                crate::bounded::limit::TEXT
+            } else {
+                crate::bounded::limit::DATA
+            };
+            crate::bounded::read(&path.join(file), limit)
         };
         let mpath = path.join(MANIFEST_FILE);
         let manifest: AtlasManifest =
@@ -268,8 +272,21 @@ impl Atlas {
         let colour_file = read(manifest.params.colour.file_name())?;
         let alpha_file = read(ALPHA_FILE)?;
         let npath = path.join(NODES_FILE);
+        let node_bytes = read(NODES_FILE)?;
+        // The header's count is checked against the manifest's before anything is inflated.
+        let (claimed, _) =
+            nodes_codec::header(&node_bytes).map_err(|e| FormatError::invalid(&npath, e))?;
+        if claimed as u64 != manifest.node_count {
+            return Err(FormatError::invalid(
+                &npath,
+                format!(
+                    "its header claims {claimed} nodes, the manifest says {}",
+                    manifest.node_count
+                ),
+            ));
+        }
         let (nodes, roots) =
-            nodes_codec::decode(&read(NODES_FILE)?).map_err(|e| FormatError::invalid(&npath, e))?;
+            nodes_codec::decode(&node_bytes).map_err(|e| FormatError::invalid(&npath, e))?;
         if nodes.len() as u64 != manifest.node_count {
             return Err(FormatError::invalid(
                 &npath,

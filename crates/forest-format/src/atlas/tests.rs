@@ -109,6 +109,13 @@ fn the_loader_names_what_is_wrong() {
     std::fs::write(&nodes, &bytes[..bytes.len() - 3]).unwrap();
     assert!(err(&path).contains(NODES_FILE), "{}", err(&path));
     reset();
+    // A header claiming 16.7 M nodes (within the format) is refused by the manifest's count,
+    // before anything is inflated.
+    let mut forged = bytes.clone();
+    forged[4..8].copy_from_slice(&((1u32 << 24) - 1).to_le_bytes());
+    std::fs::write(&nodes, &forged).unwrap();
+    assert!(err(&path).contains("claims"), "{}", err(&path));
+    reset();
     std::fs::remove_file(path.join(ALPHA_FILE)).unwrap();
     assert!(err(&path).contains(ALPHA_FILE), "{}", err(&path));
     assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));

@@ -1,0 +1,82 @@
+//! Bounded file reads: every file the project reads from a user is checked to be a regular
+//! file no larger than a limit before a byte is read, and read through a reader that stops at
+//! the limit (for files whose size lies, such as those under /proc). An OBJ whose `mtllib`
+//! names /dev/zero is refused instead of read until memory runs out.
+
+use std::io::Read;
+use std::path::Path;
+
+use crate::error::FormatError;
+
+/// Limits (bytes) of the files the project reads.
+pub mod limit {
+    /// An atlas manifest, a camera path, a material library.
+    pub const TEXT: u64 = 64 << 20;
+    /// An OBJ model, a forest file, an atlas mosaic or node file, an image.
+    pub const DATA: u64 = 4 << 30;
+    /// A texture of a model.
+    pub const TEXTURE: u64 = 1 << 30;
+}
+
+/// Read `path` whole when it is a regular file of at most `limit` bytes; the error names the
+/// file and the cause.
+pub fn read(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
+    let meta = std::fs::metadata(path).map_err(|e| FormatError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(FormatError::invalid(
+            path,
+            "is not a regular file (a folder, device or pipe): refusing to read it",
+        ));
+    }
+    if meta.len() > limit {
+        return Err(FormatError::invalid(
+            path,
+            format!("{} bytes, more than the {limit}-byte limit", meta.len()),
+        ));
+    }
+    let file = std::fs::File::open(path).map_err(|e| FormatError::io(path, e))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| FormatError::io(path, e))?;
+    if bytes.len() as u64 > limit {
+        return Err(FormatError::invalid(
+            path,
+            format!("grew past the {limit}-byte limit while being read"),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// [`read`] as UTF-8 text.
+pub fn read_text(path: &Path, limit: u64) -> Result<String, FormatError> {
+    String::from_utf8(read(path, limit)?)
+        .map_err(|_| FormatError::invalid(path, "is not UTF-8 text"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn special_and_oversized_files_are_refused_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("a.bin");
+        std::fs::write(&f, [7u8; 100]).unwrap();
+        assert_eq!(read(&f, 100).unwrap().len(), 100);
+        assert!(read(&f, 99).unwrap_err().to_string().contains("limit"));
+        assert!(
+            read(dir.path(), 1 << 20)
+                .unwrap_err()
+                .to_string()
+                .contains("regular file")
+        );
+        if Path::new("/dev/zero").exists() {
+            let e = read(Path::new("/dev/zero"), 1 << 20)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("regular file"), "{e}");
+        }
+        assert!(read(&dir.path().join("none"), 10).is_err());
+    }
+}
