@@ -174,6 +174,27 @@ fn bad_models_give_one_clear_error_and_write_nothing() {
     );
     assert!(fails(&missing_mtl, &[], d).contains("material library"));
 
+    write("one.mtl", "newmtl bark\nKd 0.3 0.2 0.1\n");
+    let undefined = write(
+        "undef.obj",
+        "mtllib one.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\n",
+    );
+    let err = fails(&undefined, &[], d);
+    assert!(
+        err.contains("line 5") && err.contains("usemtl leaf"),
+        "{err}"
+    );
+
+    let device = write(
+        "dev.obj",
+        "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let err = fails(&device, &[], d);
+    assert!(
+        err.contains("/dev/zero") && err.contains("regular file"),
+        "{err}"
+    );
+
     // Cleanup of the fixtures is the tempdir's; the listing check in `fails` covers outputs.
 }
 

@@ -399,6 +399,16 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
     ]));
     assert!(e.contains("may span"), "{e}");
     assert!(snapshot(d) == before);
+    // Messages name their cause once.
+    let e = err(&forest(&[
+        "render",
+        &p("none.forest"),
+        "--view",
+        "inside",
+        "-o",
+        &p("y.png"),
+    ]));
+    assert_eq!(e.matches("os error 2").count(), 1, "{e}");
     // No temporary files were left either (the snapshot holds every file there is).
     assert!(
         !before

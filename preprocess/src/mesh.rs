@@ -125,6 +125,25 @@ impl Mesh {
             reason: e.to_string(),
         })?;
 
+        // A `usemtl` naming no material of the libraries is an error, not material 0.
+        for (n, line) in String::from_utf8_lossy(&obj_bytes).lines().enumerate() {
+            if let Some(name) = line.trim_start().strip_prefix("usemtl") {
+                let name = name.trim();
+                if !name.is_empty() && !materials.iter().any(|m| m.name == name) {
+                    return Err(BakeError::Parse {
+                        path: path.into(),
+                        what: "OBJ",
+                        reason: format!(
+                            "line {}: usemtl {name}: no material of that name in the material \
+                             libraries ({} defined)",
+                            n + 1,
+                            materials.len()
+                        ),
+                    });
+                }
+            }
+        }
+
         let mut textures: Vec<Texture> = Vec::new();
         let mut by_path: HashMap<PathBuf, (usize, bool)> = HashMap::new();
         let mut load_texture = |material: &str, spec: &str, hash: &mut u64| {

@@ -89,8 +89,39 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("forest: error: {e:#}");
+            eprintln!("forest: error: {}", message(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// An error and its causes on one line, each cause once: a cause whose text the message
+/// already holds (an I/O error wrapped with its path) is not repeated.
+fn message(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1) {
+        let c = cause.to_string();
+        if !text.contains(&c) {
+            text.push_str(": ");
+            text.push_str(&c);
+        }
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn causes_are_named_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let wrapped = forest_format::FormatError::Io {
+            path: "f.forest".into(),
+            source: io,
+        };
+        let e = anyhow::Error::from(wrapped).context("loading the scene");
+        assert_eq!(
+            super::message(&e),
+            "loading the scene: f.forest: no such file"
+        );
     }
 }
