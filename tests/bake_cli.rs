@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 mod cli;
 
-use cli::forest;
+use cli::{forest, model, ok};
 
 fn bush() -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -250,4 +250,47 @@ fn outputs_that_cannot_be_written_are_refused_up_front() {
     let info = forest(&["info", dir.path().join("nothing.atlas").to_str().unwrap()]);
     assert!(!info.status.success());
     assert!(String::from_utf8_lossy(&info.stderr).contains("no such atlas"));
+}
+
+#[test]
+fn the_memory_estimate_bounds_a_measured_bake_and_refuses_what_cannot_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b.atlas");
+    let o = out.to_str().unwrap();
+    let args = [
+        "bake",
+        &model("bush"),
+        "-o",
+        o,
+        "--resolution",
+        "256",
+        "--directions",
+        "5",
+        "--below",
+        "0",
+        "--spp",
+        "1",
+    ];
+    // Refused before any work, with the figure and the limit; nothing written.
+    let mut small = args.to_vec();
+    small.extend(["--memory-limit", "0.01"]);
+    let refused = forest(&small);
+    assert!(!refused.status.success());
+    let e = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        e.contains("GiB at its peak") && e.contains("0.0 GiB available"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // The estimate is an upper bound of the measured peak, and not a loose one.
+    let mut json = args.to_vec();
+    json.push("--json");
+    let v: serde_json::Value = serde_json::from_str(&ok(&forest(&json))).unwrap();
+    let estimate = v["peak_estimate_bytes"].as_f64().unwrap();
+    if let Some(measured) = v["peak_resident_bytes"].as_f64() {
+        assert!(
+            measured <= estimate && estimate <= 3.0 * measured,
+            "estimate {estimate} vs measured peak {measured}"
+        );
+    }
 }

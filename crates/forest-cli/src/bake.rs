@@ -55,6 +55,10 @@ pub struct BakeArgs {
     /// Print one JSON line of figures instead of the human summary.
     #[arg(long)]
     pub json: bool,
+    /// Refuse bakes whose estimated peak memory exceeds this many GiB (default: the memory
+    /// the system reports available).
+    #[arg(long, value_name = "GIB")]
+    pub memory_limit: Option<f64>,
 }
 
 /// Arguments of `forest info`.
@@ -129,6 +133,22 @@ fn check_output_file(path: &Path, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// Memory the system reports available (`MemAvailable` in /proc/meminfo), where it says.
+fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Peak resident memory of this process so far (`VmHWM`), where the system says.
+fn peak_resident() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
 /// Run `forest bake`.
 pub fn run(args: &BakeArgs) -> Result<()> {
     let params = args.params();
@@ -149,6 +169,29 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         && !p.is_dir()
     {
         bail!("output folder {} does not exist", p.display());
+    }
+    // Refuse what cannot fit before tracing for minutes and then failing an allocation.
+    let model_bytes = std::fs::metadata(&args.model).map(|m| m.len()).unwrap_or(0);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u64);
+    let need = forest_bake::peak_bytes_estimate(&params, model_bytes, threads);
+    let limit = match args.memory_limit {
+        Some(g) if g.is_finite() && g > 0.0 => Some((g * f64::from(1u32 << 30)) as u64),
+        Some(g) => bail!("memory limit {g} GiB must be positive"),
+        None => available_memory(),
+    };
+    if let Some(limit) = limit
+        && need > limit
+    {
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        bail!(
+            "this bake needs about {:.1} GiB at its peak ({} layers of {}x{} px), more than the \
+             {:.1} GiB available: lower --resolution or --directions/--below/--slabs",
+            gib(need),
+            params.layers(),
+            params.resolution,
+            params.resolution,
+            gib(limit)
+        );
     }
     // The model's own files (OBJ, material libraries, textures) are never overwritten, and
     // the outputs never overwrite each other.
@@ -210,6 +253,8 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         "degenerate_triangles": m.source.degenerate_triangles,
         "seconds": (out.seconds * 1000.0).round() / 1000.0,
         "disk_bytes": disk,
+        "peak_estimate_bytes": need,
+        "peak_resident_bytes": peak_resident(),
         "colour_bytes": out.atlas.colour_file.len(),
         "alpha_bytes": out.atlas.alpha_file.len(),
         "gpu_bytes": m.gpu_bytes(),
