@@ -416,3 +416,54 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
             .any(|(f, _)| f.to_string_lossy().contains(".tmp-"))
     );
 }
+
+#[test]
+fn an_interrupted_scene_leaves_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    bake_small("bush", &d.join("bush.atlas"), 32, 5);
+    let atlas = d.join("bush.atlas").display().to_string();
+    let out = d.join("big.forest").display().to_string();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_forest"))
+        .args([
+            "scene",
+            "--trees",
+            "3000000",
+            "--species",
+            &atlas,
+            "-o",
+            &out,
+        ])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Interrupt while the temporary file is being written (or, failing that, while the trees
+    // are being placed).
+    let start = std::time::Instant::now();
+    let writing = || {
+        std::fs::read_dir(d)
+            .unwrap()
+            .any(|e| e.unwrap().file_name().to_string_lossy().contains(".tmp-"))
+    };
+    while !writing() && start.elapsed().as_secs() < 60 && child.try_wait().unwrap().is_none() {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let status = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let code = child.wait().unwrap();
+    let names: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(!names.iter().any(|n| n.contains(".tmp-")), "{names:?}");
+    // Stopped before the rename: no forest either (130 = interrupted); a run that finished
+    // first left a whole one.
+    if code.code() == Some(130) {
+        assert!(!names.contains(&"big.forest".to_string()), "{names:?}");
+    } else {
+        assert!(code.success(), "{code:?}");
+    }
+}

@@ -77,6 +77,13 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // Stopped by SIGINT or SIGTERM: remove the temporary files being written, then exit as
+    // the shell expects (128 + SIGINT).
+    let _ = ctrlc::set_handler(|| {
+        forest_format::atomic::remove_pending();
+        eprintln!("forest: interrupted; temporary files removed");
+        std::process::exit(130);
+    });
     let result = match cli {
         Cli::Bake(args) => bake::run(&args),
         Cli::Info(args) => bake::info(&args),

@@ -61,6 +61,17 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         }
         species.push(stored_path(s, &args.output)?);
     }
+    // Millions of trees take seconds to place and sort: say so while it runs.
+    let spinner = indicatif::ProgressBar::new_spinner();
+    if args.trees >= 100_000 {
+        spinner.set_message(format!(
+            "placing {} trees and sorting them along {} directions",
+            args.trees, args.presort_directions
+        ));
+        spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    } else {
+        spinner.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
     let forest = generate(&GenerateParams {
         trees: args.trees,
         species,
@@ -73,7 +84,9 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     .map_err(anyhow::Error::msg)?;
     // What `render` would refuse is refused here, before anything is written.
     forest.check(&args.output)?;
+    spinner.set_message(format!("writing {}", args.output.display()));
     forest.save(&args.output)?;
+    spinner.finish_and_clear();
     println!(
         "{} trees of {} species, {:.0} m across, {} presort directions -> {}",
         forest.instances.len(),

@@ -4,8 +4,39 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::error::FormatError;
+
+/// Temporary files and folders being written now: what [`remove_pending`] deletes when the
+/// process is interrupted.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Mark `tmp` (a file or folder) as being written until [`done`].
+pub fn pending(tmp: &Path) {
+    PENDING
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(tmp.to_path_buf());
+}
+
+/// `tmp` was renamed into place or removed.
+pub fn done(tmp: &Path) {
+    PENDING
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .retain(|p| p != tmp);
+}
+
+/// Remove every temporary file or folder still being written: for an interrupt handler
+/// (SIGINT, SIGTERM), so that a stopped command leaves no litter.
+pub fn remove_pending() {
+    let pending = std::mem::take(&mut *PENDING.lock().unwrap_or_else(|e| e.into_inner()));
+    for p in pending {
+        let _ = std::fs::remove_file(&p);
+        let _ = std::fs::remove_dir_all(&p);
+    }
+}
 
 /// The temporary sibling of `path` a writer fills before the rename: `.NAME.tmp-PID` in the
 /// same folder (so the rename stays on one file system).
@@ -28,12 +59,14 @@ pub fn write_with<E: std::fmt::Display>(
         return Err(FormatError::invalid(path, "not a file name"));
     }
     let tmp = tmp_name(path);
+    pending(&tmp);
     let result = write(&tmp)
         .map_err(|e| FormatError::invalid(path, e.to_string()))
         .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| FormatError::io(path, e)));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    done(&tmp);
     result
 }
 

@@ -202,6 +202,7 @@ impl Atlas {
         };
         let tmp = crate::atomic::tmp_name(&parent.join(&name));
         let _ = std::fs::remove_dir_all(&tmp);
+        crate::atomic::pending(&tmp);
         let result = (|| {
             std::fs::create_dir_all(&tmp).map_err(|e| FormatError::io(&tmp, e))?;
             let manifest =
@@ -234,6 +235,7 @@ impl Atlas {
         if result.is_err() {
             let _ = std::fs::remove_dir_all(&tmp);
         }
+        crate::atomic::done(&tmp);
         result
     }
 
