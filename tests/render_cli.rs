@@ -399,6 +399,18 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
     ]));
     assert!(e.contains("may span"), "{e}");
     assert!(snapshot(d) == before);
+    // A negative number is an option's value, refused for what it is.
+    let e = err(&forest(&[
+        "render",
+        &f,
+        "--view",
+        "inside",
+        "--epsilon",
+        "-1",
+        "-o",
+        &p("z.png"),
+    ]));
+    assert!(e.contains("epsilon -1 must be positive"), "{e}");
     // Messages name their cause once.
     let e = err(&forest(&[
         "render",

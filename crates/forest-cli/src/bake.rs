@@ -38,7 +38,7 @@ pub struct BakeArgs {
     #[arg(long, default_value_t = 4)]
     pub spp: u32,
     /// Sun direction as AZIMUTH,ELEVATION in degrees (azimuth from +Z towards +X).
-    #[arg(long, default_value = "30,55", value_parser = parse_sun)]
+    #[arg(long, default_value = "30,55", value_parser = parse_sun, allow_hyphen_values = true)]
     pub sun: (f32, f32),
     /// JPEG quality of the colour mosaic (1–100).
     #[arg(long, default_value_t = 80, conflicts_with = "lossless")]

@@ -37,10 +37,10 @@ pub struct RenderArgs {
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Refinement threshold ε in pixels.
-    #[arg(long, default_value_t = 16.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 16.0)]
     pub epsilon: f32,
     /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 60.0)]
     pub fov: f32,
     /// Print one JSON line of figures per view.
     #[arg(long)]
@@ -81,13 +81,13 @@ pub struct MethodArgs {
     #[arg(long)]
     pub unsorted: bool,
     /// Stochastic: distance (m, per unit tree scale) within which every leaf is drawn.
-    #[arg(long, default_value_t = Stochastic::default().d0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Stochastic::default().d0)]
     pub d0: f32,
     /// Stochastic: the d0²/d² at which half the leaves are drawn, in (0, 1).
-    #[arg(long, default_value_t = Stochastic::default().h)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Stochastic::default().h)]
     pub h: f32,
     /// Stochastic: fading band width as a fraction of λ.
-    #[arg(long, default_value_t = Stochastic::default().fade)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Stochastic::default().fade)]
     pub fade: f32,
     /// Stochastic: no area preservation.
     #[arg(long)]
@@ -115,7 +115,7 @@ pub struct MethodArgs {
     pub near: Near,
     /// Hybrid: width of the transition band, as a fraction of the switch distance (a tree
     /// in it is drawn by both forms through complementary screen-door masks).
-    #[arg(long, default_value_t = Hybrid::default().band)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Hybrid::default().band)]
     pub band: f32,
 }
 

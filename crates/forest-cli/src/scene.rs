@@ -19,10 +19,10 @@ pub struct SceneArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Mean ground area per tree in m² (sets the forest's size).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 30.0)]
     pub area_per_tree: f32,
     /// Clump size in metres.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 60.0)]
     pub clump_size: f32,
     /// Presort directions.
     #[arg(long, default_value_t = 15)]

@@ -47,7 +47,7 @@ pub struct ViewArgs {
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Refinement threshold ε in pixels (quad stream).
-    #[arg(long, default_value_t = 4.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 4.0)]
     pub epsilon: f32,
     #[command(flatten)]
     pub m: MethodArgs,
