@@ -261,4 +261,24 @@ impl RendererOptions {
             wgpu::CompareFunction::LessEqual
         }
     }
+
+    /// The depth state of a pipeline drawing into these targets: their depth format and
+    /// test, depth written or not.
+    pub fn depth_stencil(&self, write: bool) -> wgpu::DepthStencilState {
+        wgpu::DepthStencilState {
+            format: self.depth_format,
+            depth_write_enabled: Some(write),
+            depth_compare: Some(self.depth_compare()),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }
+    }
+
+    /// The multisample state of a pipeline drawing into these targets.
+    pub fn multisample(&self) -> wgpu::MultisampleState {
+        wgpu::MultisampleState {
+            count: self.sample_count,
+            ..Default::default()
+        }
+    }
 }

@@ -279,17 +279,8 @@ impl GeometryRenderer {
                         cull_mode: None,
                         ..Default::default()
                     },
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: opts.depth_format,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(opts.depth_compare()),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: wgpu::MultisampleState {
-                        count: opts.sample_count,
-                        ..Default::default()
-                    },
+                    depth_stencil: Some(opts.depth_stencil(true)),
+                    multisample: opts.multisample(),
                     fragment: Some(wgpu::FragmentState {
                         module: &draw_module,
                         entry_point: Some(fs),
@@ -459,10 +450,14 @@ impl GeometryRenderer {
     /// Write the camera (with the renderer's `forms`): the one upload of a frame.
     pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
         camera.validate()?;
-        let mut g = camera.to_gpu();
-        g.forms = self.forms;
-        forest_render::camera::upload(&ctx.queue, &self.camera, &g, &mut self.writes);
+        self.write_camera(&ctx.queue, camera.to_gpu());
         Ok(())
+    }
+
+    /// Write a camera uniform with the renderer's `forms`.
+    fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
+        g.forms = self.forms;
+        forest_render::camera::upload(queue, &self.camera, &g, &mut self.writes);
     }
 
     /// Write the camera from the host's matrices (as `QuadStream::prepare`); then
@@ -473,9 +468,7 @@ impl GeometryRenderer {
         frame: &forest_render::FrameParams,
     ) -> Result<(), RenderError> {
         frame.validate()?;
-        let mut g = frame.to_gpu();
-        g.forms = self.forms;
-        forest_render::camera::upload(queue, &self.camera, &g, &mut self.writes);
+        self.write_camera(queue, frame.to_gpu());
         Ok(())
     }
 

@@ -109,17 +109,8 @@ impl DrawPass {
                     cull_mode: None,
                     ..Default::default()
                 },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: opts.depth_format,
-                    depth_write_enabled: Some(depth_write),
-                    depth_compare: Some(opts.depth_compare()),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState {
-                    count: opts.sample_count,
-                    ..Default::default()
-                },
+                depth_stencil: Some(opts.depth_stencil(depth_write)),
+                multisample: opts.multisample(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(fs),
