@@ -97,13 +97,7 @@ fn shaders_validate() {
         forest_baselines::shaders::GEOMETRY_DRAW_WGSL.concat(),
         forest_baselines::shaders::GEOMETRY_CULL_WGSL.concat(),
     ] {
-        let module = naga::front::wgsl::parse_str(&src).unwrap();
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{e:?}"));
+        layout_check::validated(&src);
     }
 }
 

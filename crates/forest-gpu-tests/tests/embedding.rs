@@ -50,6 +50,46 @@ fn host_clear(ctx: &GpuContext, target: &Target, colour: wgpu::Color) {
     ctx.queue.submit([enc.finish()]);
 }
 
+/// A host's multisampled colour and depth targets of `samples` samples, and the readable
+/// target the colour resolves to.
+fn msaa_targets(ctx: &GpuContext, samples: u32) -> (wgpu::TextureView, wgpu::TextureView, Target) {
+    let make = |format, label| {
+        ctx.device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: SIZE.0,
+                    height: SIZE.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+    };
+    (
+        make(TARGET_FORMAT, "msaa colour"),
+        make(wgpu::TextureFormat::Depth32Float, "msaa depth"),
+        Target::new(ctx, SIZE.0, SIZE.1),
+    )
+}
+
+/// `cam` seen through a reverse-Z projection with an infinite far plane (same field of view).
+fn reverse_z_frame(cam: &forest_render::Camera) -> FrameParams {
+    FrameParams {
+        proj: glam::camera::rh::proj::directx::perspective_infinite_reverse(
+            cam.fov_y_deg.to_radians(),
+            cam.viewport.0 as f32 / cam.viewport.1 as f32,
+            cam.near,
+        ),
+        ..FrameParams::from(cam)
+    }
+}
+
 #[test]
 fn drawing_over_a_host_frame_keeps_its_pixels_where_no_tree_is() {
     let ctx = common::ctx();
@@ -192,35 +232,8 @@ fn reverse_z_and_msaa_targets_of_the_host() {
         ..opts(Background::Sky)
     };
     let mut s = QuadStream::new(&ctx.device, scene, &host).unwrap();
-    let make = |format, label| {
-        ctx.device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: SIZE.0,
-                    height: SIZE.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default())
-    };
-    let msaa = make(TARGET_FORMAT, "msaa colour");
-    let depth = make(wgpu::TextureFormat::Depth32Float, "msaa depth");
-    let resolved = Target::new(&ctx, SIZE.0, SIZE.1);
-    let frame = FrameParams {
-        proj: glam::camera::rh::proj::directx::perspective_infinite_reverse(
-            60f32.to_radians(),
-            4.0 / 3.0,
-            0.1,
-        ),
-        ..FrameParams::from(&cam)
-    };
+    let (msaa, depth, resolved) = msaa_targets(&ctx, samples);
+    let frame = reverse_z_frame(&cam);
     s.prepare(&ctx.queue, &frame).unwrap();
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     let targets = Targets {
@@ -330,35 +343,8 @@ fn the_geometry_renderer_draws_into_reverse_z_msaa_targets() {
     let mut geo = GeometryRenderer::with_targets(&ctx, common::prepared(), &forest, &host).unwrap();
     geo.set_method(&ctx, MeshMethod::Full { depth_sort: true })
         .unwrap();
-    let make = |format, label| {
-        ctx.device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: SIZE.0,
-                    height: SIZE.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default())
-    };
-    let msaa = make(TARGET_FORMAT, "msaa colour");
-    let depth = make(wgpu::TextureFormat::Depth32Float, "msaa depth");
-    let resolved = Target::new(&ctx, SIZE.0, SIZE.1);
-    let frame = FrameParams {
-        proj: glam::camera::rh::proj::directx::perspective_infinite_reverse(
-            60f32.to_radians(),
-            4.0 / 3.0,
-            0.1,
-        ),
-        ..FrameParams::from(&cam)
-    };
+    let (msaa, depth, resolved) = msaa_targets(&ctx, samples);
+    let frame = reverse_z_frame(&cam);
     geo.prepare(&ctx.queue, &frame).unwrap();
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     geo.encode_compute(&mut enc);

@@ -39,13 +39,7 @@ fn draw_structs_match_the_host() {
 #[test]
 fn shaders_validate() {
     for src in [compute_source(), draw_source()] {
-        let module = naga::front::wgsl::parse_str(&src).unwrap();
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{e:?}"));
+        layout_check::validated(&src);
     }
 }
 

@@ -281,16 +281,23 @@ pub fn workgroup_sizes(source: &str) -> Vec<(String, u32)> {
         .collect()
 }
 
-/// Bindings used (read or written) by the entry points of a module that `entry` selects, from
-/// naga's validation info.
-pub fn used_bindings(source: &str, entry: impl Fn(&str) -> bool) -> Vec<(u32, u32)> {
-    let module = naga::front::wgsl::parse_str(source).unwrap();
+/// Parse and validate a WGSL module with every check naga has; panics with the message.
+pub fn validated(source: &str) -> (naga::Module, naga::valid::ModuleInfo) {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
     let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
     .validate(&module)
-    .unwrap();
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    (module, info)
+}
+
+/// Bindings used (read or written) by the entry points of a module that `entry` selects, from
+/// naga's validation info.
+pub fn used_bindings(source: &str, entry: impl Fn(&str) -> bool) -> Vec<(u32, u32)> {
+    let (module, info) = validated(source);
     let mut used = std::collections::BTreeSet::new();
     for (i, ep) in module.entry_points.iter().enumerate() {
         if !entry(&ep.name) {
