@@ -157,6 +157,20 @@ fn bad_models_give_one_clear_error_and_write_nothing() {
     let inf = write("inf.obj", "v 0 0 0\nv 1 inf 0\nv 0 1 0\nf 1 2 3\n");
     assert!(fails(&inf, &[], d).contains("non-finite"));
 
+    // Coordinates whose triangle areas overflow f32 are named as such, not as degenerate.
+    let huge = write("huge.obj", "v 0 0 0\nv 1e38 0 0\nv 0 1e38 0\nf 1 2 3\n");
+    let err = fails(&huge, &[], d);
+    assert!(err.contains("1e38") && err.contains("rescale"), "{err}");
+
+    // A colour statement short of values (tobj 4 would panic on it) names the file and line.
+    write("short.mtl", "newmtl leaf\nKd 0.3 0\n");
+    let short = write(
+        "short.obj",
+        "mtllib short.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\n",
+    );
+    let err = fails(&short, &[], d);
+    assert!(err.contains("short.mtl") && err.contains("line 2"), "{err}");
+
     let degenerate = write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
     assert!(fails(&degenerate, &[], d).contains("degenerate"));
 

@@ -73,12 +73,38 @@ pub fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
 }
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
+/// Refuse what tobj 4 would panic on in a material library: a colour statement (`Ka`, `Kd`,
+/// `Ks`, `Ke`) with fewer than three values.
+fn check_mtl(file: &Path, bytes: &[u8]) -> Result<(), forest_format::FormatError> {
+    for (n, line) in String::from_utf8_lossy(bytes).lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if let Some(w @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+            let values = words.count();
+            if values < 3 {
+                return Err(forest_format::FormatError::invalid(
+                    file,
+                    format!(
+                        "line {}: {w} needs three numbers (r g b), found {values}",
+                        n + 1
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn texture_path(obj_dir: &Path, spec: &str) -> PathBuf {
     // MTL map statements may carry options before the file name (`-bm 1 file.png`): the file
     // is the last word.
     let file = spec.split_whitespace().last().unwrap_or(spec);
     obj_dir.join(file.replace('\\', "/"))
 }
+
+/// The largest vertex coordinate (absolute value, model units) a model may have: beyond it,
+/// areas of the model's triangles (fourth powers of coordinates in the zero-area test)
+/// overflow `f32`. NaN and infinities are refused by the same test.
+pub const MAX_MODEL_COORDINATE: f32 = 1e6;
 
 impl Mesh {
     /// Load an OBJ file with its materials and textures.
@@ -98,6 +124,10 @@ impl Mesh {
                 match bounded::read(&file, bounded::limit::TEXT) {
                     Ok(b) => {
                         mtl_hash.set(fnv1a(mtl_hash.get(), &b));
+                        if let Err(e) = check_mtl(&file, &b) {
+                            *mtl_error.borrow_mut() = Some(e);
+                            return Err(tobj::LoadError::MaterialParseError);
+                        }
                         tobj::load_mtl_buf(&mut std::io::Cursor::new(b))
                     }
                     // A missing library is tobj's to report; a refused one is ours.
@@ -160,8 +190,14 @@ impl Mesh {
             let bytes =
                 bounded::read(&file, bounded::limit::TEXTURE).map_err(|e| err(e.to_string()))?;
             *hash = fnv1a(*hash, &bytes);
-            let img = image::load_from_memory(&bytes).map_err(|e| err(e.to_string()))?;
-            let img = img.to_rgba8();
+            let img = bounded::decode_image(&bytes, None, &file)
+                .map_err(|e| {
+                    err(match e {
+                        forest_format::FormatError::Image { what, .. } => what,
+                        other => other.to_string(),
+                    })
+                })?
+                .into_rgba8();
             if img.width() == 0 || img.height() == 0 {
                 return Err(err("empty image".into()));
             }
@@ -215,15 +251,23 @@ impl Mesh {
         let mut extent = 0.0f32;
         for model in &models {
             let mesh = &model.mesh;
-            if let Some(i) = mesh.positions.iter().position(|x| !x.is_finite()) {
+            if let Some(i) = mesh
+                .positions
+                .iter()
+                .position(|x| !x.is_finite() || x.abs() > MAX_MODEL_COORDINATE)
+            {
+                let x = mesh.positions[i];
+                let why = if x.is_finite() {
+                    format!(
+                        "the coordinate {x:e}, beyond the ±{MAX_MODEL_COORDINATE:e} model units \
+                         the bake handles (rescale the model)"
+                    )
+                } else {
+                    format!("a non-finite coordinate ({x})")
+                };
                 return Err(BakeError::Model {
                     path: path.into(),
-                    what: format!(
-                        "object {:?}: vertex {} has a non-finite coordinate ({})",
-                        model.name,
-                        i / 3 + 1,
-                        mesh.positions[i]
-                    ),
+                    what: format!("object {:?}: vertex {} has {why}", model.name, i / 3 + 1),
                 });
             }
             for p in mesh.positions.chunks_exact(3) {

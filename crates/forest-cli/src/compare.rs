@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 
 /// Arguments of `forest compare`.
@@ -29,9 +29,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     let open = |p: &PathBuf| -> Result<image::RgbaImage> {
         let bytes = forest_format::bounded::read(p, forest_format::bounded::limit::DATA)?;
-        Ok(image::load_from_memory(&bytes)
-            .with_context(|| format!("reading {}", p.display()))?
-            .to_rgba8())
+        Ok(forest_format::bounded::decode_image(&bytes, None, p)?.into_rgba8())
     };
     let (a, b) = (open(&args.reference)?, open(&args.test)?);
     let m = forest_metrics::compare(&a, &b)?;

@@ -16,6 +16,50 @@ pub mod limit {
     pub const DATA: u64 = 4 << 30;
     /// A texture of a model.
     pub const TEXTURE: u64 = 1 << 30;
+    /// The widest and tallest image decoded (pixels): textures, atlas mosaics, images given
+    /// to `compare`.
+    pub const IMAGE_SIDE: u32 = 16_384;
+    /// The most bytes a decoder may allocate for one image's pixels.
+    pub const IMAGE_ALLOC: u64 = 512 << 20;
+}
+
+/// Decode an image held in memory (`format` when the container is known, else guessed from
+/// its first bytes) with the sizes bounded by [`limit::IMAGE_SIDE`] and
+/// [`limit::IMAGE_ALLOC`], checked from the header before the pixels are allocated. Errors
+/// name `path`, the file the bytes came from.
+pub fn decode_image(
+    bytes: &[u8],
+    format: Option<image::ImageFormat>,
+    path: &Path,
+) -> Result<image::DynamicImage, FormatError> {
+    let err = |what: String| FormatError::Image {
+        path: path.into(),
+        what,
+    };
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    match format {
+        Some(f) => reader.set_format(f),
+        None => {
+            reader = reader
+                .with_guessed_format()
+                .map_err(|e| err(e.to_string()))?
+        }
+    }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(limit::IMAGE_SIDE);
+    limits.max_image_height = Some(limit::IMAGE_SIDE);
+    limits.max_alloc = Some(limit::IMAGE_ALLOC);
+    reader.limits(limits);
+    reader.decode().map_err(|e| {
+        err(match e {
+            image::ImageError::Limits(_) => format!(
+                "larger than the {side}×{side} pixels or {mb} MB of pixels read from one image",
+                side = limit::IMAGE_SIDE,
+                mb = limit::IMAGE_ALLOC >> 20
+            ),
+            other => other.to_string(),
+        })
+    })
 }
 
 /// Read `path` whole when it is a regular file of at most `limit` bytes; the error names the

@@ -96,7 +96,12 @@ impl CameraPath {
     /// Load and check a path file.
     pub fn load(path: &Path) -> Result<Self, FormatError> {
         let bytes = crate::bounded::read(path, crate::bounded::limit::TEXT)?;
-        let p: CameraPath = serde_json::from_slice(&bytes)
+        Self::parse(path, &bytes)
+    }
+
+    /// [`CameraPath::load`] from the file's bytes; errors name `path`.
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, FormatError> {
+        let p: CameraPath = serde_json::from_slice(bytes)
             .map_err(|e| FormatError::invalid(path, format!("not a valid camera path: {e}")))?;
         p.check(path)?;
         Ok(p)

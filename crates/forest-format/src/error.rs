@@ -57,7 +57,8 @@ impl FormatError {
             source,
         }
     }
-    pub(crate) fn invalid(path: impl Into<PathBuf>, what: impl Into<String>) -> Self {
+    /// An error naming `path` and what is wrong with it.
+    pub fn invalid(path: impl Into<PathBuf>, what: impl Into<String>) -> Self {
         Self::Invalid {
             path: path.into(),
             what: what.into(),

@@ -216,8 +216,14 @@ impl Forest {
     /// Read a forest: JSON when the name ends in `.json`, else binary.
     pub fn load(path: &Path) -> Result<Self, FormatError> {
         let bytes = crate::bounded::read(path, crate::bounded::limit::DATA)?;
+        Self::parse(path, &bytes)
+    }
+
+    /// [`Forest::load`] from the file's bytes: JSON when `path` ends in `.json`, else binary;
+    /// errors name `path`.
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, FormatError> {
         let forest = if path.extension().is_some_and(|e| e == "json") {
-            let j: JsonForest = serde_json::from_slice(&bytes)
+            let j: JsonForest = serde_json::from_slice(bytes)
                 .map_err(|e| FormatError::invalid(path, format!("not a valid forest JSON: {e}")))?;
             let instances = j
                 .instances
@@ -238,7 +244,7 @@ impl Forest {
             }
             Self::new(j.species, instances, k)
         } else {
-            Self::from_bytes(&bytes).map_err(|e| FormatError::invalid(path, e))?
+            Self::from_bytes(bytes).map_err(|e| FormatError::invalid(path, e))?
         };
         forest.check(path)?;
         Ok(forest)

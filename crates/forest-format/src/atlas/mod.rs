@@ -105,19 +105,17 @@ impl Atlas {
         let p = &self.manifest.params;
         let colour_path = path.join(p.colour.file_name());
         let alpha_path = path.join(ALPHA_FILE);
-        let img_err = |path: &Path, e: image::ImageError| FormatError::Image {
-            path: path.into(),
-            what: e.to_string(),
-        };
         let format = match p.colour {
             ColourEncoding::Jpeg { .. } => image::ImageFormat::Jpeg,
             ColourEncoding::Png => image::ImageFormat::Png,
         };
-        let colour = image::load_from_memory_with_format(&self.colour_file, format)
-            .map_err(|e| img_err(&colour_path, e))?
-            .to_rgb8();
-        let alpha = image::load_from_memory_with_format(&self.alpha_file, image::ImageFormat::Png)
-            .map_err(|e| img_err(&alpha_path, e))?;
+        let colour = crate::bounded::decode_image(&self.colour_file, Some(format), &colour_path)?
+            .into_rgb8();
+        let alpha = crate::bounded::decode_image(
+            &self.alpha_file,
+            Some(image::ImageFormat::Png),
+            &alpha_path,
+        )?;
         // 8-bit grey, or a grey palette (which decodes to RGB with equal channels).
         let alpha = match alpha {
             image::DynamicImage::ImageLuma8(a) => a,
@@ -264,6 +262,16 @@ impl Atlas {
             };
             crate::bounded::read(&path.join(file), limit)
         };
+        Self::from_files(path, &read)
+    }
+
+    /// [`Atlas::load`] from the folder's files as `read(file name)` returns them (the files
+    /// of the folder `path`, which errors name). The manifest is read and checked first, so
+    /// no other file is read for an atlas whose manifest is refused.
+    pub fn from_files(
+        path: &Path,
+        read: &dyn Fn(&str) -> Result<Vec<u8>, FormatError>,
+    ) -> Result<Self, FormatError> {
         let mpath = path.join(MANIFEST_FILE);
         let manifest: AtlasManifest =
             serde_json::from_slice(&read(MANIFEST_FILE)?).map_err(|source| FormatError::Json {
