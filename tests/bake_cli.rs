@@ -171,6 +171,17 @@ fn bad_models_give_one_clear_error_and_write_nothing() {
     let err = fails(&short, &[], d);
     assert!(err.contains("short.mtl") && err.contains("line 2"), "{err}");
 
+    // Face indices naming nothing defined (tobj 4 overflows on them) name the line and index.
+    let far = write(
+        "far.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/9223372036854775807 2 3\n",
+    );
+    let err = fails(&far, &[], d);
+    assert!(
+        err.contains("line 5") && err.contains("texture coordinate index"),
+        "{err}"
+    );
+
     let degenerate = write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
     assert!(fails(&degenerate, &[], d).contains("degenerate"));
 

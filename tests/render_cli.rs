@@ -336,6 +336,11 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
         &p("a.png"),
     ]));
     std::fs::copy(d.join("a.png"), d.join("b.png")).unwrap();
+    std::fs::write(
+        d.join("walk.json"),
+        r#"{"version":1,"fov_deg":60,"keys":[{"eye":[0,1.7,5],"target":[0,1,0]}]}"#,
+    )
+    .unwrap();
     let before = snapshot(d);
     let (f, a, b, n, x) = (
         p("f.forest"),
@@ -348,6 +353,7 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
     let sheet_in_output = format!("{n}/sheet.png");
     let texture = m.join("leaves_aspen.png").display().to_string();
     let inside = format!("{}/manifest.json", p("bush.atlas"));
+    let walk = p("walk.json");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             vec!["render", &f, "--view", "inside", "-o", &f],
@@ -379,6 +385,21 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
             "inside the output atlas",
         ),
         (vec!["bake", &obj, "-o", &n, "--depth-exr", &b], ".exr name"),
+        (vec!["view", &f, "--record", &f], "is the input"),
+        (
+            vec!["view", &f, "--record", &walk, "--path", &walk],
+            "is the input",
+        ),
+        (vec!["view", &f, "--record", &inside], "inside the atlas"),
+        (vec!["view", &f, "--record", &a], "JSON"),
+        (
+            vec!["view", &f, "--screenshots", &atlas],
+            "inside the atlas",
+        ),
+        (
+            vec!["view", &f, "--path", &walk, "--frames", &atlas],
+            "inside the atlas",
+        ),
     ];
     for (args, why) in cases {
         let e = err(&forest(&args));

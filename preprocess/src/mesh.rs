@@ -73,6 +73,44 @@ pub fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
 }
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
+/// Refuse face (`f`, `l`) indices that name no vertex, texture coordinate or normal defined
+/// before them: tobj 4 overflows on such indices (a panic with overflow checks, a wrong
+/// vertex without). The error names the line and the index.
+fn check_face_indices(path: &Path, bytes: &[u8]) -> Result<(), BakeError> {
+    const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    let mut defined = [0i64; 3];
+    for (n, line) in String::from_utf8_lossy(bytes).lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => defined[0] += 1,
+            Some("vt") => defined[1] += 1,
+            Some("vn") => defined[2] += 1,
+            Some("f" | "l") => {
+                for word in words {
+                    for (k, part) in word.split('/').enumerate().take(3) {
+                        // Unparsable indices are tobj's to report.
+                        let Ok(i) = part.parse::<i64>() else { continue };
+                        if i == 0 || i.unsigned_abs() > defined[k] as u64 {
+                            return Err(BakeError::Parse {
+                                path: path.into(),
+                                what: "OBJ",
+                                reason: format!(
+                                    "line {}: {} index {i} names none of the {} defined before it",
+                                    n + 1,
+                                    KINDS[k],
+                                    defined[k]
+                                ),
+                            });
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Refuse what tobj 4 would panic on in a material library: a colour statement (`Ka`, `Kd`,
 /// `Ks`, `Ke`) with fewer than three values.
 fn check_mtl(file: &Path, bytes: &[u8]) -> Result<(), forest_format::FormatError> {
@@ -116,6 +154,7 @@ impl Mesh {
         // refused, not read until memory runs out) and hashed too.
         let mtl_hash = std::cell::Cell::new(hash);
         let mtl_error = std::cell::RefCell::new(None);
+        check_face_indices(path, &obj_bytes)?;
         let loaded = tobj::load_obj_buf(
             &mut std::io::Cursor::new(&obj_bytes),
             &tobj::GPU_LOAD_OPTIONS,

@@ -79,6 +79,45 @@ pub fn extension(output: &Path, what: &str, format: &str, extensions: &[&str]) -
     Ok(())
 }
 
+/// Refuse `output` (a file or folder the command writes into) when it is an atlas folder or
+/// lies inside one, whatever the command's inputs: an atlas is a folder holding
+/// `manifest.json` and `nodes.bin`, and nothing but the bake writes there.
+pub fn not_in_atlas(output: &Path, what: &str) -> Result<()> {
+    let out = resolved(output);
+    for dir in out.ancestors() {
+        if dir.join(forest_format::atlas::MANIFEST_FILE).is_file()
+            && dir.join(forest_format::atlas::NODES_FILE).is_file()
+        {
+            bail!(
+                "{what} {} lies inside the atlas {}: refusing to write into it",
+                output.display(),
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `path` when nothing exists there, else the first free `STEM-N.EXT` beside it (N = 1, 2,
+/// …): a file the user already has is never written over.
+pub fn unused(path: &Path) -> PathBuf {
+    if !path.exists() {
+        return path.to_path_buf();
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    (1u64..)
+        .map(|n| path.with_file_name(format!("{stem}-{n}{ext}")))
+        .find(|p| !p.exists())
+        .expect("some number is free")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,5 +141,28 @@ mod tests {
         assert!(not_an_input(&d.join("shot.png"), "output", &inputs).is_ok());
         assert!(extension(&d.join("x.jpg"), "image", "PNG", &["png"]).is_err());
         assert!(extension(&d.join("x.PNG"), "image", "PNG", &["png"]).is_ok());
+    }
+
+    #[test]
+    fn unused_names_skip_existing_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("camera-path.json");
+        assert_eq!(unused(&p), p);
+        std::fs::write(&p, "{}").unwrap();
+        std::fs::write(dir.path().join("camera-path-1.json"), "{}").unwrap();
+        assert_eq!(unused(&p), dir.path().join("camera-path-2.json"));
+    }
+
+    #[test]
+    fn atlas_folders_are_refused_as_outputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let atlas = dir.path().join("oak.atlas");
+        std::fs::create_dir(&atlas).unwrap();
+        std::fs::write(atlas.join("manifest.json"), "{}").unwrap();
+        std::fs::write(atlas.join("nodes.bin"), "").unwrap();
+        assert!(not_in_atlas(&atlas, "frames").is_err());
+        assert!(not_in_atlas(&atlas.join("manifest.json"), "--record").is_err());
+        assert!(not_in_atlas(&atlas.join("x/y.png"), "output").is_err());
+        assert!(not_in_atlas(&dir.path().join("frames"), "frames").is_ok());
     }
 }

@@ -9,6 +9,7 @@ mod bench;
 mod compare;
 mod demo;
 mod guard;
+mod progress;
 mod render;
 mod scene;
 mod view;

@@ -13,7 +13,7 @@ use forest_format::forest::Forest;
 use forest_render::options::{AspectBlend, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
-use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
 /// Arguments of `forest render`.
@@ -236,7 +236,13 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 /// Load a forest and its species' atlases (resolved against the forest's folder).
 pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
+    let spinner = crate::progress::spinner(format!("loading {}", path.display()));
     let forest = Forest::load(path)?;
+    spinner.set_message(format!(
+        "loading the {} atlases of {}",
+        forest.species.len(),
+        path.display()
+    ));
     let dir = path.parent().unwrap_or(Path::new("."));
     let species = forest
         .species
@@ -246,6 +252,7 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
             SpeciesData::load(&p).with_context(|| format!("species {s} of {}", path.display()))
         })
         .collect::<Result<Vec<_>>>()?;
+    spinner.finish_and_clear();
     Ok((forest, species))
 }
 
@@ -388,7 +395,7 @@ fn stream_for(
     species: &[SpeciesData],
     forest: &Forest,
 ) -> Result<QuadStream> {
-    let scene = GpuScene::with_format(ctx, species, forest, crate::colour_format())?;
+    let scene = crate::progress::upload(ctx, species, forest)?;
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         min_epsilon: args.epsilon.min(8.0),

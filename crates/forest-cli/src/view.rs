@@ -14,7 +14,7 @@ use forest_format::forest::Forest;
 use forest_render::options::{Background, DebugView, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
-use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
 use crate::render::{MethodArgs, load_scene, parse_size, prepare_models, write_png};
@@ -79,7 +79,7 @@ fn quad_stream(
     };
     Ok(QuadStream::new(
         &ctx.device,
-        GpuScene::with_format(ctx, species, forest, crate::colour_format())?,
+        crate::progress::upload(ctx, species, forest)?,
         &opts,
     )?)
 }
@@ -129,6 +129,17 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             dir.display()
         );
     }
+    // Nothing the viewer reads may be written over: the forest, the path, the models, and
+    // no atlas at all (the forest's atlases are checked once it is loaded).
+    let mut inputs = vec![forest_file.clone()];
+    inputs.extend(args.path.iter().cloned());
+    for m in &args_models.models {
+        inputs.extend(forest_bake::mesh::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
+    }
+    crate::guard::not_an_input(&args.record, "--record", &inputs)?;
+    crate::guard::not_in_atlas(&args.record, "--record")?;
+    crate::guard::extension(&args.record, "--record", "a camera path (JSON)", &["json"])?;
+    crate::guard::not_in_atlas(&args.screenshots, "screenshot folder")?;
     let Some(frames) = &args.frames else {
         return interactive(args, &forest_file, &args_models);
     };
@@ -140,7 +151,14 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     if !frames.is_dir() {
         bail!("frames folder {} does not exist", frames.display());
     }
+    crate::guard::not_in_atlas(frames, "frames folder")?;
     let (forest, species) = load_scene(&forest_file)?;
+    let dir = forest_file.parent().unwrap_or(Path::new("."));
+    inputs.extend(forest.species.iter().map(|s| dir.join(s)));
+    let frame_file = |i: usize| frames.join(format!("frame-{i:05}.png"));
+    for i in 0..path.keys.len() {
+        crate::guard::not_an_input(&frame_file(i), "frame", &inputs)?;
+    }
     let mesh_method = args_models.checked_method(forest.species.len())?;
     let ctx = crate::gpu_context()?;
     let geometry = match mesh_method {
@@ -185,10 +203,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         ctx.check_errors()?;
         let t = stats.times.unwrap_or_default();
         total_ms += t.cull_ms + t.refine_ms + t.draw_ms;
-        write_png(
-            &target.read(&ctx),
-            &frames.join(format!("frame-{i:05}.png")),
-        )?;
+        write_png(&target.read(&ctx), &frame_file(i))?;
     }
     println!(
         "{} frames of {} -> {} (mean GPU {:.1} ms/frame, {})",

@@ -23,6 +23,66 @@ pub mod limit {
     pub const IMAGE_ALLOC: u64 = 512 << 20;
 }
 
+fn image_reader<'a>(
+    bytes: &'a [u8],
+    format: Option<image::ImageFormat>,
+    path: &Path,
+) -> Result<image::ImageReader<std::io::Cursor<&'a [u8]>>, FormatError> {
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    match format {
+        Some(f) => reader.set_format(f),
+        None => {
+            reader = reader
+                .with_guessed_format()
+                .map_err(|e| FormatError::Image {
+                    path: path.into(),
+                    what: e.to_string(),
+                })?
+        }
+    }
+    Ok(reader)
+}
+
+/// The width and height (pixels) an encoded image's header claims, read without decoding its
+/// pixels: sizes that must agree with other counts are compared before anything is decoded.
+pub fn image_dimensions(
+    bytes: &[u8],
+    format: Option<image::ImageFormat>,
+    path: &Path,
+) -> Result<(u32, u32), FormatError> {
+    image_reader(bytes, format, path)?
+        .into_dimensions()
+        .map_err(|e| FormatError::Image {
+            path: path.into(),
+            what: e.to_string(),
+        })
+}
+
+/// Refuse a PNG whose palette chunk (PLTE) is not a whole number of RGB entries, as the PNG
+/// specification requires: png 0.18.1 panics on one (image-rs/image-png#694). Other chunks
+/// are the decoder's to check.
+fn check_png_chunks(bytes: &[u8]) -> Result<(), String> {
+    const SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
+    let Some(mut rest) = bytes.strip_prefix(SIGNATURE) else {
+        return Ok(());
+    };
+    while rest.len() >= 8 {
+        let len = u32::from_be_bytes(rest[..4].try_into().expect("4 bytes")) as usize;
+        let kind = &rest[4..8];
+        if kind == b"PLTE" && !len.is_multiple_of(3) {
+            return Err(format!(
+                "PNG palette chunk of {len} bytes, not a multiple of 3 (RGB entries)"
+            ));
+        }
+        if kind == b"IDAT" || kind == b"IEND" {
+            break;
+        }
+        // Length, type, data, CRC.
+        rest = rest.get(12usize.saturating_add(len)..).unwrap_or(&[]);
+    }
+    Ok(())
+}
+
 /// Decode an image held in memory (`format` when the container is known, else guessed from
 /// its first bytes) with the sizes bounded by [`limit::IMAGE_SIDE`] and
 /// [`limit::IMAGE_ALLOC`], checked from the header before the pixels are allocated. Errors
@@ -36,15 +96,8 @@ pub fn decode_image(
         path: path.into(),
         what,
     };
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-    match format {
-        Some(f) => reader.set_format(f),
-        None => {
-            reader = reader
-                .with_guessed_format()
-                .map_err(|e| err(e.to_string()))?
-        }
-    }
+    check_png_chunks(bytes).map_err(err)?;
+    let mut reader = image_reader(bytes, format, path)?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(limit::IMAGE_SIDE);
     limits.max_image_height = Some(limit::IMAGE_SIDE);
@@ -101,6 +154,28 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, FormatError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn images_are_checked_before_decoding() {
+        // A PNG whose palette is not whole RGB entries (png 0.18.1 panics on it).
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend_from_slice(&13u32.to_be_bytes());
+        png.extend_from_slice(b"IHDR");
+        png.extend_from_slice(&[0, 0, 0, 1, 0, 0, 0, 1, 8, 3, 0, 0, 0, 0, 0, 0, 0]);
+        png.extend_from_slice(&4u32.to_be_bytes());
+        png.extend_from_slice(b"PLTE\x01\x02\x03\x04\0\0\0\0");
+        let e = decode_image(&png, None, Path::new("p.png")).unwrap_err();
+        assert!(e.to_string().contains("not a multiple of 3"), "{e}");
+        // Sizes come from the header alone.
+        let img = image::RgbImage::new(40, 3);
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+        let bytes = bytes.into_inner();
+        assert_eq!(
+            image_dimensions(&bytes, None, Path::new("i.png")).unwrap(),
+            (40, 3)
+        );
+    }
 
     #[test]
     fn special_and_oversized_files_are_refused_before_reading() {

@@ -57,6 +57,14 @@ pub fn corpus_dir(target: &str) -> std::path::PathBuf {
         .join(target)
 }
 
+/// Inputs the fuzzer once found to crash or hang `target`, kept as regression cases (the
+/// smoke run replays them; they need not load).
+pub fn regressions_dir(target: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("regressions")
+        .join(target)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -177,7 +177,13 @@ pub fn colour_mip_count(resolution: u32) -> u32 {
 }
 
 /// Every layer's mip chain (layer-major), encoded as BC7 or kept as RGBA8; layers in parallel.
-fn colour_data(species: &[SpeciesData], resolution: u32, bc7: bool) -> Vec<u8> {
+/// `progress(done, total)` is called as layers finish.
+fn colour_data(
+    species: &[SpeciesData],
+    resolution: u32,
+    bc7: bool,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Vec<u8> {
     use rayon::prelude::*;
     let table = srgb_decode_table();
     let mips = colour_mip_count(resolution);
@@ -186,6 +192,8 @@ fn colour_data(species: &[SpeciesData], resolution: u32, bc7: bool) -> Vec<u8> {
         .iter()
         .flat_map(|s| (0..s.layers.count).map(|l| s.layers.layer(l)))
         .collect();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let total = layers.len() as u64;
     let chains: Vec<Vec<u8>> = layers
         .par_iter()
         .map(|layer| {
@@ -209,6 +217,10 @@ fn colour_data(species: &[SpeciesData], resolution: u32, bc7: bool) -> Vec<u8> {
                     out.extend_from_slice(&img);
                 }
             }
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                total,
+            );
             out
         })
         .collect();
@@ -313,6 +325,19 @@ impl GpuScene {
         forest: &Forest,
         colour_format: ColourFormat,
     ) -> Result<Self, RenderError> {
+        Self::with_progress(ctx, species, forest, colour_format, &|_, _| {})
+    }
+
+    /// [`GpuScene::with_format`], calling `progress(done, total)` as colour layers are
+    /// prepared (mip chains, and BC7 encoding where the GPU has it: the long step of a
+    /// scene with many species at high resolution).
+    pub fn with_progress(
+        ctx: &GpuContext,
+        species: &[SpeciesData],
+        forest: &Forest,
+        colour_format: ColourFormat,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<Self, RenderError> {
         let tables = SceneTables::new(species, forest)?;
         let limits = ctx.device.limits();
         if tables.layers > limits.max_texture_array_layers {
@@ -330,7 +355,7 @@ impl GpuScene {
             wgpu::TextureFormat::Rgba8UnormSrgb
         };
         let res = tables.resolution.max(1);
-        let data = colour_data(species, res, bc7);
+        let data = colour_data(species, res, bc7, progress);
         let layers = tables.layers.max(1);
         let data = if tables.layers == 0 {
             vec![

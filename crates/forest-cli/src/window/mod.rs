@@ -397,12 +397,10 @@ impl Viewer {
             }
             KeyCode::KeyR => match self.recording.take() {
                 Some(p) if !p.keys.is_empty() => {
-                    let text = match p.save(&self.record_to) {
-                        Ok(()) => format!(
-                            "saved {} keys to {}",
-                            p.keys.len(),
-                            self.record_to.display()
-                        ),
+                    // A path saved earlier (or any file of that name) is kept: a new name.
+                    let to = crate::guard::unused(&self.record_to);
+                    let text = match p.save(&to) {
+                        Ok(()) => format!("saved {} keys to {}", p.keys.len(), to.display()),
                         // Keep walking; the message says why nothing was saved.
                         Err(e) => format!("could not save the path: {e}"),
                     };

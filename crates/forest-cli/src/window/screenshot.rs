@@ -23,6 +23,13 @@ impl Viewer {
         g.renderer.render_frame(&g.ctx, &cam, &target)?;
         let img = target.read(&g.ctx);
         g.ctx.check_errors()?;
+        // The next number whose image and camera files are both free: earlier screenshots
+        // (of this session or another) are never written over.
+        let free = |n: &u32| {
+            let base = self.screenshots.join(format!("screenshot-{n:03}"));
+            !base.with_extension("png").exists() && !base.with_extension("json").exists()
+        };
+        self.shots = (self.shots..).find(free).expect("some number is free");
         let base = self
             .screenshots
             .join(format!("screenshot-{:03}", self.shots));

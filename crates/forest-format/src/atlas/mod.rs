@@ -109,6 +109,24 @@ impl Atlas {
             ColourEncoding::Jpeg { .. } => image::ImageFormat::Jpeg,
             ColourEncoding::Png => image::ImageFormat::Png,
         };
+        // Sizes from the headers first: a mosaic of the wrong size is refused undecoded.
+        let (cols, rows) = (p.mosaic_columns(), p.mosaic_rows());
+        let (w, h) = (cols * p.resolution, rows * p.resolution);
+        for (file, bytes, format) in [
+            (&colour_path, &self.colour_file, format),
+            (&alpha_path, &self.alpha_file, image::ImageFormat::Png),
+        ] {
+            let dims = crate::bounded::image_dimensions(bytes, Some(format), file)?;
+            if dims != (w, h) {
+                return Err(FormatError::invalid(
+                    file,
+                    format!(
+                        "mosaic is {}×{} pixels, expected {w}×{h} ({cols}×{rows} tiles of {})",
+                        dims.0, dims.1, p.resolution
+                    ),
+                ));
+            }
+        }
         let colour = crate::bounded::decode_image(&self.colour_file, Some(format), &colour_path)?
             .into_rgb8();
         let alpha = crate::bounded::decode_image(
@@ -133,8 +151,7 @@ impl Atlas {
                 ));
             }
         };
-        let (cols, rows) = (p.mosaic_columns(), p.mosaic_rows());
-        let (w, h) = (cols * p.resolution, rows * p.resolution);
+        // The decoders must agree with the headers they were checked by.
         for (file, dims) in [
             (&colour_path, colour.dimensions()),
             (&alpha_path, alpha.dimensions()),
@@ -142,10 +159,7 @@ impl Atlas {
             if dims != (w, h) {
                 return Err(FormatError::invalid(
                     file,
-                    format!(
-                        "mosaic is {}×{} pixels, expected {w}×{h} ({cols}×{rows} tiles of {})",
-                        dims.0, dims.1, p.resolution
-                    ),
+                    format!("decoded to {}×{} pixels, expected {w}×{h}", dims.0, dims.1),
                 ));
             }
         }
