@@ -53,7 +53,8 @@ impl GpuContext {
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
             | wgpu::Features::TEXTURE_COMPRESSION_BC
-            | wgpu::Features::INDIRECT_FIRST_INSTANCE;
+            | wgpu::Features::INDIRECT_FIRST_INSTANCE
+            | wgpu::Features::PIPELINE_STATISTICS_QUERY;
         let features = adapter.features() & wanted;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("forest"),

@@ -23,6 +23,7 @@ pub mod scene;
 pub mod stats;
 pub mod stream;
 pub mod target;
+pub mod work;
 
 pub use camera::Camera;
 pub use context::{ColourFormat, GpuContext, RenderError};

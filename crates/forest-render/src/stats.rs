@@ -41,6 +41,8 @@ pub struct FrameStats {
     pub overflow_refine: u32,
     /// GPU pass times, where the adapter has timestamp queries.
     pub times: Option<PassTimes>,
+    /// The work the frame asked of the GPU (counts; see [`crate::work`]).
+    pub work: crate::work::FrameWork,
 }
 
 struct Slot {

@@ -10,6 +10,7 @@
 //! rebuilds only the view's own buffers.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use wgpu::util::DeviceExt;
 
@@ -26,6 +27,7 @@ use crate::passes::refine::RefinePass;
 use crate::passes::scan::ScanPass;
 use crate::scene::GpuScene;
 use crate::stats::{FrameStats, PassTimes, StatsRing};
+use crate::work::{CountingPass, FrameWork, StatisticsQueries};
 
 /// Bytes of the resolved timestamps (six queries).
 const TIMESTAMP_BYTES: u64 = 48;
@@ -51,6 +53,24 @@ struct Sized {
     args_group: wgpu::BindGroup,
     ring: StatsRing,
     owned: Vec<(&'static str, wgpu::Buffer)>,
+    /// Bytes of the view's own buffers (the scene's are in `GpuScene::bytes`).
+    view_bytes: u64,
+}
+
+/// The query results read back with the counters, in this order: timestamps, then pipeline
+/// statistics, each where the device has them.
+fn readback<'a>(
+    times: Option<&'a (wgpu::QuerySet, wgpu::Buffer)>,
+    statistics: Option<&'a StatisticsQueries>,
+) -> Vec<(&'a wgpu::Buffer, u64)> {
+    let mut out = Vec::new();
+    if let Some((_, b)) = times {
+        out.push((b, TIMESTAMP_BYTES));
+    }
+    if let Some(q) = statistics {
+        out.push((&q.resolve, crate::work::STATISTICS_BYTES));
+    }
+    out
 }
 
 /// The quad stream of one view over a shared scene.
@@ -67,6 +87,9 @@ pub struct QuadStream {
     levels: u32,
     iterations: u32,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    statistics: Option<StatisticsQueries>,
+    /// Dispatches and draws of the last recorded frame (counted as recorded).
+    recorded: (AtomicU32, AtomicU32),
     writes: (u64, u64),
     prepared: bool,
     debug: DebugView,
@@ -159,6 +182,7 @@ impl QuadStream {
                 );
                 (set, resolve)
             });
+        let statistics = StatisticsQueries::new(device);
         let sized = Self::build_sized(
             device,
             &scene,
@@ -166,7 +190,7 @@ impl QuadStream {
             &camera,
             &ground,
             &capacity,
-            queries.as_ref().map(|q| &q.1),
+            &readback(queries.as_ref(), statistics.as_ref()),
         )?;
         let levels = scene.tables.max_levels;
         Ok(Self {
@@ -184,6 +208,8 @@ impl QuadStream {
             ground,
             sized,
             queries,
+            statistics,
+            recorded: (AtomicU32::new(0), AtomicU32::new(0)),
             writes: (0, 0),
             prepared: false,
             debug: DebugView::Off,
@@ -201,7 +227,7 @@ impl QuadStream {
         camera: &wgpu::Buffer,
         ground: &wgpu::Buffer,
         capacity: &Capacity,
-        timestamps: Option<&wgpu::Buffer>,
+        readback: &[(&wgpu::Buffer, u64)],
     ) -> Result<Sized, RenderError> {
         let limit = device.limits().max_storage_buffer_binding_size;
         let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
@@ -330,10 +356,15 @@ impl QuadStream {
             })
         });
         let mut sources = vec![(state.clone(), std::mem::size_of::<GpuState>() as u64)];
-        if let Some(ts) = timestamps {
-            sources.push((ts.clone(), TIMESTAMP_BYTES));
-        }
+        sources.extend(readback.iter().map(|(b, n)| ((*b).clone(), *n)));
         let ring = StatsRing::new(device, sources);
+        let view_bytes = [
+            camera, &consts, ground, &state, &args, &spare, &data, &want, &sums, &quads[0],
+            &quads[1],
+        ]
+        .iter()
+        .map(|b| b.size())
+        .sum::<u64>();
         let owned: Vec<(&'static str, wgpu::Buffer)> = [
             ("camera", camera),
             ("scene constants", &consts),
@@ -367,6 +398,7 @@ impl QuadStream {
             args_group,
             ring,
             owned,
+            view_bytes,
         })
     }
 
@@ -402,7 +434,7 @@ impl QuadStream {
                 &self.camera,
                 &self.ground,
                 &capacity,
-                self.queries.as_ref().map(|q| &q.1),
+                &readback(self.queries.as_ref(), self.statistics.as_ref()),
             )?;
             self.capacity = capacity;
         }
@@ -563,21 +595,40 @@ impl QuadStream {
                 })
         };
         let p = &self.passes;
+        let stats = self.statistics.as_ref().map(|q| &q.set);
+        let mut dispatches = 0;
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cull"),
                 timestamp_writes: ts(0),
             });
-            p.cull.record(&mut pass, &self.bindings(), &p.scan);
+            if let Some(set) = stats {
+                pass.begin_pipeline_statistics_query(set, crate::work::CULL);
+            }
+            let mut counted = CountingPass::new(&mut pass);
+            p.cull.record(&mut counted, &self.bindings(), &p.scan);
+            dispatches += counted.dispatches;
+            if stats.is_some() {
+                pass.end_pipeline_statistics_query();
+            }
         }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("refine"),
                 timestamp_writes: ts(2),
             });
+            if let Some(set) = stats {
+                pass.begin_pipeline_statistics_query(set, crate::work::REFINE);
+            }
+            let mut counted = CountingPass::new(&mut pass);
             p.refine
-                .record(&mut pass, self.iterations, &self.bindings(), &p.scan);
+                .record(&mut counted, self.iterations, &self.bindings(), &p.scan);
+            dispatches += counted.dispatches;
+            if stats.is_some() {
+                pass.end_pipeline_statistics_query();
+            }
         }
+        self.recorded.0.store(dispatches, Ordering::Relaxed);
     }
 
     /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
@@ -601,12 +652,14 @@ impl QuadStream {
     /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
     /// `ground` and the background is the sky), then the quads.
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
-        self.passes.draw.record(
+        let draws = self.passes.draw.record(
             pass,
             &self.sized.bg_draw[(self.iterations % 2) as usize],
             &self.sized.args,
             ground && self.opts.background == Background::Sky,
+            self.statistics.as_ref().map(|q| &q.set),
         );
+        self.recorded.1.store(draws, Ordering::Relaxed);
     }
 
     /// Resolve the frame's pass times (after the render pass that used
@@ -615,9 +668,18 @@ impl QuadStream {
         if let Some((set, resolve)) = &self.queries {
             encoder.resolve_query_set(set, 0..6, resolve, 0);
         }
+        if let Some(q) = &self.statistics {
+            q.resolve(encoder);
+        }
     }
 
-    fn decode(&self, state: &[u8], times: Option<&[u8]>, period: f32) -> FrameStats {
+    fn decode(
+        &self,
+        state: &[u8],
+        times: Option<&[u8]>,
+        statistics: Option<&[u8]>,
+        period: f32,
+    ) -> FrameStats {
         let mut s = GpuState::default();
         let n = state.len().min(std::mem::size_of::<GpuState>());
         bytemuck::bytes_of_mut(&mut s)[..n].copy_from_slice(&state[..n]);
@@ -645,6 +707,12 @@ impl QuadStream {
             overflow_cull: s.overflow_cull,
             overflow_refine: s.overflow_refine,
             times,
+            work: FrameWork {
+                dispatches: self.recorded.0.load(Ordering::Relaxed),
+                draws: self.recorded.1.load(Ordering::Relaxed),
+                passes: statistics.and_then(crate::work::decode),
+                bytes: self.scene.bytes + self.sized.view_bytes,
+            },
         }
     }
 
@@ -656,16 +724,33 @@ impl QuadStream {
             .queries
             .as_ref()
             .map(|(_, resolve)| ctx.read_buffer(resolve, TIMESTAMP_BYTES));
-        self.decode(&state, times.as_deref(), ctx.queue.get_timestamp_period())
+        let statistics = self
+            .statistics
+            .as_ref()
+            .map(|q| ctx.read_buffer(&q.resolve, crate::work::STATISTICS_BYTES));
+        self.decode(
+            &state,
+            times.as_deref(),
+            statistics.as_deref(),
+            ctx.queue.get_timestamp_period(),
+        )
     }
 
     /// Counters of a recent frame without waiting: `None` until a read-back has arrived
     /// (a few frames late; see [`crate::stats::StatsRing`]).
     pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<FrameStats> {
         let parts = self.sized.ring.poll(device, queue)?;
+        // The ring's sources: the state, then the timestamps and the statistics where present.
+        let times = self.queries.is_some().then(|| parts.get(1)).flatten();
+        let statistics = self
+            .statistics
+            .is_some()
+            .then(|| parts.get(1 + usize::from(self.queries.is_some())))
+            .flatten();
         Some(self.decode(
             &parts[0],
-            parts.get(1).map(|t| t.as_slice()),
+            times.map(|t| t.as_slice()),
+            statistics.map(|t| t.as_slice()),
             queue.get_timestamp_period(),
         ))
     }

@@ -2,6 +2,7 @@
 
 use super::scan::ScanPass;
 use super::{ComputeShared, StreamBindings, args};
+use crate::work::CountingPass;
 
 /// The cull pass's pipelines.
 pub struct CullPass {
@@ -23,18 +24,18 @@ impl CullPass {
     }
 
     /// Record: reset the frame state, count each tree's quads, scan, emit, clamp.
-    pub fn record(&self, pass: &mut wgpu::ComputePass, b: &StreamBindings, scan: &ScanPass) {
+    pub fn record(&self, pass: &mut CountingPass, b: &StreamBindings, scan: &ScanPass) {
         let args_buf = b.args_buf;
-        pass.set_bind_group(0, b.cull, &[]);
-        pass.set_bind_group(1, b.args_group, &[]);
-        pass.set_pipeline(&self.setup);
-        pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(&self.count);
-        pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+        pass.pass.set_bind_group(0, b.cull, &[]);
+        pass.pass.set_bind_group(1, b.args_group, &[]);
+        pass.pass.set_pipeline(&self.setup);
+        pass.dispatch(1, 1, 1);
+        pass.pass.set_pipeline(&self.count);
+        pass.dispatch_indirect(args_buf, args::ITEMS);
         scan.record(pass, args_buf);
-        pass.set_pipeline(&self.emit);
-        pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
-        pass.set_pipeline(&self.finish);
-        pass.dispatch_workgroups(1, 1, 1);
+        pass.pass.set_pipeline(&self.emit);
+        pass.dispatch_indirect(args_buf, args::ITEMS);
+        pass.pass.set_pipeline(&self.finish);
+        pass.dispatch(1, 1, 1);
     }
 }

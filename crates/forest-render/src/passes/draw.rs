@@ -137,20 +137,30 @@ impl DrawPass {
         }
     }
 
-    /// Record the ground (when `ground`) and the indirect quad draw.
+    /// Record the ground (when `ground`) and the indirect quad draw, the latter inside the
+    /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone).
+    /// Returns the draws recorded.
     pub fn record(
         &self,
         pass: &mut wgpu::RenderPass,
         bind_group: &wgpu::BindGroup,
         args_buf: &wgpu::Buffer,
         ground: bool,
-    ) {
+        statistics: Option<&wgpu::QuerySet>,
+    ) -> u32 {
         pass.set_bind_group(0, bind_group, &[]);
         if ground {
             pass.set_pipeline(&self.ground);
             pass.draw(0..4, 0..1);
         }
         pass.set_pipeline(&self.quads);
+        if let Some(set) = statistics {
+            pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
+        }
         pass.draw_indirect(args_buf, args::DRAW);
+        if statistics.is_some() {
+            pass.end_pipeline_statistics_query();
+        }
+        1 + u32::from(ground)
     }
 }

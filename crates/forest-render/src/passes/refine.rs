@@ -3,6 +3,7 @@
 
 use super::scan::ScanPass;
 use super::{ComputeShared, StreamBindings, args};
+use crate::work::CountingPass;
 
 /// The refine pass's pipelines.
 pub struct RefinePass {
@@ -29,27 +30,28 @@ impl RefinePass {
     /// statistics over the final buffer through `final_in` (a bind group reading it).
     pub fn record(
         &self,
-        pass: &mut wgpu::ComputePass,
+        pass: &mut CountingPass,
         iterations: u32,
         b: &StreamBindings,
         scan: &ScanPass,
     ) {
         let (ping, pong, args_buf) = (b.ping, b.pong, b.args_buf);
-        pass.set_bind_group(1, b.args_group, &[]);
+        pass.pass.set_bind_group(1, b.args_group, &[]);
         for it in 0..iterations {
-            pass.set_bind_group(0, if it.is_multiple_of(2) { ping } else { pong }, &[]);
-            pass.set_pipeline(&self.count);
-            pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+            pass.pass
+                .set_bind_group(0, if it.is_multiple_of(2) { ping } else { pong }, &[]);
+            pass.pass.set_pipeline(&self.count);
+            pass.dispatch_indirect(args_buf, args::ITEMS);
             scan.record(pass, args_buf);
             for p in [&self.decide, &self.emit] {
-                pass.set_pipeline(p);
-                pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+                pass.pass.set_pipeline(p);
+                pass.dispatch_indirect(args_buf, args::ITEMS);
             }
-            pass.set_pipeline(&self.finish);
-            pass.dispatch_workgroups(1, 1, 1);
+            pass.pass.set_pipeline(&self.finish);
+            pass.dispatch(1, 1, 1);
         }
         // The final stream is A after an even number of steps (read it through `ping`).
-        pass.set_bind_group(
+        pass.pass.set_bind_group(
             0,
             if iterations.is_multiple_of(2) {
                 ping
@@ -58,7 +60,7 @@ impl RefinePass {
             },
             &[],
         );
-        pass.set_pipeline(&self.stats);
-        pass.dispatch_workgroups_indirect(args_buf, args::ITEMS);
+        pass.pass.set_pipeline(&self.stats);
+        pass.dispatch_indirect(args_buf, args::ITEMS);
     }
 }

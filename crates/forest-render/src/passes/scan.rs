@@ -1,6 +1,7 @@
 //! The order-preserving prefix sum (`shaders/scan.wgsl`) used by cull and refine.
 
 use super::{ComputeShared, args};
+use crate::work::CountingPass;
 
 /// Exclusive scan of `data[0..state.n]` in place; total in `state.total`.
 pub struct ScanPass {
@@ -24,7 +25,7 @@ impl ScanPass {
     }
 
     /// Record the five dispatches (the bind group is already set).
-    pub fn record(&self, pass: &mut wgpu::ComputePass, args_buf: &wgpu::Buffer) {
+    pub fn record(&self, pass: &mut CountingPass, args_buf: &wgpu::Buffer) {
         for (p, offset) in [
             (&self.reduce0, args::BLOCKS0),
             (&self.reduce1, args::BLOCKS1),
@@ -32,8 +33,8 @@ impl ScanPass {
             (&self.down1, args::BLOCKS1),
             (&self.down0, args::BLOCKS0),
         ] {
-            pass.set_pipeline(p);
-            pass.dispatch_workgroups_indirect(args_buf, offset);
+            pass.pass.set_pipeline(p);
+            pass.dispatch_indirect(args_buf, offset);
         }
     }
 }

@@ -1,0 +1,216 @@
+//! Work counters against analytic counts: a rectangle of known size shades its pixels and no
+//! more; the quad stream's counts follow from its quads and its recorded passes.
+
+mod common;
+
+use forest_render::options::{Background, RendererOptions};
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::work::{self, StatisticsQueries};
+use forest_render::{GpuScene, QuadStream};
+use glam::Vec3;
+
+/// Pixels x 8..40, y 4..20 of a 64×32 target, edges on pixel boundaries.
+const RECT_WGSL: &str = "
+@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let x = select(-0.75, 0.25, (i & 1u) == 1u);
+    let y = select(0.75, -0.25, (i & 2u) == 2u);
+    return vec4<f32>(x, y, 0.5, 1.0);
+}
+@fragment fn fs() -> @location(0) vec4<f32> { return vec4<f32>(1.0); }
+";
+
+/// Pixels shaded when fragments are shaded in aligned `b`×`b` blocks: the blocks that each of
+/// the rectangle's two triangles (strip order: corners (8,4) (40,4) (8,20), then (40,4)
+/// (8,20) (40,20)) covers with a pixel centre, summed over the triangles, times `b²`. No pixel
+/// centre lies on the shared diagonal (x + 2y = 46.5 there).
+fn shaded_in_blocks(b: i32) -> u64 {
+    let inside = |p: [f32; 2], t: [[f32; 2]; 3]| {
+        let e = |a: [f32; 2], b: [f32; 2]| {
+            (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+        };
+        let (d0, d1, d2) = (e(t[0], t[1]), e(t[1], t[2]), e(t[2], t[0]));
+        (d0 >= 0.0 && d1 >= 0.0 && d2 >= 0.0) || (d0 <= 0.0 && d1 <= 0.0 && d2 <= 0.0)
+    };
+    let tris = [
+        [[8.0, 4.0], [40.0, 4.0], [8.0, 20.0]],
+        [[40.0, 4.0], [8.0, 20.0], [40.0, 20.0]],
+    ];
+    let mut blocks = 0;
+    for t in tris {
+        for qy in 0..32 / b {
+            for qx in 0..64 / b {
+                let hit = (0..b * b).any(|k| {
+                    let (x, y) = (qx * b + k % b, qy * b + k / b);
+                    // Strictly inside the rectangle's pixel range, then the triangle.
+                    (8..40).contains(&x)
+                        && (4..20).contains(&y)
+                        && inside([x as f32 + 0.5, y as f32 + 0.5], t)
+                });
+                blocks += u64::from(hit);
+            }
+        }
+    }
+    blocks * (b * b) as u64
+}
+
+#[test]
+fn a_rectangle_of_known_size_shades_its_pixels() {
+    let ctx = common::ctx();
+    let Some(queries) = StatisticsQueries::new(&ctx.device) else {
+        eprintln!(
+            "no pipeline-statistics queries on {}",
+            ctx.adapter_info.name
+        );
+        return;
+    };
+    let module = ctx
+        .device
+        .create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("rectangle"),
+            source: wgpu::ShaderSource::Wgsl(RECT_WGSL.into()),
+        });
+    let layout = ctx
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[],
+            immediate_size: 0,
+        });
+    let pipeline = ctx
+        .device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("rectangle"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+                ..Default::default()
+            },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(TARGET_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+    let target = Target::new(&ctx, 64, 32);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    for q in [work::CULL, work::REFINE] {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.begin_pipeline_statistics_query(&queries.set, q);
+        pass.end_pipeline_statistics_query();
+    }
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: None,
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target.colour_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.begin_pipeline_statistics_query(&queries.set, work::DRAW);
+        pass.draw(0..4, 0..1);
+        pass.end_pipeline_statistics_query();
+    }
+    queries.resolve(&mut enc);
+    ctx.queue.submit([enc.finish()]);
+    let bytes = ctx.read_buffer(&queries.resolve, work::STATISTICS_BYTES);
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    let p = work::decode(&bytes).unwrap();
+    let draw = p[work::DRAW as usize];
+    let covered = target.read(&ctx).pixels().filter(|px| px[3] > 0).count() as u64;
+    assert_eq!(covered, 32 * 16);
+    assert_eq!(draw.vertex_invocations, 4, "{draw:?}");
+    assert_eq!(draw.primitives, 2, "{draw:?}");
+    // Fragments are counted per pixel, or per aligned block a triangle touches (2×2 quads
+    // with their helper invocations on most GPUs; lavapipe counts its 4×4 stamps): each
+    // answer is analytic, and the count must be one of them.
+    let answers: Vec<u64> = [1, 2, 4].map(shaded_in_blocks).to_vec();
+    assert_eq!(answers[0], covered);
+    assert!(
+        answers.contains(&draw.fragment_invocations),
+        "{draw:?}: per pixel, 2×2 and 4×4 blocks give {answers:?}"
+    );
+    assert_eq!(draw.compute_invocations, 0);
+    assert_eq!(p[work::CULL as usize], work::PassWork::default());
+}
+
+#[test]
+fn the_stream_counts_its_work() {
+    let ctx = common::ctx();
+    let forest = common::forest(6);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let opts = RendererOptions {
+        viewport: (160, 120),
+        min_epsilon: 2.0,
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
+    let target = Target::new(&ctx, 160, 120);
+    let side = forest.extent();
+    let cam = common::camera(Vec3::new(0.0, 2.0, side * 1.5), Vec3::ZERO, 2.0);
+    stream.render_frame(&ctx, &cam, &target).unwrap();
+    let stats = stream.read_stats(&ctx);
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    let w = &stats.work;
+    assert!(stats.quads > 0, "the camera sees trees");
+    // Cull: setup, count, a five-dispatch scan, emit, finish. Refine: per iteration count, the
+    // scan, decide, emit, finish; then the statistics.
+    let iterations = stream.scene.tables.max_levels - 1;
+    assert_eq!(w.dispatches, 9 + 9 * iterations + 1);
+    assert_eq!(w.draws, 1, "quads only over a transparent background");
+    assert!(w.bytes >= stream.scene.bytes + stream.capacity.bytes());
+    let Some(p) = w.passes else {
+        eprintln!(
+            "no pipeline-statistics queries on {}",
+            ctx.adapter_info.name
+        );
+        return;
+    };
+    let (cull, refine, draw) = (
+        p[work::CULL as usize],
+        p[work::REFINE as usize],
+        p[work::DRAW as usize],
+    );
+    // Every quad is a four-vertex strip: two triangles unless clipped.
+    assert_eq!(draw.vertex_invocations, 4 * u64::from(stats.quads));
+    assert!(draw.primitives > 0 && draw.primitives <= 4 * u64::from(stats.quads));
+    // Every covered pixel was shaded at least once.
+    let covered = target.read(&ctx).pixels().filter(|px| px[3] > 0).count() as u64;
+    assert!(
+        covered > 0 && draw.fragment_invocations >= covered,
+        "{draw:?} {covered}"
+    );
+    // Compute work in the compute passes only; the cull visits every tree at least once.
+    assert!(cull.compute_invocations >= forest.instances.len() as u64);
+    assert!(refine.compute_invocations >= u64::from(stats.quads));
+    assert_eq!(draw.compute_invocations, 0);
+    assert_eq!(cull.fragment_invocations + refine.fragment_invocations, 0);
+    // The frame loop's read-back (a few frames late) brings the same counts.
+    let polled = (0..20).find_map(|_| {
+        stream.render_frame(&ctx, &cam, &target).unwrap();
+        stream.poll_stats(&ctx.device, &ctx.queue)
+    });
+    let polled = polled.expect("statistics arrive within 20 frames");
+    assert_eq!(polled.work, stats.work);
+}
