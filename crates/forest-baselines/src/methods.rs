@@ -62,6 +62,8 @@ pub struct MethodStats {
     pub overflow: u32,
     /// GPU pass times, where the adapter has timestamp queries.
     pub times: Option<PassTimes>,
+    /// The work the frame asked of the GPU (both forms' for the hybrid).
+    pub work: forest_render::work::FrameWork,
 }
 
 /// The quad stream and, when models were given, the geometry renderer of one forest.
@@ -252,6 +254,7 @@ impl ForestRenderer {
                         refine_ms: q.refine_ms,
                         draw_ms: q.draw_ms,
                     }),
+                    work: q.work.combined(&s.work),
                 }
             }
             (Method::Mesh(_), Some(g)) => {
@@ -264,6 +267,7 @@ impl ForestRenderer {
                     per_level: Vec::new(),
                     overflow: 0,
                     times: s.times,
+                    work: s.work,
                 }
             }
             _ => {
@@ -276,6 +280,7 @@ impl ForestRenderer {
                     per_level: s.per_level,
                     overflow: s.overflow_cull + s.overflow_refine,
                     times: s.times,
+                    work: s.work,
                 }
             }
         }

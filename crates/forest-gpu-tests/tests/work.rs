@@ -214,3 +214,74 @@ fn the_stream_counts_its_work() {
     let polled = polled.expect("statistics arrive within 20 frames");
     assert_eq!(polled.work, stats.work);
 }
+
+#[test]
+fn every_method_counts_its_work() {
+    use forest_baselines::geometry::{GeometryRenderer, MeshMethod};
+    use forest_baselines::hybrid::{Hybrid, Near};
+    use forest_baselines::methods::{ForestRenderer, Method};
+
+    let ctx = common::ctx();
+    let forest = common::forest(6);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let opts = RendererOptions {
+        viewport: (160, 120),
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let geometry = GeometryRenderer::new(
+        &ctx,
+        common::prepared(),
+        &forest,
+        TARGET_FORMAT,
+        Background::Transparent,
+    )
+    .unwrap();
+    let gpu_bytes = geometry.gpu_bytes;
+    let mut r = ForestRenderer::new(
+        QuadStream::new(&ctx.device, scene, &opts).unwrap(),
+        Some(geometry),
+    );
+    let side = forest.extent();
+    let cam = common::camera(Vec3::new(0.0, 2.0, side * 1.5), Vec3::ZERO, 2.0);
+    let target = Target::new(&ctx, 160, 120);
+    let segments = forest_bake::lod::BANDS * forest.species.len() as u32;
+    let mut run = |method: Method| {
+        r.set_method(&ctx, method).unwrap();
+        r.render_frame(&ctx, &cam, &target).unwrap();
+        let s = r.read_stats(&ctx);
+        assert_eq!(ctx.take_errors(), Vec::<String>::new(), "{method:?}");
+        let covered = target.read(&ctx).pixels().filter(|px| px[3] > 0).count() as u64;
+        (s, covered)
+    };
+    let (full, covered) = run(Method::Mesh(MeshMethod::Full { depth_sort: false }));
+    let w = &full.work;
+    // Reset, classify, arguments, scatter; one indirect draw per band and species.
+    assert_eq!((w.dispatches, w.draws, w.bytes), (4, segments, gpu_bytes));
+    if let Some(p) = w.passes {
+        let draw = p[work::DRAW as usize];
+        // Indexed triangles: at most three vertices each, at least one (shared vertices).
+        assert!(draw.vertex_invocations <= 3 * full.primitives, "{draw:?}");
+        assert!(draw.vertex_invocations >= full.primitives / 3, "{draw:?}");
+        assert!(
+            draw.fragment_invocations >= covered && covered > 0,
+            "{draw:?}"
+        );
+        assert_eq!(p[work::REFINE as usize], work::PassWork::default());
+        assert!(p[work::CULL as usize].compute_invocations >= forest.instances.len() as u64);
+    }
+    let (quads, _) = run(Method::Quads);
+    let (hybrid, _) = run(Method::Hybrid(Hybrid {
+        near: Near::Metres(side * 0.4),
+        ..Default::default()
+    }));
+    // The hybrid's work is both forms' work in one frame: the stream's dispatches and its
+    // one draw, the geometry's four dispatches and its draws, both renderers' memory.
+    let h = &hybrid.work;
+    assert_eq!(h.dispatches, quads.work.dispatches + 4);
+    assert_eq!(h.draws, 1 + segments);
+    assert_eq!(h.bytes, quads.work.bytes + gpu_bytes);
+    if let (Some(t), Some(_)) = (h.total(), quads.work.passes) {
+        assert!(t.compute_invocations > 0 && t.vertex_invocations > 0);
+    }
+}

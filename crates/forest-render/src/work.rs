@@ -72,6 +72,20 @@ impl FrameWork {
             .map(|p| p.into_iter().fold(PassWork::default(), PassWork::add))
     }
 
+    /// Two renderers' work in one frame (the hybrid's quads and geometry): counts added,
+    /// statistics where both have them.
+    pub fn combined(&self, other: &Self) -> Self {
+        Self {
+            dispatches: self.dispatches + other.dispatches,
+            draws: self.draws + other.draws,
+            passes: self
+                .passes
+                .zip(other.passes)
+                .map(|(a, b)| std::array::from_fn(|i| a[i].add(b[i]))),
+            bytes: self.bytes + other.bytes,
+        }
+    }
+
     /// How the counts were obtained, for reports.
     pub fn source(&self) -> &'static str {
         if self.passes.is_some() {

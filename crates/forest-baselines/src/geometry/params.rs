@@ -193,6 +193,8 @@ pub struct GeometryStats {
     pub billboards: u32,
     /// GPU pass times (refine is 0), where the adapter has timestamp queries.
     pub times: Option<PassTimes>,
+    /// The work the frame asked of the GPU (see [`forest_render::work`]).
+    pub work: forest_render::work::FrameWork,
 }
 
 /// What one species was prepared into, for reports.

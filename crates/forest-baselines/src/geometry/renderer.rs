@@ -12,6 +12,8 @@ use forest_render::options::Background;
 use forest_render::options::RendererOptions;
 use forest_render::stats::PassTimes;
 use forest_render::target::Target;
+use forest_render::work::{self, FrameWork, StatisticsQueries};
+use std::sync::atomic::AtomicU32;
 use wgpu::util::DeviceExt;
 
 use super::layout::{compute_entries, draw_entries};
@@ -44,6 +46,9 @@ pub struct GeometryRenderer {
     draw_bg: wgpu::BindGroup,
     args: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
+    statistics: Option<StatisticsQueries>,
+    /// Draws recorded by the last [`Self::record_draw`].
+    draws: AtomicU32,
     species: u32,
     instances: u32,
     background: Background,
@@ -357,9 +362,13 @@ impl GeometryRenderer {
                 let resolve = zeros("geometry timestamps", 32, U::QUERY_RESOLVE | U::COPY_SRC);
                 (set, resolve, f64::from(ctx.queue.get_timestamp_period()))
             });
+        let statistics = StatisticsQueries::new(device);
         let mut sources = vec![(args.clone(), u64::from(cap.segments) * 16)];
         if let Some((_, resolve, _)) = &queries {
             sources.push((resolve.clone(), 32));
+        }
+        if let Some(q) = &statistics {
+            sources.push((q.resolve.clone(), work::STATISTICS_BYTES));
         }
         let ring = forest_render::stats::StatsRing::new(device, sources);
         Ok(Self {
@@ -381,6 +390,8 @@ impl GeometryRenderer {
             draw_bg,
             args,
             queries,
+            statistics,
+            draws: AtomicU32::new(0),
             species: geo_species.len() as u32,
             instances: instances.len() as u32,
             background,
@@ -490,6 +501,9 @@ impl GeometryRenderer {
                 }
             }),
         });
+        if let Some(q) = &self.statistics {
+            pass.begin_pipeline_statistics_query(&q.set, work::CULL);
+        }
         pass.set_bind_group(0, &self.compute_bg, &[]);
         let segments = BANDS * self.species;
         pass.set_pipeline(&self.reset);
@@ -508,15 +522,26 @@ impl GeometryRenderer {
             1,
             1,
         );
+        if let Some(q) = &self.statistics {
+            pass.end_pipeline_statistics_query();
+            // No refine pass: its query is written empty, so every query is resolved.
+            pass.begin_pipeline_statistics_query(&q.set, work::REFINE);
+            pass.end_pipeline_statistics_query();
+        }
     }
 
     /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
     /// `ground` and the background is the sky), then the bands nearest first.
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
-        if ground && self.background == Background::Sky {
+        let ground = ground && self.background == Background::Sky;
+        if ground {
             pass.set_pipeline(&self.ground_pipeline);
             pass.set_bind_group(0, &self.ground_bg, &[]);
             pass.draw(0..4, 0..1);
+        }
+        // The statistics are the trees' alone (the ground is outside the query).
+        if let Some(q) = &self.statistics {
+            pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
         }
         pass.set_bind_group(0, &self.draw_bg, &[]);
         let first_billboard = self.method.first_billboard_band();
@@ -531,6 +556,13 @@ impl GeometryRenderer {
                 pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);
             }
         }
+        if self.statistics.is_some() {
+            pass.end_pipeline_statistics_query();
+        }
+        self.draws.store(
+            BANDS * self.species + u32::from(ground),
+            std::sync::atomic::Ordering::Relaxed,
+        );
     }
 
     /// Resolve the frame's pass times: the cull pass's, and the draw pass's when `draw` (the
@@ -538,6 +570,9 @@ impl GeometryRenderer {
     pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder, draw: bool) {
         if let Some((set, resolve, _)) = &self.queries {
             encoder.resolve_query_set(set, 0..if draw { 4 } else { 2 }, resolve, 0);
+        }
+        if let Some(q) = &self.statistics {
+            q.resolve(encoder);
         }
     }
 
@@ -576,17 +611,37 @@ impl GeometryRenderer {
             .queries
             .as_ref()
             .map(|(_, resolve, _)| ctx.read_buffer(resolve, 32));
-        self.decode(&args, times.as_deref())
+        let statistics = self
+            .statistics
+            .as_ref()
+            .map(|q| ctx.read_buffer(&q.resolve, work::STATISTICS_BYTES));
+        self.decode(&args, times.as_deref(), statistics.as_deref())
     }
 
     /// Counters of a recent frame without waiting (a few frames late; `None` until one has
     /// arrived): see [`forest_render::stats::StatsRing`].
     pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<GeometryStats> {
         let parts = self.ring.poll(device, queue)?;
-        Some(self.decode(&parts[0], parts.get(1).map(|t| t.as_slice())))
+        // The ring's sources: the arguments, then timestamps and statistics where present.
+        let times = self.queries.is_some().then(|| parts.get(1)).flatten();
+        let statistics = self
+            .statistics
+            .is_some()
+            .then(|| parts.get(1 + usize::from(self.queries.is_some())))
+            .flatten();
+        Some(self.decode(
+            &parts[0],
+            times.map(|t| t.as_slice()),
+            statistics.map(|t| t.as_slice()),
+        ))
     }
 
-    fn decode(&self, args: &[u8], times: Option<&[u8]>) -> GeometryStats {
+    fn decode(
+        &self,
+        args: &[u8],
+        times: Option<&[u8]>,
+        statistics: Option<&[u8]>,
+    ) -> GeometryStats {
         let n = ((BANDS * self.species) as usize).min(args.len() / 16);
         let args: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&args[..n * 16]);
         let first_billboard = self.method.first_billboard_band();
@@ -613,6 +668,12 @@ impl GeometryRenderer {
                 draw_ms: ms(2),
             }
         });
+        stats.work = FrameWork {
+            dispatches: 4,
+            draws: self.draws.load(std::sync::atomic::Ordering::Relaxed),
+            passes: statistics.and_then(work::decode),
+            bytes: self.gpu_bytes,
+        };
         stats
     }
 }
