@@ -92,6 +92,31 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
             "{m}"
         );
     }
+    // The work columns, appended to Table 1, the path and the accuracy tables, with counts
+    // wherever the adapter has pipeline statistics; the work-against-accuracy charts.
+    let work = "dispatches,draws,vertex_invocations,primitives_rasterised,fragment_invocations,\
+                compute_invocations,gpu_mb,covered_pixels,fragments_per_covered_pixel,work_source";
+    for f in ["table1.csv", "path.csv", "accuracy.csv"] {
+        let text = std::fs::read_to_string(results.join(f)).unwrap();
+        let head = text.lines().next().unwrap();
+        assert!(head.ends_with(work), "{f}: {head}");
+        for row in text.lines().skip(1) {
+            // The work cells are the last ten (earlier cells may hold quoted commas).
+            let cells: Vec<&str> = row.split(',').collect();
+            let k = cells.len() - 10;
+            let dispatches: u32 = cells[k].parse().unwrap_or_else(|_| panic!("{f}: {row}"));
+            assert!(dispatches > 0, "{f}: {row}");
+            if cells[k + 9] == "pipeline statistics" {
+                let per_pixel = cells[k + 8];
+                let covered: u64 = cells[k + 7].parse().unwrap();
+                assert!(
+                    covered == 0 || per_pixel.parse::<f64>().unwrap() >= 1.0,
+                    "{f}: a covered pixel is shaded at least once: {row}"
+                );
+            }
+        }
+    }
+    assert!(results.join("accuracy_work_walkthrough.png").is_file());
     // The walkthrough of random eye-height cameras, and the hybrid's switch choices.
     assert!(accuracy.lines().any(|l| l.contains(",walkthrough,")));
     let budget = std::fs::read_to_string(results.join("budget.csv")).unwrap();

@@ -91,6 +91,20 @@ impl ForestRenderer {
         self.method
     }
 
+    /// Draw over `background` from the next frame on, every method: the sky and ground, or
+    /// transparent black (whose alpha is the trees' coverage).
+    pub fn set_background(&mut self, background: forest_render::options::Background) {
+        self.stream.set_background(background);
+        if let Some(g) = &mut self.geometry {
+            g.set_background(background);
+        }
+    }
+
+    /// The background every method draws over.
+    pub fn background(&self) -> forest_render::options::Background {
+        self.stream.options_built().background
+    }
+
     /// Switch the method; the geometry-based ones and the hybrid need the geometry renderer.
     pub fn set_method(&mut self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
         let missing = RenderError::MissingData {

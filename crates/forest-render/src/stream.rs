@@ -457,6 +457,12 @@ impl QuadStream {
         self.debug = view;
     }
 
+    /// Draw over `background` from the next frame on (what [`Self::encode`] clears to and
+    /// whether it draws the ground; the pipelines do not depend on it).
+    pub fn set_background(&mut self, background: Background) {
+        self.opts.background = background;
+    }
+
     /// The debug view in use.
     pub fn debug_view(&self) -> DebugView {
         self.debug

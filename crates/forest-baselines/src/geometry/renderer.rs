@@ -415,6 +415,11 @@ impl GeometryRenderer {
         self.method
     }
 
+    /// Draw over `background` from the next frame on (the clear colour and the ground).
+    pub fn set_background(&mut self, background: Background) {
+        self.background = background;
+    }
+
     /// Which trees the renderer draws from the next camera write on (the camera's `forms`, see
     /// [`forest_render::forms`]); [`forest_render::forms::FORMS_GEOMETRY`], every tree, unless the hybrid
     /// method set it.

@@ -102,6 +102,11 @@ const COLUMNS: [&str; 8] = [
     "primitives",
 ];
 
+/// Columns of `accuracy.csv`: [`COLUMNS`], then the work columns.
+fn columns() -> Vec<&'static str> {
+    COLUMNS.iter().copied().chain(super::WORK_COLUMNS).collect()
+}
+
 /// Seed of the walkthrough cameras.
 pub const WALK_SEED: u64 = 0x3a1f_2c77;
 
@@ -235,7 +240,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     let forest = b.forest(trees, side, 7)?;
     let mut r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
-    let mut table = Table::new(&COLUMNS);
+    let mut table = Table::new(&columns());
     let walk = walk_cameras(b.quick);
     let mut groups: Vec<(&str, Vec<Camera>)> = views(&forest, side, viewport, b.clearance())
         .into_iter()
@@ -250,11 +255,14 @@ pub fn run(b: &Bench) -> Result<Section> {
         for (method, param) in settings(b.quick) {
             // Means over the view's cameras (one, or the walkthrough's).
             let (mut frame_ms, mut flip, mut ssim, mut psnr, mut prims) = (0.0, 0.0, 0.0, 0.0, 0);
+            let mut work = Vec::new();
             for (cam, reference) in cams.iter().zip(&references) {
                 let mut c = *cam;
                 c.epsilon = epsilon_of(&param);
                 let (s, t) = b.measure(&mut r, method, &c, &target, b.frames_for(method))?;
-                let m = forest_metrics::compare(reference, &target.read(&b.ctx))?;
+                let img = target.read(&b.ctx);
+                let m = forest_metrics::compare(reference, &img)?;
+                work.push((s.work.clone(), super::covered(&img)));
                 frame_ms += t;
                 flip += f64::from(m.flip_mean);
                 ssim += m.ssim;
@@ -268,7 +276,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 method.name(),
                 prims / cams.len().max(1) as u64
             );
-            table.push(vec![
+            let mut row = vec![
                 method.name().into(),
                 param.clone(),
                 view.into(),
@@ -277,7 +285,9 @@ pub fn run(b: &Bench) -> Result<Section> {
                 format!("{:.4}", ssim / n),
                 format!("{:.2}", psnr / n),
                 (prims / cams.len().max(1) as u64).to_string(),
-            ]);
+            ];
+            row.extend(super::work_cells(&work));
+            table.push(row);
         }
     }
     b.write("accuracy.csv", &table.csv())?;
@@ -350,7 +360,64 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
             },
         )?;
         charts.push(stem);
+        // The same settings by the work they ask of a GPU (shader invocations: vertex,
+        // fragment and compute) instead of lavapipe's time, where the table has the counts.
+        let invocations = |row: &[String]| {
+            let k = COLUMNS.len();
+            let v = [k + 2, k + 4, k + 5].map(|i| row.get(i).and_then(|c| c.parse::<f64>().ok()));
+            Some(v[0]? + v[1]? + v[2]?)
+        };
+        let mut work_series: Vec<Series> = Vec::new();
+        for row in table.rows.iter().filter(|r| &r[2] == view) {
+            let Some(x) = invocations(row) else { continue };
+            let point = (x, cell(row, 4));
+            match work_series.iter_mut().find(|s| s.name == row[0]) {
+                Some(s) => s.points.push(point),
+                None => work_series.push(Series {
+                    name: row[0].clone(),
+                    points: vec![point],
+                    front: true,
+                    ..Default::default()
+                }),
+            }
+        }
+        if !work_series.is_empty() {
+            let stem = format!("accuracy_work_{view}");
+            b.chart(
+                &stem,
+                &Chart {
+                    title: format!(
+                        "Work against accuracy: {view} ({}x{})",
+                        viewport.0, viewport.1
+                    ),
+                    x_label: "shader invocations per frame (vertex + fragment + compute)".into(),
+                    y_label: "mean FLIP against the reference".into(),
+                    log_x: true,
+                    series: work_series,
+                    ..Default::default()
+                },
+            )?;
+            charts.push(stem);
+        }
     }
+    // Fragments shaded per covered pixel in the walkthrough: each method's median setting.
+    let overdraw = {
+        let k = COLUMNS.len() + 8;
+        let mut out = Vec::new();
+        for row in table.rows.iter().filter(|r| r[2] == "walkthrough") {
+            if let Some(f) = row.get(k).and_then(|c| c.parse::<f64>().ok())
+                && !out
+                    .iter()
+                    .any(|(m, _, _): &(String, String, f64)| *m == row[0])
+            {
+                out.push((row[0].clone(), row[1].clone(), f));
+            }
+        }
+        out.iter()
+            .map(|(m, p, f)| format!("{m} ({p}) {f:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     // The hybrid against the quad stream in the walkthrough, at the same ε.
     let walk_rows: Vec<&Vec<String>> = table
         .rows
@@ -384,7 +451,11 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
          where a tree's finest quads project longer than ε, at least 1.5 px). The walkthrough \
          view is the mean over {walk} seeded random eye-height cameras inside the forest (seed \
          {WALK_SEED:#x}; none rejected). Hybrid in the walkthrough, with its automatic switch: \
-         {walk_ratio}.\n\n{}",
+         {walk_ratio}.\n\nThe work charts put the same settings against the shader \
+         invocations a frame asks of a GPU (pipeline-statistics queries), which a CPU \
+         rasteriser's times distort: it charges triangles far more than a GPU does. Fragments \
+         shaded per covered pixel in the walkthrough (first setting of each method; lavapipe \
+         counts fragments per 4×4 stamp): {overdraw}.\n\n{}",
         viewport.0,
         viewport.1,
         summary
@@ -409,8 +480,11 @@ pub fn redraw(b: &Bench) -> Result<Section> {
         .with_context(|| format!("reading {} (run the accuracy suite first)", path.display()))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let mut table = Table::new(&COLUMNS);
-    if header != table.header {
+    // Files written before the work columns were added have the first columns only.
+    let mut table = Table::new(&columns());
+    if header == COLUMNS {
+        table = Table::new(&COLUMNS);
+    } else if header != table.header {
         anyhow::bail!("{}: unexpected columns {header:?}", path.display());
     }
     for l in lines.filter(|l| !l.is_empty()) {

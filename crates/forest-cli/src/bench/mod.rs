@@ -26,6 +26,7 @@ use forest_render::options::{Background, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::stats::PassTimes;
 use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::work::FrameWork;
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
 /// The suites, in the order `all` runs them.
@@ -290,6 +291,27 @@ impl Bench {
         ))
     }
 
+    /// The pixels `method` covers from `cam`: its transparent render's alpha (the frame
+    /// already in `target` when the renderer draws transparent, else one more frame over a
+    /// transparent background, the renderer's own background restored after).
+    pub fn coverage(
+        &self,
+        r: &mut ForestRenderer,
+        method: Method,
+        cam: &Camera,
+        target: &Target,
+    ) -> Result<u64> {
+        let background = r.background();
+        if background != Background::Transparent {
+            r.set_method(&self.ctx, method)?;
+            r.set_background(Background::Transparent);
+            let drawn = r.render_frame(&self.ctx, cam, target);
+            r.set_background(background);
+            drawn?;
+        }
+        Ok(covered(&target.read(&self.ctx)))
+    }
+
     /// Frames to measure for a method: one for full geometry and stochastic simplification on
     /// a CPU rasteriser (seconds per frame there), else the configured count.
     pub fn frames_for(&self, method: Method) -> u32 {
@@ -317,6 +339,67 @@ impl Bench {
         println!("wrote {}.png, .svg", self.out.join(stem).display());
         Ok(())
     }
+}
+
+/// Columns of the work a frame asked of the GPU, appended to the suites' tables (see
+/// [`forest_render::work`]): recorded dispatches and draws; vertex and fragment shader
+/// invocations, rasterised primitives and compute invocations from pipeline-statistics
+/// queries (empty where the adapter has none; lavapipe counts fragments per 4×4 stamp, GPUs
+/// per 2×2 quad); MB of buffers and textures the frame can touch; the pixels the trees cover
+/// (alpha of the method's transparent render) and fragments shaded per covered pixel.
+pub const WORK_COLUMNS: [&str; 10] = [
+    "dispatches",
+    "draws",
+    "vertex_invocations",
+    "primitives_rasterised",
+    "fragment_invocations",
+    "compute_invocations",
+    "gpu_mb",
+    "covered_pixels",
+    "fragments_per_covered_pixel",
+    "work_source",
+];
+
+/// The [`WORK_COLUMNS`] cells of frames' work, each with the pixels it covered: means over
+/// the frames (one frame: its counts), fragments per covered pixel as a ratio of sums.
+pub fn work_cells(frames: &[(FrameWork, u64)]) -> Vec<String> {
+    let n = frames.len().max(1) as u64;
+    let mean = |f: &dyn Fn(&FrameWork) -> u64| frames.iter().map(|(w, _)| f(w)).sum::<u64>() / n;
+    let stats: Option<Vec<_>> = frames.iter().map(|(w, _)| w.total()).collect();
+    let stat = |f: fn(&forest_render::work::PassWork) -> u64| {
+        stats.as_ref().map_or(String::new(), |t| {
+            (t.iter().map(f).sum::<u64>() / n).to_string()
+        })
+    };
+    let covered: u64 = frames.iter().map(|(_, c)| c).sum();
+    let per_pixel = stats
+        .as_ref()
+        .filter(|_| covered > 0)
+        .map_or(String::new(), |t| {
+            let fragments: u64 = t.iter().map(|t| t.fragment_invocations).sum();
+            format!("{:.3}", fragments as f64 / covered as f64)
+        });
+    vec![
+        mean(&|w| u64::from(w.dispatches)).to_string(),
+        mean(&|w| u64::from(w.draws)).to_string(),
+        stat(|t| t.vertex_invocations),
+        stat(|t| t.primitives),
+        stat(|t| t.fragment_invocations),
+        stat(|t| t.compute_invocations),
+        format!("{:.2}", mean(&|w| w.bytes) as f64 / 1e6),
+        (covered / n).to_string(),
+        per_pixel,
+        if stats.is_some() {
+            "pipeline statistics".into()
+        } else {
+            "recorded commands".into()
+        },
+    ]
+}
+
+/// Pixels of `img` with non-zero alpha (a transparent render's coverage).
+pub fn covered(img: &image::RgbaImage) -> u64 {
+    img.pixels().filter(|p| p[3] > 0).count() as u64
 }
 
 /// A CSV table: header and rows of already-formatted cells.

@@ -11,7 +11,7 @@ use glam::Vec3;
 
 use super::chart::{Chart, Series};
 use super::report::Section;
-use super::{Bench, Table, ms};
+use super::{Bench, Table, WORK_COLUMNS, ms, work_cells};
 
 /// View `i` of `n` along the walkthrough of a forest of side `side`: eye height 1.7 m, across
 /// the forest on a gentle S-curve, looking ahead and swinging left and right.
@@ -59,7 +59,9 @@ pub fn run(b: &Bench) -> Result<Section> {
             1,
         ));
     }
-    let mut table = Table::new(&["view", "method", "frame_ms", "primitives", "visible_trees"]);
+    let mut columns = vec!["view", "method", "frame_ms", "primitives", "visible_trees"];
+    columns.extend(WORK_COLUMNS);
+    let mut table = Table::new(&columns);
     let mut series = Vec::new();
     let mut means = Vec::new();
     for (method, stride) in methods {
@@ -72,14 +74,17 @@ pub fn run(b: &Bench) -> Result<Section> {
             let cam = view(i, views, side, viewport);
             // One measured frame per view: the hundred views are the samples.
             let (st, t) = b.measure(&mut r, method, &cam, &target, 1)?;
+            let covered = b.coverage(&mut r, method, &cam, &target)?;
             s.points.push((f64::from(i), t));
-            table.push(vec![
+            let mut row = vec![
                 i.to_string(),
                 method.name().into(),
                 ms(t),
                 st.primitives.to_string(),
                 st.visible_trees.to_string(),
-            ]);
+            ];
+            row.extend(work_cells(&[(st.work.clone(), covered)]));
+            table.push(row);
         }
         let mean = s.points.iter().map(|p| p.1).sum::<f64>() / s.points.len().max(1) as f64;
         let worst = s.points.iter().map(|p| p.1).fold(0.0, f64::max);

@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use super::chart::{Chart, Series};
 use super::report::Section;
-use super::{Bench, Table, ms};
+use super::{Bench, Table, WORK_COLUMNS, ms, work_cells};
 
 /// Side of the square every Table 1 forest covers (metres): forests differ in density.
 const SIDE: f32 = 1000.0;
@@ -42,7 +42,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             SIDE,
         )
     };
-    let mut table = Table::new(&[
+    let mut columns = vec![
         "trees",
         "view",
         "visible_trees",
@@ -53,7 +53,9 @@ pub fn run(b: &Bench) -> Result<Section> {
         "total_ms",
         "overflow",
         "device",
-    ]);
+    ];
+    columns.extend(WORK_COLUMNS);
+    let mut table = Table::new(&columns);
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut series: Vec<Series> = views(side)
         .iter()
@@ -77,9 +79,10 @@ pub fn run(b: &Bench) -> Result<Section> {
                 epsilon: 16.0,
             };
             let (s, p, _) = b.measure_passes(&mut r, Method::Quads, &cam, &target, b.frames)?;
+            let covered = b.coverage(&mut r, Method::Quads, &cam, &target)?;
             let (c, rf, d) = (p.cull_ms, p.refine_ms, p.draw_ms);
             series[k].points.push((f64::from(trees), c + rf + d));
-            table.push(vec![
+            let mut row = vec![
                 trees.to_string(),
                 view.into(),
                 s.visible_trees.to_string(),
@@ -90,7 +93,9 @@ pub fn run(b: &Bench) -> Result<Section> {
                 ms(c + rf + d),
                 s.overflow.to_string(),
                 b.device.clone(),
-            ]);
+            ];
+            row.extend(work_cells(&[(s.work.clone(), covered)]));
+            table.push(row);
             println!(
                 "{trees} trees, {view}: {} visible, {} quads, cull {c:.1} refine {rf:.1} draw {d:.1} ms",
                 s.visible_trees, s.primitives
