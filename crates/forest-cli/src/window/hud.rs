@@ -51,6 +51,24 @@ impl Viewer {
                         s.visible_trees, s.primitives, s.billboards, s.overflow
                     ));
                 }
+                // The work counts (pipeline statistics where the adapter has them).
+                let w = &s.work;
+                let counts = match w.total() {
+                    Some(t) => format!(
+                        "{} vertices, {} primitives, {} fragments, {} compute threads",
+                        si(t.vertex_invocations),
+                        si(t.primitives),
+                        si(t.fragment_invocations),
+                        si(t.compute_invocations)
+                    ),
+                    None => "no pipeline statistics on this adapter".into(),
+                };
+                ui.label(format!(
+                    "work: {} dispatches, {} draws, {:.0} MB; {counts}",
+                    w.dispatches,
+                    w.draws,
+                    w.bytes as f64 / 1e6
+                ));
                 if !s.per_level.is_empty() {
                     let levels: Vec<String> = s
                         .per_level
@@ -103,5 +121,27 @@ impl Viewer {
                 }
             });
         (method, debug)
+    }
+}
+
+/// A count with an SI suffix (k, M, G) and one decimal.
+fn si(n: u64) -> String {
+    let x = n as f64;
+    match n {
+        0..1_000 => n.to_string(),
+        1_000..1_000_000 => format!("{:.1}k", x / 1e3),
+        1_000_000..1_000_000_000 => format!("{:.1}M", x / 1e6),
+        _ => format!("{:.1}G", x / 1e9),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn counts_get_si_suffixes() {
+        assert_eq!(super::si(999), "999");
+        assert_eq!(super::si(12_345), "12.3k");
+        assert_eq!(super::si(708_320_000), "708.3M");
+        assert_eq!(super::si(2_500_000_000), "2.5G");
     }
 }
