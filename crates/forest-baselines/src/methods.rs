@@ -100,6 +100,20 @@ impl ForestRenderer {
         }
     }
 
+    /// Gather pipeline statistics in every method's frames from the next frame on (off by
+    /// default; see `QuadStream::set_pipeline_statistics`).
+    pub fn set_pipeline_statistics(&mut self, on: bool) {
+        self.stream.set_pipeline_statistics(on);
+        if let Some(g) = &mut self.geometry {
+            g.set_pipeline_statistics(on);
+        }
+    }
+
+    /// Whether frames gather pipeline statistics.
+    pub fn pipeline_statistics(&self) -> bool {
+        self.stream.pipeline_statistics()
+    }
+
     /// The background every method draws over.
     pub fn background(&self) -> forest_render::options::Background {
         self.stream.options_built().background

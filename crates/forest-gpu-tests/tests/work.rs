@@ -169,8 +169,18 @@ fn the_stream_counts_its_work() {
     let target = Target::new(&ctx, 160, 120);
     let side = forest.extent();
     let cam = common::camera(Vec3::new(0.0, 2.0, side * 1.5), Vec3::ZERO, 2.0);
+    // Off by default: no statistics, the recorded counts all the same.
+    stream.render_frame(&ctx, &cam, &target).unwrap();
+    let off = stream.read_stats(&ctx);
+    assert_eq!(off.work.passes, None);
+    assert!(off.work.dispatches > 0 && off.work.draws == 1);
+    stream.set_pipeline_statistics(true);
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let stats = stream.read_stats(&ctx);
+    assert_eq!(
+        (stats.work.dispatches, stats.work.draws, stats.work.bytes),
+        (off.work.dispatches, off.work.draws, off.work.bytes)
+    );
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     let w = &stats.work;
     assert!(stats.quads > 0, "the camera sees trees");
@@ -242,6 +252,7 @@ fn every_method_counts_its_work() {
         QuadStream::new(&ctx.device, scene, &opts).unwrap(),
         Some(geometry),
     );
+    r.set_pipeline_statistics(true);
     let side = forest.extent();
     let cam = common::camera(Vec3::new(0.0, 2.0, side * 1.5), Vec3::ZERO, 2.0);
     let target = Target::new(&ctx, 160, 120);

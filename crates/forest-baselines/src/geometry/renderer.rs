@@ -47,6 +47,8 @@ pub struct GeometryRenderer {
     args: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     statistics: Option<StatisticsQueries>,
+    /// Whether frames gather pipeline statistics.
+    count_work: bool,
     /// Draws recorded by the last [`Self::record_draw`].
     draws: AtomicU32,
     species: u32,
@@ -391,6 +393,7 @@ impl GeometryRenderer {
             args,
             queries,
             statistics,
+            count_work: false,
             draws: AtomicU32::new(0),
             species: geo_species.len() as u32,
             instances: instances.len() as u32,
@@ -413,6 +416,17 @@ impl GeometryRenderer {
     /// The current method.
     pub fn method(&self) -> MeshMethod {
         self.method
+    }
+
+    /// Gather pipeline statistics from the next frame on (see
+    /// `QuadStream::set_pipeline_statistics`; off by default).
+    pub fn set_pipeline_statistics(&mut self, on: bool) {
+        self.count_work = on;
+    }
+
+    /// The statistics queries when frames gather them.
+    fn counting(&self) -> Option<&StatisticsQueries> {
+        self.statistics.as_ref().filter(|_| self.count_work)
     }
 
     /// Draw over `background` from the next frame on (the clear colour and the ground).
@@ -506,7 +520,7 @@ impl GeometryRenderer {
                 }
             }),
         });
-        if let Some(q) = &self.statistics {
+        if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::CULL);
         }
         pass.set_bind_group(0, &self.compute_bg, &[]);
@@ -527,7 +541,7 @@ impl GeometryRenderer {
             1,
             1,
         );
-        if let Some(q) = &self.statistics {
+        if let Some(q) = self.counting() {
             pass.end_pipeline_statistics_query();
             // No refine pass: its query is written empty, so every query is resolved.
             pass.begin_pipeline_statistics_query(&q.set, work::REFINE);
@@ -545,7 +559,7 @@ impl GeometryRenderer {
             pass.draw(0..4, 0..1);
         }
         // The statistics are the trees' alone (the ground is outside the query).
-        if let Some(q) = &self.statistics {
+        if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
         }
         pass.set_bind_group(0, &self.draw_bg, &[]);
@@ -561,7 +575,7 @@ impl GeometryRenderer {
                 pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);
             }
         }
-        if self.statistics.is_some() {
+        if self.counting().is_some() {
             pass.end_pipeline_statistics_query();
         }
         self.draws.store(
@@ -576,7 +590,7 @@ impl GeometryRenderer {
         if let Some((set, resolve, _)) = &self.queries {
             encoder.resolve_query_set(set, 0..if draw { 4 } else { 2 }, resolve, 0);
         }
-        if let Some(q) = &self.statistics {
+        if let Some(q) = self.counting() {
             q.resolve(encoder);
         }
     }
@@ -676,7 +690,9 @@ impl GeometryRenderer {
         stats.work = FrameWork {
             dispatches: 4,
             draws: self.draws.load(std::sync::atomic::Ordering::Relaxed),
-            passes: statistics.and_then(work::decode),
+            passes: statistics
+                .filter(|_| self.count_work)
+                .and_then(work::decode),
             bytes: self.gpu_bytes,
         };
         stats

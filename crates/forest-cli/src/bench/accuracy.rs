@@ -239,6 +239,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     let (trees, side, viewport) = scene(b);
     let forest = b.forest(trees, side, 7)?;
     let mut r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
+    r.set_pipeline_statistics(true);
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&columns());
     let walk = walk_cameras(b.quick);
@@ -260,6 +261,8 @@ pub fn run(b: &Bench) -> Result<Section> {
                 let mut c = *cam;
                 c.epsilon = epsilon_of(&param);
                 let (s, t) = b.measure(&mut r, method, &c, &target, b.frames_for(method))?;
+                // The measured frames gathered statistics (set below); the background is
+                // transparent, so the image's alpha is the coverage.
                 let img = target.read(&b.ctx);
                 let m = forest_metrics::compare(reference, &img)?;
                 work.push((s.work.clone(), super::covered(&img)));

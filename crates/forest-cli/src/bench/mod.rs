@@ -291,25 +291,29 @@ impl Bench {
         ))
     }
 
-    /// The pixels `method` covers from `cam`: its transparent render's alpha (the frame
-    /// already in `target` when the renderer draws transparent, else one more frame over a
-    /// transparent background, the renderer's own background restored after).
-    pub fn coverage(
+    /// The work `method` asks of the GPU for `cam` and the pixels it covers: one more frame,
+    /// over a transparent background (its alpha is the coverage) and with pipeline
+    /// statistics on; the renderer's background and statistics are restored after. Timed
+    /// frames ([`Self::measure`]) run as the renderer is set (statistics off unless a suite
+    /// turned them on).
+    pub fn work(
         &self,
         r: &mut ForestRenderer,
         method: Method,
         cam: &Camera,
         target: &Target,
-    ) -> Result<u64> {
-        let background = r.background();
-        if background != Background::Transparent {
-            r.set_method(&self.ctx, method)?;
-            r.set_background(Background::Transparent);
-            let drawn = r.render_frame(&self.ctx, cam, target);
-            r.set_background(background);
-            drawn?;
-        }
-        Ok(covered(&target.read(&self.ctx)))
+    ) -> Result<(FrameWork, u64)> {
+        let (background, counting) = (r.background(), r.pipeline_statistics());
+        r.set_method(&self.ctx, method)?;
+        r.set_background(Background::Transparent);
+        r.set_pipeline_statistics(true);
+        let drawn = r.render_frame(&self.ctx, cam, target);
+        r.set_background(background);
+        r.set_pipeline_statistics(counting);
+        drawn?;
+        let stats = r.read_stats(&self.ctx);
+        self.ctx.check_errors()?;
+        Ok((stats.work, covered(&target.read(&self.ctx))))
     }
 
     /// Frames to measure for a method: one for full geometry and stochastic simplification on

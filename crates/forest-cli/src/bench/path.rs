@@ -74,7 +74,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             let cam = view(i, views, side, viewport);
             // One measured frame per view: the hundred views are the samples.
             let (st, t) = b.measure(&mut r, method, &cam, &target, 1)?;
-            let covered = b.coverage(&mut r, method, &cam, &target)?;
+            let work = b.work(&mut r, method, &cam, &target)?;
             s.points.push((f64::from(i), t));
             let mut row = vec![
                 i.to_string(),
@@ -83,7 +83,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 st.primitives.to_string(),
                 st.visible_trees.to_string(),
             ];
-            row.extend(work_cells(&[(st.work.clone(), covered)]));
+            row.extend(work_cells(&[work]));
             table.push(row);
         }
         let mean = s.points.iter().map(|p| p.1).sum::<f64>() / s.points.len().max(1) as f64;

@@ -44,6 +44,7 @@ impl Viewer {
             };
             let view = output.texture.create_view(&Default::default());
             let mut enc = g.ctx.device.create_command_encoder(&Default::default());
+            g.renderer.set_pipeline_statistics(self.count_work);
             g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
             let raw = g.egui_state.take_egui_input(&g.window);
             let ui_ctx = g.egui.clone();

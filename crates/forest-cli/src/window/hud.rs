@@ -61,7 +61,8 @@ impl Viewer {
                         si(t.fragment_invocations),
                         si(t.compute_invocations)
                     ),
-                    None => "no pipeline statistics on this adapter".into(),
+                    None if self.count_work => "no pipeline statistics on this adapter".into(),
+                    None => "shader counts off".into(),
                 };
                 ui.label(format!(
                     "work: {} dispatches, {} draws, {:.0} MB; {counts}",
@@ -85,6 +86,10 @@ impl Viewer {
                 );
                 ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
                 ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
+                ui.checkbox(
+                    &mut self.count_work,
+                    "count shader work (pipeline statistics)",
+                );
                 ui.label("method:");
                 for (i, m) in self.methods.iter().enumerate() {
                     if ui

@@ -115,6 +115,8 @@ pub struct Viewer {
     method: usize,
     debug: DebugView,
     show_hud: bool,
+    /// Whether frames gather pipeline statistics for the HUD.
+    count_work: bool,
     path: Option<CameraPath>,
     /// Next key of `path` to show while playing.
     playing: Option<usize>,
@@ -164,6 +166,7 @@ impl Viewer {
             methods: st.methods,
             debug: st.debug_view,
             show_hud: true,
+            count_work: true,
             playing: st.path.as_ref().map(|_| 0),
             path: st.path,
             screenshots: st.screenshots,
