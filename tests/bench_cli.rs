@@ -116,6 +116,18 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
             }
         }
     }
+    // Every table counts the same way: the adapter has pipeline statistics for all or none.
+    let sources: std::collections::BTreeSet<String> = ["table1.csv", "path.csv", "accuracy.csv"]
+        .iter()
+        .flat_map(|f| {
+            let text = std::fs::read_to_string(results.join(f)).unwrap();
+            text.lines()
+                .skip(1)
+                .map(|l| l.rsplit(',').next().unwrap().to_string())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert_eq!(sources.len(), 1, "{sources:?}");
     assert!(results.join("accuracy_work_walkthrough.png").is_file());
     // The walkthrough of random eye-height cameras, and the hybrid's switch choices.
     assert!(accuracy.lines().any(|l| l.contains(",walkthrough,")));

@@ -307,11 +307,12 @@ impl Bench {
         r.set_method(&self.ctx, method)?;
         r.set_background(Background::Transparent);
         r.set_pipeline_statistics(true);
-        let drawn = r.render_frame(&self.ctx, cam, target);
+        let drawn = r
+            .render_frame(&self.ctx, cam, target)
+            .map(|()| r.read_stats(&self.ctx));
         r.set_background(background);
         r.set_pipeline_statistics(counting);
-        drawn?;
-        let stats = r.read_stats(&self.ctx);
+        let stats = drawn?;
         self.ctx.check_errors()?;
         Ok((stats.work, covered(&target.read(&self.ctx))))
     }
