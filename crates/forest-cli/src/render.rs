@@ -107,6 +107,10 @@ pub struct MethodArgs {
     /// projected edge length (the paper's metric).
     #[arg(long)]
     pub depth_error: bool,
+    /// Quad stream: draw every quad over its whole square, as the paper does, instead of its
+    /// node's covered box (for comparison; the images agree, the fragments do not).
+    #[arg(long)]
+    pub untrimmed: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
     /// geometry; `auto`: where the quad stream runs out of levels, i.e. where a tree's finest
     /// quads project longer than ε (at least 1.5 px; it follows each tree's size, the view
@@ -137,6 +141,7 @@ impl MethodArgs {
         StreamOptions {
             blend: AspectBlend::from_name(&self.blend).unwrap_or_default(),
             depth_error: self.depth_error,
+            trim: !self.untrimmed,
         }
     }
 

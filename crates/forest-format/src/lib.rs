@@ -23,6 +23,7 @@ pub mod node;
 pub mod nodes_codec;
 pub mod shading;
 pub mod slab;
+pub mod trim;
 
 pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding, PlaneFit};
 pub use error::FormatError;

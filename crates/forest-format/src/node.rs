@@ -58,7 +58,8 @@ pub fn error_code(err: f32) -> u8 {
     (1..15).find(|&k| error_bound(k) >= err).unwrap_or(15)
 }
 
-/// A quad-hierarchy node: 8 bytes, read by WGSL as one texel of an `Rg32Uint` texture.
+/// A quad-hierarchy node: 8 bytes, read by WGSL as the first two words of a texel of the
+/// runtime's node texture.
 ///
 /// - `child`: bits 0..24 the index of the first existing child (zero for a leaf), bits 24..28
 ///   the depth-error code ([`error_code`]: how far the node's pixels lie from its drawn

@@ -296,3 +296,125 @@ fn every_method_counts_its_work() {
         assert!(t.compute_invocations > 0 && t.vertex_invocations > 0);
     }
 }
+
+#[test]
+fn trimmed_quads_draw_the_same_image_with_fewer_fragments() {
+    use forest_render::options::StreamOptions;
+
+    let ctx = common::ctx();
+    let forest = common::forest(40);
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let opts = RendererOptions {
+        viewport: (160, 120),
+        min_epsilon: 1.0,
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
+    stream.set_pipeline_statistics(true);
+    let target = Target::new(&ctx, 160, 120);
+    let mut frame = |trim: bool, cam: &forest_render::Camera| {
+        stream.set_options(StreamOptions {
+            trim,
+            ..Default::default()
+        });
+        stream.render_frame(&ctx, cam, &target).unwrap();
+        let s = stream.read_stats(&ctx);
+        assert_eq!(ctx.take_errors(), Vec::<String>::new());
+        let fragments = s
+            .work
+            .passes
+            .map(|p| p[work::DRAW as usize].fragment_invocations);
+        (target.read(&ctx), fragments, s.quads)
+    };
+    let side = forest.extent();
+    let mut cams = common::cameras(side);
+    cams.push((
+        "close_up",
+        common::camera(Vec3::new(3.0, 1.5, 3.0), Vec3::new(0.0, 1.5, 0.0), 1.0),
+    ));
+    for (name, cam) in cams {
+        let (whole, whole_fragments, whole_quads) = frame(false, &cam);
+        let (trimmed, trimmed_fragments, quads) = frame(true, &cam);
+        assert_eq!(quads, whole_quads, "{name}: trimming changes no quad");
+        let m = forest_metrics::compare(&whole, &trimmed).unwrap();
+        if m.flip_mean > 0.01 {
+            let out = common::root().join("target/test-output");
+            std::fs::create_dir_all(&out).unwrap();
+            whole
+                .save(out.join(format!("trim-{name}-untrimmed.png")))
+                .unwrap();
+            trimmed
+                .save(out.join(format!("trim-{name}-trimmed.png")))
+                .unwrap();
+            panic!("{name}: trimmed against untrimmed FLIP {}", m.flip_mean);
+        }
+        if let (Some(t), Some(w)) = (trimmed_fragments, whole_fragments)
+            && quads > 0
+        {
+            eprintln!(
+                "{name}: {quads} quads, fragments {w} untrimmed, {t} trimmed, FLIP {}",
+                m.flip_mean
+            );
+            assert!(t <= w, "{name}: {t} fragments trimmed, {w} untrimmed");
+        }
+    }
+}
+
+#[test]
+fn every_covered_texel_lies_in_its_nodes_box() {
+    use forest_format::trim;
+    for s in common::species() {
+        let m = &s.atlas.manifest;
+        let t = trim::node_trims(&s.atlas.nodes, &m.layer_roots, &s.layers, m.levels);
+        let res = s.layers.resolution;
+        let (mut nodes, mut texels) = (0, 0);
+        for (l, root) in m.layer_roots.iter().enumerate() {
+            let Some(root) = root else { continue };
+            let rgba = s.layers.layer(l as u32);
+            let mut stack = vec![(*root, 0u32, 0u32, 0u32)];
+            while let Some((n, level, x, y)) = stack.pop() {
+                let side = res >> level;
+                let (lo, hi) = trim::unpack(t[n as usize]);
+                for py in y * side..(y + 1) * side {
+                    for px in x * side..(x + 1) * side {
+                        if rgba[((py * res + px) * 4 + 3) as usize] == 0 {
+                            continue;
+                        }
+                        let fx = (px - x * side) as f32 / side as f32;
+                        let fy = (py - y * side) as f32 / side as f32;
+                        let inv = 1.0 / side as f32;
+                        assert!(
+                            fx >= lo[0] - 1e-6
+                                && fy >= lo[1] - 1e-6
+                                && fx + inv <= hi[0] + 1e-6
+                                && fy + inv <= hi[1] + 1e-6,
+                            "layer {l} node {n} (level {level}): texel ({px}, {py}) outside \
+                             {lo:?}..{hi:?}"
+                        );
+                        texels += 1;
+                    }
+                }
+                nodes += 1;
+                let node = s.atlas.nodes[n as usize];
+                for c in 0..4 {
+                    if let Some(k) = node.child_index(c) {
+                        stack.push((k, level + 1, x * 2 + (c & 1), y * 2 + (c >> 1)));
+                    }
+                }
+            }
+        }
+        assert!(nodes > 0 && texels > 0);
+        // The boxes trim: on average a node's box is well under its square.
+        let area: f32 = t
+            .iter()
+            .map(|&b| {
+                let (lo, hi) = trim::unpack(b);
+                (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0)
+            })
+            .sum::<f32>()
+            / t.len() as f32;
+        eprintln!("{nodes} nodes, {texels} covered texel visits, mean box area {area:.3}");
+        assert!(area < 0.9, "mean box area {area}");
+    }
+}

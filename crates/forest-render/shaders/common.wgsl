@@ -43,7 +43,8 @@ struct Species {
     node_base: u32,
     // Direction triangles for views from below, after the tri_count upper ones.
     lower_tri_count: u32,
-    pad0: u32,
+    // Slab image side in texels.
+    resolution: u32,
     pad1: u32,
     pad2: u32,
 }
@@ -97,6 +98,7 @@ const WEIGHT_ONE: u32 = 4095u;
 const FLAG_DITHER: u32 = 1u;
 const FLAG_NEAREST: u32 = 2u;
 const FLAG_DEPTH_ERROR: u32 = 4u;
+const FLAG_UNTRIMMED: u32 = 8u;
 const BLOCK: u32 = 512u;
 const NONE: u32 = 0xffffffffu;
 const NODE_TEX_WIDTH: u32 = 4096u;

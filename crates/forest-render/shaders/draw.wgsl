@@ -59,6 +59,29 @@ fn crack_margin(sp: Species, inst: Instance, level: u32, p: vec3<f32>) -> f32 {
     return CRACK_MARGIN * clamp(quad_px / CRACK_PIXELS - 1.0, 0.0, 1.0);
 }
 
+// Pixels the covered box of a node is widened by on each side (within the node), so that the
+// texture filter's fringe around covered texels is still drawn. The filter reads about one
+// texel of the mip level the derivatives pick, which is set by the node's most compressed
+// screen extent: the fringe is counted in those pixels, and is at least one texel of the
+// finest level (magnified, the bilinear filter spreads half a texel).
+const TRIM_FRINGE: f32 = 2.0;
+
+// The shortest screen extent (pixels) of the edges of the node (`x`, `y`, side `size` in slab
+// units, corner depths `d`), or 0 when a corner is behind the eye.
+fn node_min_extent(sp: Species, f: Frame, inst: Instance, slab: u32, x: f32, y: f32, size: f32,
+                   d: vec4<f32>) -> f32 {
+    var s: array<vec2<f32>, 4>;
+    for (var c = 0u; c < 4u; c++) {
+        let p = to_world(inst, slab_point(sp, f, slab, (x + f32(c & 1u)) * size,
+                                          (y + f32(c >> 1u)) * size, d[c]));
+        let clip = camera.view_proj * vec4<f32>(p, 1.0);
+        if (clip.w <= 0.0) { return 0.0; }
+        s[c] = clip.xy / clip.w * camera.viewport.xy * 0.5;
+    }
+    return min(min(distance(s[0], s[1]), distance(s[2], s[3])),
+               min(distance(s[0], s[2]), distance(s[1], s[3])));
+}
+
 @vertex
 fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
     let q = quads[qi];
@@ -66,16 +89,39 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let sp = species[inst.species];
     let dir = quad_dir(q);
     let f = frames[sp.dir_base + dir];
-    let node = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).xy;
-    let size = 1.0 / f32(1u << quad_level(q));
+    let node = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).xyz;
+    let level = quad_level(q);
+    let size = 1.0 / f32(1u << level);
     let finest = 1.0 / f32(1u << (sp.levels - 1u));
-    let u0 = (f32(quad_x(q)) + f32(vi & 1u)) * size;
-    let v0 = (f32(quad_y(q)) + f32(vi >> 1u)) * size;
-    let t0 = f32((node.y >> (8u * vi)) & 255u) / 255.0;
+    let corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u));
+    let d = vec4<f32>(f32(node.y & 255u), f32((node.y >> 8u) & 255u),
+                      f32((node.y >> 16u) & 255u), f32(node.y >> 24u)) / 255.0;
+    // The node's covered box (fractions of its side; see forest_format::trim), widened by
+    // the fringe; the whole node when untrimmed.
+    var box_lo = vec2<f32>(0.0);
+    var box_hi = vec2<f32>(1.0);
+    if ((stream_flags(camera) & FLAG_UNTRIMMED) == 0u) {
+        let px = node_min_extent(sp, f, inst, quad_slab(q), f32(quad_x(q)), f32(quad_y(q)), size, d);
+        // At least one texel too: magnified, the bilinear filter spreads half a texel.
+        let texel = 1.0 / f32(max(sp.resolution >> level, 1u));
+        let fringe = select(1.0, max(TRIM_FRINGE / px, texel), px > 0.0);
+        box_lo = max(vec2<f32>(f32(node.z & 255u), f32((node.z >> 8u) & 255u)) / 255.0 - fringe,
+                 vec2<f32>(0.0));
+        box_hi = min(vec2<f32>(f32((node.z >> 16u) & 255u), f32(node.z >> 24u)) / 255.0 + fringe,
+                 vec2<f32>(1.0));
+    }
+    let a = mix(box_lo, box_hi, corner);
+    let u0 = (f32(quad_x(q)) + a.x) * size;
+    let v0 = (f32(quad_y(q)) + a.y) * size;
+    // The node's plane at `a`: bilinear in its corner depths (exact for a plane).
+    let t0 = mix(mix(d.x, d.y, a.x), mix(d.z, d.w, a.x), a.y);
     var w = to_world(inst, slab_point(sp, f, quad_slab(q), u0, v0, t0));
-    let margin = crack_margin(sp, inst, quad_level(q), w);
-    let u = u0 + (f32(vi & 1u) * 2.0 - 1.0) * margin * finest;
-    let v = v0 + (f32(vi >> 1u) * 2.0 - 1.0) * margin * finest;
+    // Crack margin outwards on every side (finest level), as untrimmed: from a side that
+    // reaches the node's edge it overlaps the neighbour's quad; from a trimmed side it only
+    // covers the node's own blank texels.
+    let margin = crack_margin(sp, inst, level, w);
+    let u = u0 + (corner.x * 2.0 - 1.0) * margin * finest;
+    let v = v0 + (corner.y * 2.0 - 1.0) * margin * finest;
     if (margin > 0.0) {
         w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t0));
     }

@@ -66,8 +66,10 @@ pub struct GpuSpecies {
     /// Direction triangles for views from below, right after the upper ones (0: views from
     /// below are clamped onto the horizon).
     pub lower_tri_count: u32,
+    /// Slab image side in texels (the same for every species of a scene).
+    pub resolution: u32,
     /// Padding to 16 bytes.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
 
 /// A sampling direction's frame (48 bytes; `w` unused).

@@ -165,6 +165,10 @@ pub struct StreamOptions {
     /// buys 1–3 % lower FLIP for 2–6× the quads, where a smaller ε buys as much for fewer
     /// quads, so it is off unless asked for.
     pub depth_error: bool,
+    /// Draw each quad over its node's covered box (widened by two pixels for the texture
+    /// filter) instead of its whole square (see `forest_format::trim`). On (the default);
+    /// off draws the untrimmed quads, for comparison.
+    pub trim: bool,
 }
 
 impl Default for StreamOptions {
@@ -172,6 +176,7 @@ impl Default for StreamOptions {
         Self {
             blend: AspectBlend::Over,
             depth_error: false,
+            trim: true,
         }
     }
 }
@@ -182,6 +187,8 @@ pub const FLAG_DITHER: u32 = 1;
 pub const FLAG_NEAREST: u32 = 2;
 /// See [`FLAG_DITHER`].
 pub const FLAG_DEPTH_ERROR: u32 = 4;
+/// See [`FLAG_DITHER`].
+pub const FLAG_UNTRIMMED: u32 = 8;
 
 impl StreamOptions {
     /// The flag bits written to the camera uniform's `viewport.w`.
@@ -197,6 +204,7 @@ impl StreamOptions {
             } else {
                 0
             }
+            | if self.trim { 0 } else { FLAG_UNTRIMMED }
     }
 }
 

@@ -44,6 +44,8 @@ pub struct SceneTables {
     pub roots: Vec<u32>,
     /// All nodes, species after species.
     pub nodes: Vec<QuadNode>,
+    /// Each node's covered box (see [`forest_format::trim`]), in node order.
+    pub trims: Vec<u32>,
     /// Presort directions (xyz; w unused).
     pub presort_dirs: Vec<[f32; 4]>,
     /// Presort orders, one after another (`K × N`).
@@ -96,7 +98,8 @@ impl SceneTables {
                 layer_base: t.layers,
                 node_base,
                 lower_tri_count: m.lower_triangles.len() as u32,
-                pad: [0; 3],
+                resolution: m.params.resolution,
+                pad: [0; 2],
             });
             t.frames.extend(m.directions.iter().map(|f| GpuFrame {
                 dir: f.dir.extend(0.0).to_array(),
@@ -115,6 +118,12 @@ impl SceneTables {
                     .map(|r| r.map_or(u32::MAX, |r| r + node_base)),
             );
             t.nodes.extend_from_slice(&s.atlas.nodes);
+            t.trims.extend(forest_format::trim::node_trims(
+                &s.atlas.nodes,
+                &m.layer_roots,
+                &s.layers,
+                m.levels,
+            ));
             t.layers += m.params.layers();
             t.max_levels = t.max_levels.max(m.levels);
             t.quads_per_tree = t.quads_per_tree.max(3 * m.params.slabs);
@@ -233,7 +242,8 @@ pub struct GpuScene {
     pub tables: SceneTables,
     /// Colour layers of all species.
     pub colour: wgpu::Texture,
-    /// Node texture (`Rg32Uint`, [`NODE_TEXTURE_WIDTH`] wide).
+    /// Node texture (`Rgba32Uint`, [`NODE_TEXTURE_WIDTH`] wide): the node's two words, its
+    /// covered box, 0.
     pub nodes: wgpu::Texture,
     /// Presort texture (`R32Uint`, [`PRESORT_TEXTURE_WIDTH`] wide).
     pub presort: wgpu::Texture,
@@ -392,13 +402,22 @@ impl GpuScene {
             wgpu::util::TextureDataOrder::LayerMajor,
             &data,
         );
+        let node_texels: Vec<[u32; 4]> = tables
+            .nodes
+            .iter()
+            .zip(&tables.trims)
+            .map(|(n, &t)| {
+                let [child, depth]: [u32; 2] = bytemuck::cast(*n);
+                [child, depth, t, 0]
+            })
+            .collect();
         let nodes = u32_texture(
             ctx,
             "nodes",
-            wgpu::TextureFormat::Rg32Uint,
+            wgpu::TextureFormat::Rgba32Uint,
             NODE_TEXTURE_WIDTH,
-            8,
-            bytemuck::cast_slice(&tables.nodes),
+            16,
+            bytemuck::cast_slice(&node_texels),
         )?;
         let presort = u32_texture(
             ctx,
@@ -409,7 +428,7 @@ impl GpuScene {
             bytemuck::cast_slice(&tables.presort),
         )?;
         let bytes = data.len() as u64
-            + u64::from(nodes.height()) * u64::from(NODE_TEXTURE_WIDTH) * 8
+            + u64::from(nodes.height()) * u64::from(NODE_TEXTURE_WIDTH) * 16
             + u64::from(presort.height()) * u64::from(PRESORT_TEXTURE_WIDTH) * 4
             + (std::mem::size_of_val(tables.instances.as_slice())
                 + std::mem::size_of_val(tables.species.as_slice())

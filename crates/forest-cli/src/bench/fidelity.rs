@@ -71,6 +71,7 @@ fn variants(quick: bool) -> Vec<Variant> {
         options: StreamOptions {
             blend: AspectBlend::Over,
             depth_error: false,
+            trim: false,
         },
         epsilon: EPS,
     };
@@ -98,6 +99,13 @@ fn variants(quick: bool) -> Vec<Variant> {
             "depth-error refine",
             StreamOptions {
                 depth_error: true,
+                ..default
+            },
+        ),
+        runtime(
+            "untrimmed",
+            StreamOptions {
+                trim: false,
                 ..default
             },
         ),

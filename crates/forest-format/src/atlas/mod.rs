@@ -36,7 +36,7 @@ pub const MANIFEST_FILE: &str = "manifest.json";
 pub const ALPHA_FILE: &str = "alpha.png";
 /// Node file name.
 pub const NODES_FILE: &str = "nodes.bin";
-/// Width in texels of the node texture the runtime uploads (`Rg32Uint`, one node per texel).
+/// Width in texels of the node texture the runtime uploads (one node per texel).
 pub const NODE_TEXTURE_WIDTH: u32 = 4096;
 /// The largest mosaic side JPEG allows.
 const MAX_MOSAIC_SIDE: u64 = 65_535;

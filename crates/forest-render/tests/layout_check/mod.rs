@@ -86,9 +86,9 @@ pub fn shared() -> Vec<Expect> {
                 ("layer_base", offset_of!(GpuSpecies, layer_base)),
                 ("node_base", offset_of!(GpuSpecies, node_base)),
                 ("lower_tri_count", offset_of!(GpuSpecies, lower_tri_count)),
-                ("pad0", offset_of!(GpuSpecies, pad)),
-                ("pad1", offset_of!(GpuSpecies, pad) + 4),
-                ("pad2", offset_of!(GpuSpecies, pad) + 8),
+                ("resolution", offset_of!(GpuSpecies, resolution)),
+                ("pad1", offset_of!(GpuSpecies, pad)),
+                ("pad2", offset_of!(GpuSpecies, pad) + 4),
             ],
         ),
         (
