@@ -111,6 +111,10 @@ pub struct MethodArgs {
     /// node's covered box (for comparison; the images agree, the fragments do not).
     #[arg(long)]
     pub untrimmed: bool,
+    /// Quad stream: blend the aspects of every tree, as the paper does, also of trees that
+    /// span less than ε pixels (drawn by default with their nearest aspect alone).
+    #[arg(long)]
+    pub far_blend: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
     /// geometry; `auto`: where the quad stream runs out of levels, i.e. where a tree's finest
     /// quads project longer than ε (at least 1.5 px; it follows each tree's size, the view
@@ -142,6 +146,7 @@ impl MethodArgs {
             blend: AspectBlend::from_name(&self.blend).unwrap_or_default(),
             depth_error: self.depth_error,
             trim: !self.untrimmed,
+            far_nearest: !self.far_blend,
         }
     }
 

@@ -99,6 +99,7 @@ const FLAG_DITHER: u32 = 1u;
 const FLAG_NEAREST: u32 = 2u;
 const FLAG_DEPTH_ERROR: u32 = 4u;
 const FLAG_UNTRIMMED: u32 = 8u;
+const FLAG_FAR_BLEND: u32 = 16u;
 const BLOCK: u32 = 512u;
 const NONE: u32 = 0xffffffffu;
 const NODE_TEX_WIDTH: u32 = 4096u;

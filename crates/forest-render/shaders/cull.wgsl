@@ -91,16 +91,33 @@ fn visible(inst: Instance, sp: Species) -> bool {
     return true;
 }
 
+// Whether a tree of bounding radius `r` (world) centred at `c` spans less than ε pixels
+// across: its level-0 quads, as wide as the tree, are then never refined, and it is drawn
+// with its nearest aspect alone (one quad per slab instead of up to three), unless
+// FLAG_FAR_BLEND. Mirrored by `far_tree` in reference.rs, operation for operation.
+fn far_tree(c: vec3<f32>, r: f32) -> bool {
+    if ((stream_flags(camera) & FLAG_FAR_BLEND) != 0u) { return false; }
+    let m = camera.view_proj;
+    let w = m[0].w * c.x + m[1].w * c.y + m[2].w * c.z + m[3].w;
+    if (w <= 0.0) { return false; }
+    let fy = m[0].y * m[0].y + m[1].y * m[1].y + m[2].y * m[2].y;
+    let half = camera.viewport.y * 0.5;
+    let d = 2.0 * r * half;
+    let e = camera.eye.w * w;
+    return d * d * fy < e * e;
+}
+
 // Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, the
-// remainder given to the largest (first on ties); with FLAG_NEAREST the largest alone.
+// remainder given to the largest (first on ties); with FLAG_NEAREST or `nearest` the largest
+// alone.
 // Quantising first puts every later decision on integers, so a weight a rounding error away
 // from zero cannot make the GPU and the CPU reference (reference::aspect_weights) disagree.
-fn aspect_weights(w: vec3<f32>) -> vec3<u32> {
+fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
     var q = vec3<u32>(unorm12(w.x), unorm12(w.y), unorm12(w.z));
     var big = 0u;
     if (q.y > q[big]) { big = 1u; }
     if (q.z > q[big]) { big = 2u; }
-    if ((stream_flags(camera) & FLAG_NEAREST) != 0u) {
+    if (nearest || (stream_flags(camera) & FLAG_NEAREST) != 0u) {
         var one = vec3<u32>(0u);
         one[big] = WEIGHT_ONE;
         return one;
@@ -126,7 +143,7 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
     }
     let eye_obj = to_object_dir(inst, camera.eye.xyz - centre);
     let bl = blend(sp, eye_obj);
-    let w12 = aspect_weights(bl.w);
+    let w12 = aspect_weights(bl.w, far_tree(centre, sp.sphere.w * inst.scale));
     var n = 0u;
     for (var s = 0u; s < sp.slabs; s++) {
         let slab = sp.slabs - 1u - s;

@@ -169,6 +169,10 @@ pub struct StreamOptions {
     /// filter) instead of its whole square (see `forest_format::trim`). On (the default);
     /// off draws the untrimmed quads, for comparison.
     pub trim: bool,
+    /// Draw a tree that spans less than ε pixels across (its level-0 quads are never refined)
+    /// with its nearest aspect alone: one quad per slab instead of up to three. On (the
+    /// default); off blends every tree's aspects, as the paper does.
+    pub far_nearest: bool,
 }
 
 impl Default for StreamOptions {
@@ -177,6 +181,7 @@ impl Default for StreamOptions {
             blend: AspectBlend::Over,
             depth_error: false,
             trim: true,
+            far_nearest: true,
         }
     }
 }
@@ -189,6 +194,8 @@ pub const FLAG_NEAREST: u32 = 2;
 pub const FLAG_DEPTH_ERROR: u32 = 4;
 /// See [`FLAG_DITHER`].
 pub const FLAG_UNTRIMMED: u32 = 8;
+/// See [`FLAG_DITHER`].
+pub const FLAG_FAR_BLEND: u32 = 16;
 
 impl StreamOptions {
     /// The flag bits written to the camera uniform's `viewport.w`.
@@ -205,6 +212,7 @@ impl StreamOptions {
                 0
             }
             | if self.trim { 0 } else { FLAG_UNTRIMMED }
+            | if self.far_nearest { 0 } else { FLAG_FAR_BLEND }
     }
 }
 

@@ -8,7 +8,7 @@ use forest_format::QuadNode;
 use forest_format::node::ERROR_BOUNDS;
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE};
-use crate::options::{FLAG_DEPTH_ERROR, FLAG_NEAREST};
+use crate::options::{FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_NEAREST};
 use crate::scene::SceneTables;
 
 /// Result of the reference: the final stream and the frame's counters.
@@ -75,6 +75,23 @@ pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
     w
 }
 
+/// Whether a tree spans less than ε pixels across (see `far_tree` in `shaders/cull.wgsl`).
+fn far_tree(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
+    if flags(cam) & FLAG_FAR_BLEND != 0 {
+        return false;
+    }
+    let m = &cam.view_proj;
+    let w = m[0][3] * c.x + m[1][3] * c.y + m[2][3] * c.z + m[3][3];
+    if w <= 0.0 {
+        return false;
+    }
+    let fy = m[0][1] * m[0][1] + m[1][1] * m[1][1] + m[2][1] * m[2][1];
+    let half = cam.viewport[1] * 0.5;
+    let d = 2.0 * r * half;
+    let e = cam.eye[3] * w;
+    d * d * fy < e * e
+}
+
 fn xyz(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
@@ -117,7 +134,8 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let upper = tris(sp.tri_base, sp.tri_count);
     let lower = tris(sp.tri_base + sp.tri_count, sp.lower_tri_count);
     let bl = blend(&dirs, &upper, &lower, eye_obj);
-    let w12 = aspect_weights(bl.weight, flags(cam));
+    let far = far_tree(cam, centre, sp.sphere[3] * inst.scale);
+    let w12 = aspect_weights(bl.weight, flags(cam) | if far { FLAG_NEAREST } else { 0 });
     let mut out = Vec::new();
     for s in 0..sp.slabs {
         let slab = sp.slabs - 1 - s;

@@ -72,6 +72,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             blend: AspectBlend::Over,
             depth_error: false,
             trim: false,
+            far_nearest: false,
         },
         epsilon: EPS,
     };
@@ -106,6 +107,13 @@ fn variants(quick: bool) -> Vec<Variant> {
             "untrimmed",
             StreamOptions {
                 trim: false,
+                ..default
+            },
+        ),
+        runtime(
+            "far trees blended",
+            StreamOptions {
+                far_nearest: false,
                 ..default
             },
         ),
