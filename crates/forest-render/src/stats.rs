@@ -45,6 +45,18 @@ pub struct FrameStats {
     pub work: crate::work::FrameWork,
 }
 
+/// The optional parts of a ring's read-back, for a ring whose sources are a renderer's
+/// counters, then its resolved timestamps (when `times`), then its pipeline statistics (when
+/// `statistics`): `(timestamps, statistics)`.
+pub fn query_parts(
+    parts: &[Vec<u8>],
+    times: bool,
+    statistics: bool,
+) -> (Option<&[u8]>, Option<&[u8]>) {
+    let at = |present: bool, k: usize| present.then(|| parts.get(k)).flatten().map(Vec::as_slice);
+    (at(times, 1), at(statistics, 1 + usize::from(times)))
+}
+
 struct Slot {
     buffer: wgpu::Buffer,
     state: Arc<AtomicU8>,

@@ -771,19 +771,9 @@ impl QuadStream {
     /// (a few frames late; see [`crate::stats::StatsRing`]).
     pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<FrameStats> {
         let parts = self.sized.ring.poll(device, queue)?;
-        // The ring's sources: the state, then the timestamps and the statistics where present.
-        let times = self.queries.is_some().then(|| parts.get(1)).flatten();
-        let statistics = self
-            .statistics
-            .is_some()
-            .then(|| parts.get(1 + usize::from(self.queries.is_some())))
-            .flatten();
-        Some(self.decode(
-            &parts[0],
-            times.map(|t| t.as_slice()),
-            statistics.map(|t| t.as_slice()),
-            queue.get_timestamp_period(),
-        ))
+        let (times, statistics) =
+            crate::stats::query_parts(&parts, self.queries.is_some(), self.statistics.is_some());
+        Some(self.decode(&parts[0], times, statistics, queue.get_timestamp_period()))
     }
 
     /// The final quad stream of the last submitted frame; waits for the GPU.

@@ -641,18 +641,12 @@ impl GeometryRenderer {
     /// arrived): see [`forest_render::stats::StatsRing`].
     pub fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<GeometryStats> {
         let parts = self.ring.poll(device, queue)?;
-        // The ring's sources: the arguments, then timestamps and statistics where present.
-        let times = self.queries.is_some().then(|| parts.get(1)).flatten();
-        let statistics = self
-            .statistics
-            .is_some()
-            .then(|| parts.get(1 + usize::from(self.queries.is_some())))
-            .flatten();
-        Some(self.decode(
-            &parts[0],
-            times.map(|t| t.as_slice()),
-            statistics.map(|t| t.as_slice()),
-        ))
+        let (times, statistics) = forest_render::stats::query_parts(
+            &parts,
+            self.queries.is_some(),
+            self.statistics.is_some(),
+        );
+        Some(self.decode(&parts[0], times, statistics))
     }
 
     fn decode(
