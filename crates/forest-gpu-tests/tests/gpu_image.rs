@@ -27,13 +27,7 @@ fn renders_match_the_stored_references() {
     let ctx = common::ctx();
     let forest = common::forest(300);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-    let opts = RendererOptions {
-        viewport: (160, 120),
-        min_epsilon: 4.0,
-        ..Default::default()
-    };
-    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
-    let target = Target::new(&ctx, 160, 120);
+    let (mut stream, target) = common::small_stream(&ctx, scene, None);
     let mut failures = Vec::new();
     for (name, cam) in common::cameras(forest.extent()) {
         if name == "culled" || name == "under_canopy" {
@@ -154,13 +148,7 @@ fn bc7_colour_renders_like_rgba8() {
     ] {
         let scene = GpuScene::with_format(&ctx, &common::species(), &forest, format).unwrap();
         assert_eq!(scene.bc7, format == forest_render::ColourFormat::Bc7);
-        let opts = RendererOptions {
-            viewport: (160, 120),
-            min_epsilon: 4.0,
-            ..Default::default()
-        };
-        let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
-        let target = Target::new(&ctx, 160, 120);
+        let (mut stream, target) = common::small_stream(&ctx, scene, None);
         stream.render_frame(&ctx, &cam, &target).unwrap();
         images.push(target.read(&ctx));
         assert_eq!(ctx.take_errors(), Vec::<String>::new());

@@ -11,14 +11,7 @@ fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
     let ctx = common::ctx();
     let forest = common::forest(trees);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-    let opts = RendererOptions {
-        viewport: (160, 120),
-        min_epsilon: 4.0,
-        max_quads,
-        ..Default::default()
-    };
-    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
-    let target = Target::new(&ctx, 160, 120);
+    let (mut stream, target) = common::small_stream(&ctx, scene, max_quads);
     let side = forest.extent();
     let mut summary = Vec::new();
     for (name, cam) in common::cameras(side) {
@@ -121,5 +114,38 @@ fn static_impostors_are_the_level0_stream() {
         );
         let _ = target.read(&ctx);
         assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    }
+}
+
+/// Long streams: the block sums of 1M trees (1954 blocks) and of their level-0 quads take the
+/// one-workgroup scan through several chunks of 512 with its carry, and an emitting
+/// workgroup's output crosses block boundaries; the stream still equals the reference.
+#[test]
+fn a_million_trees_stream_equals_the_cpu_reference() {
+    let ctx = common::ctx();
+    let (_, forest) = common::empty_and_million();
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let (mut stream, target) = common::small_stream(&ctx, scene, None);
+    let side = forest.extent();
+    let cam = common::camera(
+        glam::Vec3::new(0.0, side * 0.6, side * 0.4),
+        glam::Vec3::ZERO,
+        4.0,
+    );
+    stream.render_frame(&ctx, &cam, &target).unwrap();
+    let gpu = stream.read_quads(&ctx);
+    let stats = stream.read_stats(&ctx);
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    let cpu = reference::run(&stream.scene.tables, &cam.to_gpu(), stream.capacity.quads);
+    assert_eq!(stats.visible_trees, cpu.visible);
+    assert!(
+        stats.visible_trees > 2 * 512 * 512 / 6,
+        "{} visible trees: too few for several chunks of level-0 block sums",
+        stats.visible_trees
+    );
+    assert_eq!(stats.per_level, cpu.per_level);
+    assert_eq!(gpu.len(), cpu.quads.len(), "stream length");
+    if let Some(i) = gpu.iter().zip(&cpu.quads).position(|(a, b)| a != b) {
+        panic!("quad {i} differs: GPU {:?} CPU {:?}", gpu[i], cpu.quads[i]);
     }
 }

@@ -184,10 +184,10 @@ fn the_stream_counts_its_work() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     let w = &stats.work;
     assert!(stats.quads > 0, "the camera sees trees");
-    // Cull: setup, count, a five-dispatch scan, emit, finish. Refine: per iteration count, the
-    // scan, decide, emit, finish; then the statistics.
+    // Cull: setup, count, top, down, emit. Refine: per iteration top, down, emit; then the
+    // final length.
     let iterations = stream.scene.tables.max_levels - 1;
-    assert_eq!(w.dispatches, 9 + 9 * iterations + 1);
+    assert_eq!(w.dispatches, 5 + 3 * iterations + 1);
     assert_eq!(w.draws, 1, "quads only over a transparent background");
     assert!(w.bytes >= stream.scene.bytes + stream.capacity.bytes());
     let Some(p) = w.passes else {

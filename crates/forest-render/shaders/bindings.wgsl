@@ -20,15 +20,18 @@ struct SceneConsts {
 @group(0) @binding(8) var presort: texture_2d<u32>;
 @group(0) @binding(9) var nodes: texture_2d<u32>;
 @group(0) @binding(10) var<storage, read_write> state: StateAtomic;
+// Per item of the step being run: tree counts then offsets (cull), or each quad's wish then
+// (prefix << 3) | wish (refine); the emitters write the next step's wishes to data_next.
+@group(0) @binding(11) var<storage, read_write> data_next: array<u32>;
 @group(0) @binding(12) var<storage, read_write> data: array<u32>;
-@group(0) @binding(13) var<storage, read_write> sums: array<u32>;
-@group(0) @binding(14) var<storage, read_write> want: array<u32>;
-@group(0) @binding(15) var<storage, read> quads_in: array<Quad>;
-@group(0) @binding(16) var<storage, read_write> quads_out: array<Quad>;
+// One sum per block of BLOCK items (scan.wgsl).
+@group(0) @binding(13) var<storage, read_write> sums: array<atomic<u32>>;
+@group(0) @binding(14) var<storage, read> quads_in: array<Quad>;
+@group(0) @binding(15) var<storage, read_write> quads_out: array<Quad>;
 
 // The indirect arguments are a separate group: a buffer may not be bound for writing in the
-// same dispatch that reads its arguments from it, so only the few one-thread entry points
-// that write them (frame_setup, cull_finish, refine_finish) use a layout with group 1.
+// same dispatch that reads its arguments from it, so only the two directly dispatched entry
+// points that write them (refine_top, refine_finish) use a layout with group 1.
 @group(1) @binding(0) var<storage, read_write> args: Args;
 
 // `State` with atomic members (same layout).
@@ -46,9 +49,7 @@ struct StateAtomic {
 
 fn set_args(n: u32) {
     args.items = vec4<u32>((n + WG - 1u) / WG, 1u, 1u, 0u);
-    args.blocks0 = vec4<u32>((n + BLOCK - 1u) / BLOCK, 1u, 1u, 0u);
-    args.blocks1 = vec4<u32>((n + BLOCK * BLOCK - 1u) / (BLOCK * BLOCK), 1u, 1u, 0u);
-    args.one = vec4<u32>(1u, 1u, 1u, 0u);
+    args.blocks = vec4<u32>((n + BLOCK - 1u) / BLOCK, 1u, 1u, 0u);
     args.draw = vec4<u32>(4u, n, 0u, 0u);
 }
 

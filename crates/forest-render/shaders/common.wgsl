@@ -73,7 +73,7 @@ struct Quad {
 // Frame state written by the GPU, read back for statistics.
 struct State {
     presort: u32,       // chosen presort direction
-    n: u32,             // items of the pass being run (instances, then quads)
+    n: u32,             // quads in the stream being refined (then in the final stream)
     total: u32,         // scan total
     pmin: u32,          // refine: smallest prefix among refined quads (0xffffffff: none)
     overflow_cull: u32, // level-0 quads dropped (farthest trees first)
@@ -86,9 +86,7 @@ struct State {
 // Dispatch arguments (x, y, z) for each kind of dispatch, and the draw arguments.
 struct Args {
     items: vec4<u32>,   // ceil(n / 256) workgroups (w unused)
-    blocks0: vec4<u32>, // ceil(n / 512)
-    blocks1: vec4<u32>, // ceil(n / 512^2)
-    one: vec4<u32>,     // 1
+    blocks: vec4<u32>,  // ceil(n / 512)
     draw: vec4<u32>,    // vertex count 4, instance count n, 0, 0
 }
 

@@ -1,8 +1,9 @@
 // Pass 1, cull: over the instances in the presorted order nearest the view, frustum-test each
 // tree's bounding sphere; for each visible tree find the 1–3 sampling directions around the
 // view direction in the tree's own frame, and emit the level-0 quads of their slabs, back slab
-// first. Compaction keeps the order: cull_count writes per-tree counts, the scan turns them
-// into offsets, cull_emit writes each tree's quads at its offset.
+// first. Compaction keeps the order: cull_count writes per-tree counts and block sums,
+// cull_top scans the block sums, cull_down turns the counts into offsets, cull_emit writes
+// each tree's quads at its offset (scan.wgsl). With frame_setup: five dispatches.
 
 // Blend of the species' directions for an object-space view vector (unnormalised), exactly as
 // forest_format::directions::blend. Returns indices in .idx and weights in .w.
@@ -130,9 +131,9 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
 // Level-0 quads of one tree, in drawing order: slabs back to front; within a slab the present
 // aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
 // weight (present or blank), which the draw pass turns into a dither interval or an "over"
-// alpha (hi − lo) / hi. Writes them from `out` on (skipping indices below `skip`) when `emit`;
-// returns the count.
-fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
+// alpha (hi − lo) / hi. Puts them from `out` on (skipping indices below `skip`) when `emit`
+// (`last`: see put_quad); returns the count.
+fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 {
     let inst = instances[inst_id];
     let sp = species[inst.species];
     let centre = to_world(inst, sp.sphere.xyz);
@@ -157,8 +158,8 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
             let root = roots[layer];
             if (root == NONE) { continue; }
             if (emit && out + n >= skip) {
-                quads_out[out + n - skip] = Quad(inst_id, root,
-                    pack_pos(0u, 0u, 0u, slab), pack_dir(bl.idx[a], lo, acc));
+                put_quad(out + n - skip, Quad(inst_id, root, pack_pos(0u, 0u, 0u, slab),
+                    pack_dir(bl.idx[a], lo, acc)), last);
             }
             n = n + 1u;
         }
@@ -166,8 +167,11 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32) -> u32 {
     return n;
 }
 
-@compute @workgroup_size(1)
-fn frame_setup() {
+// Clears the frame's counters and every block sum, and picks the presort direction.
+@compute @workgroup_size(256)
+fn frame_setup(@builtin(local_invocation_index) t: u32) {
+    for (var i = t; i < arrayLength(&sums); i = i + WG) { atomicStore(&sums[i], 0u); }
+    if (t != 0u) { return; }
     // Presort direction nearest the direction towards the viewer (first on ties).
     let towards = -camera.forward.xyz;
     var best = 0u;
@@ -178,7 +182,7 @@ fn frame_setup() {
         if (c > best_c) { best = k; best_c = c; }
     }
     atomicStore(&state.presort, best);
-    atomicStore(&state.n, scene.instances);
+    atomicStore(&state.n, 0u);
     atomicStore(&state.total, 0u);
     atomicStore(&state.pmin, NONE);
     atomicStore(&state.overflow_cull, 0u);
@@ -186,44 +190,85 @@ fn frame_setup() {
     atomicStore(&state.visible, 0u);
     atomicStore(&state.quads, 0u);
     for (var l = 0u; l < 16u; l++) { atomicStore(&state.per_level[l], 0u); }
-    set_args(scene.instances);
 }
 
-@compute @workgroup_size(256)
-fn cull_count(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= scene.instances) { return; }
+// Level-0 quads of the i-th tree in presorted order (0 past the end or outside the frustum).
+fn tree_count(i: u32) -> u32 {
+    if (i >= scene.instances) { return 0u; }
     let inst_id = instance_in_order(i);
     let inst = instances[inst_id];
-    var n = 0u;
-    if (visible(inst, species[inst.species])) {
-        atomicAdd(&state.visible, 1u);
-        n = tree_quads(inst_id, false, 0u, 0u);
-    }
-    data[i] = n;
+    if (!visible(inst, species[inst.species])) { return 0u; }
+    atomicAdd(&state.visible, 1u);
+    return tree_quads(inst_id, false, 0u, 0u, false);
 }
 
-// When the level-0 quads exceed the capacity, the farthest trees' quads are dropped (the
-// first `total - capacity` of the stream), so the near trees stay.
+// Each tree's quad count, and each block's sum (two trees a thread, a block a workgroup).
 @compute @workgroup_size(256)
-fn cull_emit(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= scene.instances) { return; }
-    let total = atomicLoad(&state.total);
-    var skip = 0u;
-    if (total > scene.capacity) { skip = total - scene.capacity; }
-    let inst_id = instance_in_order(i);
-    let inst = instances[inst_id];
-    if (visible(inst, species[inst.species])) {
-        _ = tree_quads(inst_id, true, data[i], skip);
+fn cull_count(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
+    let i0 = wg.x * BLOCK + 2u * t;
+    let a = tree_count(i0);
+    let c = tree_count(i0 + 1u);
+    if (i0 < scene.instances) { data[i0] = a; }
+    if (i0 + 1u < scene.instances) { data[i0 + 1u] = c; }
+    let excl = wg_exclusive(t, a + c);
+    if (t == WG - 1u) { atomicStore(&sums[wg.x], excl + a + c); }
+}
+
+// The scan of the block sums; the level-0 stream's length. When the level-0 quads exceed the
+// capacity, the farthest trees' quads are dropped (the first `total − capacity` of the
+// stream), so the near trees stay.
+@compute @workgroup_size(256)
+fn cull_top(@builtin(local_invocation_index) t: u32) {
+    let total = scan_block_sums(t, (scene.instances + BLOCK - 1u) / BLOCK);
+    if (t == 0u) {
+        let n = min(total, scene.capacity);
+        atomicStore(&state.overflow_cull, total - n);
+        atomicStore(&state.n, n);
+        atomicStore(&state.total, 0u);
+        atomicStore(&state.pmin, NONE);
     }
 }
 
-@compute @workgroup_size(1)
-fn cull_finish() {
-    let total = atomicLoad(&state.total);
-    let n = min(total, scene.capacity);
-    atomicStore(&state.overflow_cull, total - n);
-    atomicStore(&state.n, n);
-    set_args(n);
+// Each tree's first quad in the stream (before dropping).
+@compute @workgroup_size(256)
+fn cull_down(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
+    let i0 = wg.x * BLOCK + 2u * t;
+    var v = vec2<u32>(0u);
+    if (i0 < scene.instances) { v.x = data[i0]; }
+    if (i0 + 1u < scene.instances) { v.y = data[i0 + 1u]; }
+    let p = block_prefix(wg.x, t, v.x, v.y);
+    if (i0 < scene.instances) { data[i0] = p.x; }
+    if (i0 + 1u < scene.instances) { data[i0 + 1u] = p.y; }
+}
+
+fn cull_emit_body(wg: u32, t: u32, last: bool) {
+    let skip = atomicLoad(&state.overflow_cull);
+    let first = wg * BLOCK;
+    var first_out = 0u;
+    if (first < scene.instances) { first_out = max(data[first], skip) - skip; }
+    emit_begin(t, first_out);
+    for (var k = 0u; k < 2u; k++) {
+        let i = first + 2u * t + k;
+        if (i >= scene.instances) { continue; }
+        let inst_id = instance_in_order(i);
+        let inst = instances[inst_id];
+        if (visible(inst, species[inst.species])) {
+            _ = tree_quads(inst_id, true, data[i], skip, last);
+        }
+    }
+    emit_end(t);
+}
+
+// Each visible tree's quads at its offset (two trees a thread); each with its refinement
+// wish for the first refine step.
+@compute @workgroup_size(256)
+fn cull_emit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
+    cull_emit_body(wg.x, t, false);
+}
+
+// Without refinement: each visible tree's quads, their levels counted.
+@compute @workgroup_size(256)
+fn cull_emit_last(@builtin(workgroup_id) wg: vec3<u32>,
+                  @builtin(local_invocation_index) t: u32) {
+    cull_emit_body(wg.x, t, true);
 }

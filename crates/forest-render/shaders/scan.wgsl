@@ -1,16 +1,17 @@
-// Order-preserving exclusive prefix sum of data[0..n], n = state.n, in three levels of blocks
-// of 512 (so n < 512^3): reduce0 (block sums of data -> sums[0..b1]), reduce1 (block sums of
-// those -> sums[S2..]), top (one workgroup scans the top level and writes state.total),
-// down1, down0 (each block scans itself and adds its block's offset). Deterministic: the
-// same n values give the same sums on any GPU, and the CPU reference computes the same.
-
+// Order-preserving exclusive prefix sum in two levels, its phases fused into the passes'
+// own dispatches (see cull.wgsl and refine.wgsl):
+//   1. the producer of the values also gives each block of BLOCK = 512 values its sum in
+//      `sums` (cull_count writes it; the emitters add each value with `add_to_block`);
+//   2. one workgroup scans the block sums in place (`scan_block_sums`), serially in chunks
+//      of 512 with a running carry, so any number of blocks fits;
+//   3. each block scans its own values and adds its block's offset (`block_prefix`), and
+//      clears its block sum for the next scan.
+// Integer sums in a fixed order: the same values give the same prefixes on any GPU, and the
+// CPU reference (reference.rs) computes the same. Between scans every block sum is zero
+// (frame_setup clears them all; each block clears its own after reading it).
 
 var<workgroup> wg_sum: array<u32, 256>;
-
-fn level1_count() -> u32 { return (atomicLoad(&state.n) + BLOCK - 1u) / BLOCK; }
-fn level2_count() -> u32 { return (level1_count() + BLOCK - 1u) / BLOCK; }
-// Level-2 sums start after the level-1 sums' capacity, kept in the last element's place.
-fn l2_base() -> u32 { return arrayLength(&sums) - 512u; }
+var<workgroup> wg_uniform: u32;
 
 // Inclusive scan of one value per thread across the workgroup; returns the exclusive prefix
 // and leaves the workgroup total in wg_sum[255].
@@ -27,75 +28,57 @@ fn wg_exclusive(t: u32, v: u32) -> u32 {
     return wg_sum[t] - v;
 }
 
-fn load_level(level: u32, i: u32, n: u32) -> u32 {
-    if (i >= n) { return 0u; }
-    if (level == 0u) { return data[i]; }
-    if (level == 1u) { return sums[i]; }
-    return sums[l2_base() + i];
+// A value thread 0 knows, made uniform across the workgroup (the loops below depend on it).
+fn share(t: u32, v: u32) -> u32 {
+    if (t == 0u) { wg_uniform = v; }
+    return workgroupUniformLoad(&wg_uniform);
 }
 
-fn store_level(level: u32, i: u32, n: u32, v: u32) {
-    if (i >= n) { return; }
-    if (level == 0u) { data[i] = v; } else if (level == 1u) { sums[i] = v; } else { sums[l2_base() + i] = v; }
-}
-
-fn count_of(level: u32) -> u32 {
-    if (level == 0u) { return atomicLoad(&state.n); }
-    if (level == 1u) { return level1_count(); }
-    return level2_count();
-}
-
-// Sum of block `b` of `level` into the next level.
-fn reduce(level: u32, b: u32, t: u32) {
-    let n = count_of(level);
-    let a = load_level(level, b * BLOCK + 2u * t, n);
-    let c = load_level(level, b * BLOCK + 2u * t + 1u, n);
-    let excl = wg_exclusive(t, a + c);
-    if (t == WG - 1u) {
-        store_level(level + 1u, b, count_of(level + 1u), excl + a + c);
+// Exclusive scan of sums[0..blocks) in place by one workgroup; returns the total.
+fn scan_block_sums(t: u32, blocks_of_thread0: u32) -> u32 {
+    let blocks = share(t, blocks_of_thread0);
+    var carry = 0u;
+    for (var c = 0u; c < blocks; c = c + BLOCK) {
+        let i0 = c + 2u * t;
+        var a = 0u;
+        var b = 0u;
+        if (i0 < blocks) { a = atomicLoad(&sums[i0]); }
+        if (i0 + 1u < blocks) { b = atomicLoad(&sums[i0 + 1u]); }
+        let excl = wg_exclusive(t, a + b);
+        let chunk = wg_sum[WG - 1u];
+        if (i0 < blocks) { atomicStore(&sums[i0], carry + excl); }
+        if (i0 + 1u < blocks) { atomicStore(&sums[i0 + 1u], carry + excl + a); }
+        carry = carry + chunk;
+        workgroupBarrier();
     }
+    return carry;
 }
 
-// Exclusive scan of block `b` of `level`, plus `base`.
-fn down(level: u32, b: u32, t: u32, base: u32) -> u32 {
-    let n = count_of(level);
-    let i0 = b * BLOCK + 2u * t;
-    let a = load_level(level, i0, n);
-    let c = load_level(level, i0 + 1u, n);
-    let excl = wg_exclusive(t, a + c);
-    store_level(level, i0, n, base + excl);
-    store_level(level, i0 + 1u, n, base + excl + a);
-    return excl + a + c;
+// Exclusive prefixes of a block's values, thread t holding values 2t and 2t + 1: the block's
+// offset (scanned by scan_block_sums) plus the sum of the values before. Clears the block's
+// sum for the next scan.
+fn block_prefix(b: u32, t: u32, v0: u32, v1: u32) -> vec2<u32> {
+    let base = atomicLoad(&sums[b]);
+    let excl = wg_exclusive(t, v0 + v1);
+    storageBarrier();
+    if (t == 0u) { atomicStore(&sums[b], 0u); }
+    return vec2<u32>(base + excl, base + excl + v0);
 }
 
-@compute @workgroup_size(256)
-fn scan_reduce0(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
-    reduce(0u, wg.x, t);
-}
+// Per-workgroup bins of block sums: an emitting workgroup writes a contiguous run of the
+// output, which spans a few blocks from `first_block` on; values go to the bins and one
+// atomic per bin reaches `sums` (a value beyond the bins goes there directly).
+const BINS: u32 = 16u;
+var<workgroup> wg_bins: array<atomic<u32>, 16>;
+var<workgroup> wg_first_block: u32;
 
-@compute @workgroup_size(256)
-fn scan_reduce1(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
-    reduce(1u, wg.x, t);
-}
-
-@compute @workgroup_size(256)
-fn scan_top(@builtin(local_invocation_index) t: u32) {
-    let total = down(2u, 0u, t, 0u);
-    if (t == WG - 1u) {
-        atomicStore(&state.total, total);
+fn add_to_block(out: u32, v: u32) {
+    if (v == 0u) { return; }
+    let b = out / BLOCK;
+    let k = b - wg_first_block;
+    if (b >= wg_first_block && k < BINS) {
+        atomicAdd(&wg_bins[k], v);
+    } else {
+        atomicAdd(&sums[b], v);
     }
-}
-
-@compute @workgroup_size(256)
-fn scan_down1(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
-    let base = load_level(2u, wg.x, level2_count());
-    workgroupBarrier();
-    _ = down(1u, wg.x, t, base);
-}
-
-@compute @workgroup_size(256)
-fn scan_down0(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
-    let base = load_level(1u, wg.x, level1_count());
-    workgroupBarrier();
-    _ = down(0u, wg.x, t, base);
 }

@@ -8,8 +8,9 @@ use crate::gpu_types::{GpuArgs, GpuState, Quad};
 pub const WG: u32 = 256;
 /// Scan block (two items per thread).
 pub const BLOCK: u32 = 512;
-/// Most items one scan handles (three levels of blocks).
-pub const MAX_SCAN: u64 = (BLOCK as u64).pow(3);
+/// Most quads a stream holds: per-quad dispatches run one workgroup per [`WG`] quads, at
+/// most 65 535 workgroups (the limit every device has).
+pub const MAX_QUADS: u64 = WG as u64 * 65_535;
 
 /// What the buffer sizes are computed from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,9 +34,10 @@ pub struct CapacityInput {
 pub struct Capacity {
     /// Quads each of the two stream buffers holds: `Q`.
     pub quads: u32,
-    /// Elements of the scan/count and flag buffers: `max(N, Q)`.
+    /// Elements of the first scan-data buffer (tree counts, then quads): `max(N, Q)`; the
+    /// second holds `Q`.
     pub items: u32,
-    /// Elements of the scan's block-sum buffer: `ceil(items/512) + 512`.
+    /// Elements of the scan's block-sum buffer: `ceil(items/512)`.
     pub sums: u32,
 }
 
@@ -53,13 +55,13 @@ impl Capacity {
             let half = f64::from(c.min_epsilon.max(1.0)) / 2.0;
             let refine = f64::from(c.overdraw) * f64::from(c.viewport.0) * f64::from(c.viewport.1)
                 / (half * half);
-            (level0 + refine as u64).clamp(1, MAX_SCAN.min(WG as u64 * 65_535)) as u32
+            (level0 + refine as u64).clamp(1, MAX_QUADS) as u32
         });
         let items = quads.max(c.instances).max(1);
         Self {
             quads,
             items,
-            sums: items.div_ceil(BLOCK) + BLOCK,
+            sums: items.div_ceil(BLOCK),
         }
     }
 
@@ -67,7 +69,8 @@ impl Capacity {
     pub fn bytes(&self) -> u64 {
         let quad = std::mem::size_of::<Quad>() as u64;
         2 * u64::from(self.quads) * quad
-            + 2 * u64::from(self.items) * 4
+            + u64::from(self.items) * 4
+            + u64::from(self.quads) * 4
             + u64::from(self.sums) * 4
             + (std::mem::size_of::<GpuState>() + std::mem::size_of::<GpuArgs>()) as u64
     }
@@ -117,7 +120,7 @@ mod tests {
         });
         assert_eq!(c.quads, 600_000 + 480_000);
         assert_eq!(c.items, 1_080_000);
-        assert_eq!(c.sums, 1_080_000u32.div_ceil(512) + 512);
+        assert_eq!(c.sums, 1_080_000u32.div_ceil(512));
         let fixed = Capacity::new(&CapacityInput {
             max_quads: Some(10),
             instances: 3,

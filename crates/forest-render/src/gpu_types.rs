@@ -152,7 +152,7 @@ impl Quad {
 pub struct GpuState {
     /// Chosen presort direction.
     pub presort: u32,
-    /// Items of the pass being run; after the frame, quads in the final stream.
+    /// Quads in the stream being refined; after the frame, in the final stream.
     pub n: u32,
     /// Last scan total.
     pub total: u32,
@@ -174,14 +174,10 @@ pub struct GpuState {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct GpuArgs {
-    /// Per-item dispatches.
+    /// Per-item dispatches: one workgroup per 256 quads.
     pub items: [u32; 4],
-    /// Scan level-0 blocks.
-    pub blocks0: [u32; 4],
-    /// Scan level-1 blocks.
-    pub blocks1: [u32; 4],
-    /// One workgroup.
-    pub one: [u32; 4],
+    /// Per-block dispatches: one workgroup per 512 quads.
+    pub blocks: [u32; 4],
     /// Draw: vertex count, instance count, first vertex, first instance.
     pub draw: [u32; 4],
 }

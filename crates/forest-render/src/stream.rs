@@ -24,7 +24,6 @@ use crate::passes::ComputeShared;
 use crate::passes::cull::CullPass;
 use crate::passes::draw::DrawPass;
 use crate::passes::refine::RefinePass;
-use crate::passes::scan::ScanPass;
 use crate::scene::GpuScene;
 use crate::stats::{FrameStats, PassTimes, StatsRing};
 use crate::work::{CountingPass, FrameWork, StatisticsQueries};
@@ -36,7 +35,6 @@ const TIMESTAMP_BYTES: u64 = 48;
 struct Passes {
     shared: ComputeShared,
     cull: CullPass,
-    scan: ScanPass,
     refine: RefinePass,
     draw: DrawPass,
 }
@@ -151,7 +149,6 @@ impl QuadStream {
         let shared = ComputeShared::new(device);
         let passes = Passes {
             cull: CullPass::new(device, &shared),
-            scan: ScanPass::new(device, &shared),
             refine: RefinePass::new(device, &shared),
             draw: DrawPass::new(device, opts),
             shared,
@@ -266,7 +263,6 @@ impl QuadStream {
             std::mem::size_of::<GpuArgs>() as u64,
             U::STORAGE | U::INDIRECT,
         );
-        let spare = buffer(device, "spare", 16, U::STORAGE);
         let args_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("indirect arguments"),
             layout: &passes.shared.args_layout,
@@ -275,13 +271,22 @@ impl QuadStream {
                 resource: args.as_entire_binding(),
             }],
         });
-        let data = buffer(
-            device,
-            "scan data",
-            u64::from(capacity.items) * 4,
-            U::STORAGE,
-        );
-        let want = buffer(device, "want", u64::from(capacity.items) * 4, U::STORAGE);
+        // Scan data of the current step and the next one: `data[0]` holds the cull's tree
+        // counts (instances) and the wishes of every other step, `data[1]` the others'.
+        let data = [
+            buffer(
+                device,
+                "scan data A",
+                u64::from(capacity.items) * 4,
+                U::STORAGE,
+            ),
+            buffer(
+                device,
+                "scan data B",
+                u64::from(capacity.quads) * 4,
+                U::STORAGE,
+            ),
+        ];
         let sums = buffer(
             device,
             "block sums",
@@ -298,8 +303,8 @@ impl QuadStream {
         });
         let presort_view = scene.presort.create_view(&Default::default());
         let nodes_view = scene.nodes.create_view(&Default::default());
-        let compute_bg = |label: &str, q_in: &wgpu::Buffer, q_out: &wgpu::Buffer| {
-            let res: [wgpu::BindingResource; 17] = [
+        let compute_bg = |label: &str, (d_in, d_out): (usize, usize), q: (usize, usize)| {
+            let res: [wgpu::BindingResource; 16] = [
                 camera.as_entire_binding(),
                 consts.as_entire_binding(),
                 scene.instances.as_entire_binding(),
@@ -311,12 +316,11 @@ impl QuadStream {
                 wgpu::BindingResource::TextureView(&presort_view),
                 wgpu::BindingResource::TextureView(&nodes_view),
                 state.as_entire_binding(),
-                spare.as_entire_binding(),
-                data.as_entire_binding(),
+                data[d_out].as_entire_binding(),
+                data[d_in].as_entire_binding(),
                 sums.as_entire_binding(),
-                want.as_entire_binding(),
-                q_in.as_entire_binding(),
-                q_out.as_entire_binding(),
+                quads[q.0].as_entire_binding(),
+                quads[q.1].as_entire_binding(),
             ];
             let entries = crate::passes::numbered(res.into());
             device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -325,9 +329,11 @@ impl QuadStream {
                 entries: &entries,
             })
         };
-        let bg_cull = compute_bg("cull", &quads[1], &quads[0]);
-        let bg_ab = compute_bg("refine A->B", &quads[0], &quads[1]);
-        let bg_ba = compute_bg("refine B->A", &quads[1], &quads[0]);
+        // (data in, data out), (quads in, quads out): the cull reads tree counts from data A
+        // and writes stream A with its wishes in data B; the steps then alternate.
+        let bg_cull = compute_bg("cull", (0, 1), (1, 0));
+        let bg_ab = compute_bg("refine A->B", (1, 0), (0, 1));
+        let bg_ba = compute_bg("refine B->A", (0, 1), (1, 0));
         let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -362,8 +368,7 @@ impl QuadStream {
         sources.extend(readback.iter().map(|(b, n)| ((*b).clone(), *n)));
         let ring = StatsRing::new(device, sources);
         let view_bytes = [
-            camera, &consts, ground, &state, &args, &spare, &data, &want, &sums, &quads[0],
-            &quads[1],
+            camera, &consts, ground, &state, &args, &data[0], &data[1], &sums, &quads[0], &quads[1],
         ]
         .iter()
         .map(|b| b.size())
@@ -374,9 +379,8 @@ impl QuadStream {
             ("ground", ground),
             ("state", &state),
             ("args", &args),
-            ("spare", &spare),
-            ("scan data", &data),
-            ("want", &want),
+            ("scan data A", &data[0]),
+            ("scan data B", &data[1]),
             ("block sums", &sums),
             ("stream A", &quads[0]),
             ("stream B", &quads[1]),
@@ -525,6 +529,7 @@ impl QuadStream {
     fn bindings(&self) -> crate::passes::StreamBindings<'_> {
         crate::passes::StreamBindings {
             cull: &self.sized.bg_cull,
+            instances: self.scene.tables.instances.len() as u32,
             ping: &self.sized.bg_ab,
             pong: &self.sized.bg_ba,
             args_group: &self.sized.args_group,
@@ -635,7 +640,8 @@ impl QuadStream {
                 pass.begin_pipeline_statistics_query(set, crate::work::CULL);
             }
             let mut counted = CountingPass::new(&mut pass);
-            p.cull.record(&mut counted, &self.bindings(), &p.scan);
+            p.cull
+                .record(&mut counted, &self.bindings(), self.iterations == 0);
             dispatches += counted.dispatches;
             if stats.is_some() {
                 pass.end_pipeline_statistics_query();
@@ -651,7 +657,7 @@ impl QuadStream {
             }
             let mut counted = CountingPass::new(&mut pass);
             p.refine
-                .record(&mut counted, self.iterations, &self.bindings(), &p.scan);
+                .record(&mut counted, self.iterations, &self.bindings());
             dispatches += counted.dispatches;
             if stats.is_some() {
                 pass.end_pipeline_statistics_query();

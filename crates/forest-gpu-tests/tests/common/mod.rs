@@ -171,3 +171,20 @@ pub fn prepared() -> &'static forest_baselines::geometry::PreparedGeometry {
         forest_baselines::geometry::PreparedGeometry::new(&species)
     })
 }
+
+/// The tests' small view: a quad stream over `scene` for a 160×120 target refined down to
+/// ε = 4, with `max_quads` overriding the capacity formula, and the target.
+pub fn small_stream(
+    ctx: &GpuContext,
+    scene: forest_render::GpuScene,
+    max_quads: Option<u32>,
+) -> (forest_render::QuadStream, forest_render::target::Target) {
+    let opts = forest_render::options::RendererOptions {
+        viewport: (160, 120),
+        min_epsilon: 4.0,
+        max_quads,
+        ..Default::default()
+    };
+    let stream = forest_render::QuadStream::new(&ctx.device, scene, &opts).unwrap();
+    (stream, forest_render::target::Target::new(ctx, 160, 120))
+}

@@ -1,13 +1,14 @@
 //! The GPU passes, one struct each, and the layout they share.
 //!
 //! All compute entry points live in one WGSL module (common + bindings + scan + cull +
-//! refine) and share one bind-group layout, so the ping-pong stream buffers are swapped by
-//! swapping bind groups. The draw pass has its own module (common + draw).
+//! refine) and share one bind-group layout, so the ping-pong stream and scan buffers are
+//! swapped by swapping bind groups. The order-preserving prefix sums (`shaders/scan.wgsl`)
+//! have no dispatches of their own: their phases are fused into the passes' dispatches. The
+//! draw pass has its own module (common + draw).
 
 pub mod cull;
 pub mod draw;
 pub mod refine;
-pub mod scan;
 
 /// The WGSL every module starts with: the camera, the scene's structs, the shared helpers
 /// (other crates' shaders that read the camera, such as the baselines', start with it too).
@@ -55,9 +56,9 @@ pub enum Slot {
     UintTexture,
 }
 
-/// The compute layout's group 0: 17 bindings (see `shaders/bindings.wgsl`); binding 11 is
-/// unused (the arguments are group 1, bound only for the entry points that write them).
-pub const COMPUTE_SLOTS: [Slot; 17] = [
+/// The compute layout's group 0: 16 bindings (see `shaders/bindings.wgsl`); the arguments are
+/// group 1, bound only for the entry points that write them.
+pub const COMPUTE_SLOTS: [Slot; 16] = [
     Slot::Uniform,     // 0 camera
     Slot::Uniform,     // 1 scene constants
     Slot::Read,        // 2 instances
@@ -69,12 +70,11 @@ pub const COMPUTE_SLOTS: [Slot; 17] = [
     Slot::UintTexture, // 8 presort
     Slot::UintTexture, // 9 nodes
     Slot::ReadWrite,   // 10 state
-    Slot::Read,        // 11 unused (a spare read-only slot)
-    Slot::ReadWrite,   // 12 data (scan)
+    Slot::ReadWrite,   // 11 data of the next step (the emitters' wishes)
+    Slot::ReadWrite,   // 12 data (counts, wishes, prefixes)
     Slot::ReadWrite,   // 13 block sums
-    Slot::ReadWrite,   // 14 want flags
-    Slot::Read,        // 15 quads in
-    Slot::ReadWrite,   // 16 quads out
+    Slot::Read,        // 14 quads in
+    Slot::ReadWrite,   // 15 quads out
 ];
 
 /// Bind-group entries numbered 0, 1, 2, … in the order given.
@@ -203,6 +203,8 @@ impl ComputeShared {
 pub struct StreamBindings<'a> {
     /// Cull: writes stream A.
     pub cull: &'a wgpu::BindGroup,
+    /// Tree instances in the scene (the cull's dispatches are sized by them).
+    pub instances: u32,
     /// Refine A → B.
     pub ping: &'a wgpu::BindGroup,
     /// Refine B → A.
@@ -218,11 +220,7 @@ pub mod args {
     /// `ceil(n/256)` workgroups.
     pub const ITEMS: u64 = 0;
     /// `ceil(n/512)`.
-    pub const BLOCKS0: u64 = 16;
-    /// `ceil(n/512²)`.
-    pub const BLOCKS1: u64 = 32;
-    /// One workgroup.
-    pub const ONE: u64 = 48;
+    pub const BLOCKS: u64 = 16;
     /// Draw arguments.
-    pub const DRAW: u64 = 64;
+    pub const DRAW: u64 = 32;
 }

@@ -1,66 +1,52 @@
 //! Pass 2, refine (`shaders/refine.wgsl`): `l − 1` order-preserving subdivision steps
-//! between the two stream buffers, then per-level statistics of the final stream.
+//! between the two stream buffers, three dispatches each, then the final stream's length.
 
-use super::scan::ScanPass;
 use super::{ComputeShared, StreamBindings, args};
 use crate::work::CountingPass;
 
 /// The refine pass's pipelines.
 pub struct RefinePass {
-    count: wgpu::ComputePipeline,
-    decide: wgpu::ComputePipeline,
+    top: wgpu::ComputePipeline,
+    down: wgpu::ComputePipeline,
     emit: wgpu::ComputePipeline,
+    emit_last: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
-    stats: wgpu::ComputePipeline,
 }
 
 impl RefinePass {
     /// Create the pipelines.
     pub fn new(device: &wgpu::Device, shared: &ComputeShared) -> Self {
         Self {
-            count: shared.pipeline(device, "refine_count"),
-            decide: shared.pipeline(device, "refine_decide"),
+            top: shared.writer(device, "refine_top"),
+            down: shared.pipeline(device, "refine_down"),
             emit: shared.pipeline(device, "refine_emit"),
+            emit_last: shared.pipeline(device, "refine_emit_last"),
             finish: shared.writer(device, "refine_finish"),
-            stats: shared.pipeline(device, "stats"),
         }
     }
 
-    /// Record `iterations` steps alternating `ping` (A → B) and `pong` (B → A), then the
-    /// statistics over the final buffer through `final_in` (a bind group reading it).
-    pub fn record(
-        &self,
-        pass: &mut CountingPass,
-        iterations: u32,
-        b: &StreamBindings,
-        scan: &ScanPass,
-    ) {
-        let (ping, pong, args_buf) = (b.ping, b.pong, b.args_buf);
+    /// Record `iterations` steps alternating `ping` (A → B) and `pong` (B → A), each a
+    /// one-workgroup top (stream length, arguments, block-sum scan), a per-block down
+    /// (prefixes, which quads refine) and a per-quad emit, then the final length and the
+    /// draw arguments: `3 · iterations + 1` dispatches.
+    pub fn record(&self, pass: &mut CountingPass, iterations: u32, b: &StreamBindings) {
         pass.pass.set_bind_group(1, b.args_group, &[]);
         for it in 0..iterations {
-            pass.pass
-                .set_bind_group(0, if it.is_multiple_of(2) { ping } else { pong }, &[]);
-            pass.pass.set_pipeline(&self.count);
-            pass.dispatch_indirect(args_buf, args::ITEMS);
-            scan.record(pass, args_buf);
-            for p in [&self.decide, &self.emit] {
-                pass.pass.set_pipeline(p);
-                pass.dispatch_indirect(args_buf, args::ITEMS);
-            }
-            pass.pass.set_pipeline(&self.finish);
+            let group = if it.is_multiple_of(2) { b.ping } else { b.pong };
+            pass.pass.set_bind_group(0, group, &[]);
+            pass.pass.set_pipeline(&self.top);
             pass.dispatch(1, 1, 1);
-        }
-        // The final stream is A after an even number of steps (read it through `ping`).
-        pass.pass.set_bind_group(
-            0,
-            if iterations.is_multiple_of(2) {
-                ping
+            pass.pass.set_pipeline(&self.down);
+            pass.dispatch_indirect(b.args_buf, args::BLOCKS);
+            pass.pass.set_pipeline(if it + 1 == iterations {
+                &self.emit_last
             } else {
-                pong
-            },
-            &[],
-        );
-        pass.pass.set_pipeline(&self.stats);
-        pass.dispatch_indirect(args_buf, args::ITEMS);
+                &self.emit
+            });
+            pass.dispatch_indirect(b.args_buf, args::ITEMS);
+        }
+        pass.pass.set_bind_group(0, b.ping, &[]);
+        pass.pass.set_pipeline(&self.finish);
+        pass.dispatch(1, 1, 1);
     }
 }

@@ -116,9 +116,7 @@ pub fn shared() -> Vec<Expect> {
             size_of::<GpuArgs>(),
             vec![
                 ("items", offset_of!(GpuArgs, items)),
-                ("blocks0", offset_of!(GpuArgs, blocks0)),
-                ("blocks1", offset_of!(GpuArgs, blocks1)),
-                ("one", offset_of!(GpuArgs, one)),
+                ("blocks", offset_of!(GpuArgs, blocks)),
                 ("draw", offset_of!(GpuArgs, draw)),
             ],
         ),
