@@ -64,6 +64,9 @@ pub struct MethodStats {
     pub times: Option<PassTimes>,
     /// The work the frame asked of the GPU (both forms' for the hybrid).
     pub work: forest_render::work::FrameWork,
+    /// The quad stream's own counters (default when the method draws no quads), for
+    /// [`ForestRenderer::fit`].
+    pub stream: FrameStats,
 }
 
 /// The quad stream and, when models were given, the geometry renderer of one forest.
@@ -229,6 +232,29 @@ impl ForestRenderer {
         Ok(())
     }
 
+    /// [`Self::render_frame`], drawn again while the frame overflows the quad stream and
+    /// [`Self::fit`] can grow it; the last frame's counters (waits for the GPU).
+    pub fn render_fitted(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        target: &Target,
+    ) -> Result<MethodStats, RenderError> {
+        loop {
+            self.render_frame(ctx, camera, target)?;
+            let stats = self.read_stats(ctx);
+            if !self.fit(&ctx.device, &stats)? {
+                return Ok(stats);
+            }
+        }
+    }
+
+    /// Grow the quad stream after a frame that overflowed it (see [`QuadStream::fit`]).
+    /// Returns whether its buffers were rebuilt.
+    pub fn fit(&mut self, device: &wgpu::Device, stats: &MethodStats) -> Result<bool, RenderError> {
+        self.stream.fit(device, &stats.stream)
+    }
+
     /// Counters and pass times of the last submitted frame; waits for the GPU.
     pub fn read_stats(&self, ctx: &GpuContext) -> MethodStats {
         self.combine(
@@ -275,7 +301,7 @@ impl ForestRenderer {
                     primitives: u64::from(q.quads) + s.triangles,
                     billboards: s.billboards,
                     geometry_trees: s.visible_trees,
-                    per_level: q.per_level,
+                    per_level: q.per_level.clone(),
                     overflow: q.overflow_cull + q.overflow_refine,
                     times: q.times.zip(s.times).map(|(q, s)| PassTimes {
                         cull_ms: q.cull_ms + s.cull_ms,
@@ -283,6 +309,7 @@ impl ForestRenderer {
                         draw_ms: q.draw_ms,
                     }),
                     work: q.work.combined(&s.work),
+                    stream: q.clone(),
                 }
             }
             (Method::Mesh(_), Some(g)) => {
@@ -296,6 +323,7 @@ impl ForestRenderer {
                     overflow: 0,
                     times: s.times,
                     work: s.work,
+                    stream: FrameStats::default(),
                 }
             }
             _ => {
@@ -305,10 +333,11 @@ impl ForestRenderer {
                     primitives: u64::from(s.quads),
                     billboards: 0,
                     geometry_trees: 0,
-                    per_level: s.per_level,
+                    per_level: s.per_level.clone(),
                     overflow: s.overflow_cull + s.overflow_refine,
                     times: s.times,
-                    work: s.work,
+                    work: s.work.clone(),
+                    stream: s,
                 }
             }
         }

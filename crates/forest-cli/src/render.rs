@@ -350,13 +350,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let (sw, sh) = stream_viewport(args);
     let mut stream = stream_for(args, &ctx, &species, &forest)?;
     stream.set_options(args.m.stream_options());
+    stream.set_pipeline_statistics(args.json);
     let target = Target::new(&ctx, sw, sh);
     for (name, cam) in &cameras {
         let mut cam = *cam;
         cam.viewport = (sw, sh);
         let cam = &cam;
-        stream.render_frame(&ctx, cam, &target)?;
-        let stats = stream.read_stats(&ctx);
+        let stats = stream.render_fitted(&ctx, cam, &target)?;
         let out = finish_view(&ctx, &target, args, name, cameras.len())?;
         let t = stats.times.unwrap_or_default();
         if args.json {
@@ -368,7 +368,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     "visible_trees": stats.visible_trees, "quads": stats.quads,
                     "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
                     "overflow_refine": stats.overflow_refine,
+                    "capacity_quads": stream.capacity.quads,
+                    "stream_bytes": stream.capacity.bytes(),
                     "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+                    "work": work_json(&stats.work),
                 })
             );
         } else {
@@ -388,6 +391,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A frame's work for `--json`: dispatches, draws and bytes as recorded; the pipeline
+/// statistics summed over the passes where the device counts them (null otherwise).
+fn work_json(w: &forest_render::work::FrameWork) -> serde_json::Value {
+    let total = w.total();
+    serde_json::json!({
+        "dispatches": w.dispatches, "draws": w.draws, "bytes": w.bytes,
+        "vertex_invocations": total.map(|p| p.vertex_invocations),
+        "primitives_rasterised": total.map(|p| p.primitives),
+        "fragment_invocations": total.map(|p| p.fragment_invocations),
+        "compute_invocations": total.map(|p| p.compute_invocations),
+    })
 }
 
 /// The viewport rendered (the image size times the supersampling).
@@ -432,13 +448,13 @@ fn render_hybrid(
     let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
+    r.set_pipeline_statistics(args.json);
     let (sw, sh) = stream_viewport(args);
     let target = Target::new(ctx, sw, sh);
     for (name, cam) in cameras {
         let mut cam = *cam;
         cam.viewport = (sw, sh);
-        r.render_frame(ctx, &cam, &target)?;
-        let stats = r.read_stats(ctx);
+        let stats = r.render_fitted(ctx, &cam, &target)?;
         let out = finish_view(ctx, &target, args, name, cameras.len())?;
         let t = stats.times.unwrap_or_default();
         let quads: u32 = stats.per_level.iter().sum();
@@ -453,6 +469,7 @@ fn render_hybrid(
                     "triangles": stats.primitives - u64::from(quads),
                     "overflow": stats.overflow,
                     "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+                    "work": work_json(&stats.work),
                 })
             );
         } else {

@@ -197,9 +197,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             viewport: args.size,
             epsilon: args.epsilon,
         };
-        r.render_frame(&ctx, &cam, &target)
+        let stats = r
+            .render_fitted(&ctx, &cam, &target)
             .with_context(|| format!("{}: key {i}", path_file.display()))?;
-        let stats = r.read_stats(&ctx);
         ctx.check_errors()?;
         let t = stats.times.unwrap_or_default();
         total_ms += t.cull_ms + t.refine_ms + t.draw_ms;

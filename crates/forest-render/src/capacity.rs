@@ -42,19 +42,22 @@ pub struct Capacity {
 }
 
 impl Capacity {
-    /// `Q = min(N · quads_per_tree, 2^23) + overdraw · W · H / (ε_min / 2)²`, unless given.
+    /// `Q = min(N · quads_per_tree, W · H / 4) + overdraw · W · H / (ε_min / 2)²`, at most
+    /// [`MAX_QUADS`], unless given.
     ///
-    /// The first term holds the level-0 quads of every tree at once (a bird's-eye view of the
-    /// whole forest), the second the quads refinement adds: each refined quad is at least
-    /// `ε/2` pixels on a side, so a screen covered `overdraw` times holds at most that many.
-    /// When a frame needs more, the overflow policy applies (farthest trees and quads first)
-    /// and counters report it; nothing is written out of bounds.
+    /// The second term holds the quads refinement adds: each refined quad is at least `ε/2`
+    /// pixels on a side, so a screen covered `overdraw` times holds at most that many. The
+    /// first holds the level-0 quads of the visible trees, which no screen bound limits (a
+    /// bird's-eye view sees every tree): it is an estimate, and a stream whose frames
+    /// overflow it grows to what they need ([`crate::QuadStream::fit`]). When a frame needs
+    /// more than the stream holds, the overflow policy applies (farthest trees and quads
+    /// first) and counters report it; nothing is written out of bounds.
     pub fn new(c: &CapacityInput) -> Self {
         let quads = c.max_quads.unwrap_or_else(|| {
-            let level0 = (u64::from(c.instances) * u64::from(c.quads_per_tree)).min(1 << 23);
+            let pixels = u64::from(c.viewport.0) * u64::from(c.viewport.1);
+            let level0 = (u64::from(c.instances) * u64::from(c.quads_per_tree)).min(pixels / 4);
             let half = f64::from(c.min_epsilon.max(1.0)) / 2.0;
-            let refine = f64::from(c.overdraw) * f64::from(c.viewport.0) * f64::from(c.viewport.1)
-                / (half * half);
+            let refine = f64::from(c.overdraw) * pixels as f64 / (half * half);
             (level0 + refine as u64).clamp(1, MAX_QUADS) as u32
         });
         let items = quads.max(c.instances).max(1);
@@ -115,12 +118,22 @@ mod tests {
             quads_per_tree: 6,
             viewport: (800, 600),
             min_epsilon: 8.0,
-            overdraw: 16.0,
+            overdraw: 4.0,
             max_quads: None,
         });
-        assert_eq!(c.quads, 600_000 + 480_000);
-        assert_eq!(c.items, 1_080_000);
-        assert_eq!(c.sums, 1_080_000u32.div_ceil(512));
+        assert_eq!(c.quads, 120_000 + 120_000);
+        assert_eq!(c.items, 240_000);
+        assert_eq!(c.sums, 240_000u32.div_ceil(512));
+        // Few trees: their level-0 quads, not the screen's quarter.
+        let few = Capacity::new(&CapacityInput {
+            instances: 10,
+            quads_per_tree: 6,
+            viewport: (800, 600),
+            min_epsilon: 8.0,
+            overdraw: 4.0,
+            max_quads: None,
+        });
+        assert_eq!(few.quads, 60 + 120_000);
         let fixed = Capacity::new(&CapacityInput {
             max_quads: Some(10),
             instances: 3,

@@ -43,9 +43,12 @@ pub struct RendererOptions {
     pub viewport: (u32, u32),
     /// Smallest ε that will be used (sizes the stream).
     pub min_epsilon: f32,
-    /// Quad layers per pixel the stream affords.
+    /// Layers of refined quads per pixel the stream's first sizing affords (see
+    /// [`crate::capacity::Capacity::new`]; [`crate::QuadStream::fit`] grows it to what frames
+    /// need).
     pub overdraw: f32,
-    /// Explicit quad capacity (overrides the formula; tests use small ones to force overflow).
+    /// Explicit quad capacity (overrides the formula and is never grown; tests use small ones
+    /// to force overflow).
     pub max_quads: Option<u32>,
     /// Lighting for the ground (the atlases carry their own baked lighting).
     pub lighting: Lighting,
@@ -65,7 +68,7 @@ impl Default for RendererOptions {
             reverse_z: false,
             viewport: (800, 600),
             min_epsilon: 8.0,
-            overdraw: 16.0,
+            overdraw: 4.0,
             max_quads: None,
             lighting: Lighting::with_sun(30.0, 55.0),
             background: Background::Sky,

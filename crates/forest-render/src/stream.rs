@@ -77,6 +77,8 @@ pub struct QuadStream {
     pub scene: Arc<GpuScene>,
     /// Buffer sizes.
     pub capacity: Capacity,
+    /// Quads [`Self::fit`] found frames need (0 until a frame overflows).
+    grown: u32,
     opts: RendererOptions,
     passes: Passes,
     camera: wgpu::Buffer,
@@ -111,7 +113,23 @@ fn buffer(
     })
 }
 
-fn capacity(scene: &GpuScene, opts: &RendererOptions) -> Capacity {
+/// The capacity of `opts`, and at least `grown` quads (what [`QuadStream::fit`] found frames
+/// need) unless the options fix it.
+fn capacity(scene: &GpuScene, opts: &RendererOptions, grown: u32) -> Capacity {
+    let formula = capacity_of(scene, opts);
+    if opts.max_quads.is_some() || formula.quads >= grown {
+        return formula;
+    }
+    capacity_of(
+        scene,
+        &RendererOptions {
+            max_quads: Some(grown),
+            ..opts.clone()
+        },
+    )
+}
+
+fn capacity_of(scene: &GpuScene, opts: &RendererOptions) -> Capacity {
     let t = &scene.tables;
     Capacity::new(&CapacityInput {
         instances: t.instances.len() as u32,
@@ -145,7 +163,7 @@ impl QuadStream {
                 opts.depth_format
             )));
         }
-        let capacity = capacity(&scene, opts);
+        let capacity = capacity(&scene, opts, 0);
         let shared = ComputeShared::new(device);
         let passes = Passes {
             cull: CullPass::new(device, &shared),
@@ -201,6 +219,7 @@ impl QuadStream {
             levels,
             scene,
             capacity,
+            grown: 0,
             opts: opts.clone(),
             passes,
             camera,
@@ -432,21 +451,54 @@ impl QuadStream {
             min_epsilon,
             ..self.opts.clone()
         };
-        let capacity = capacity(&self.scene, &opts);
+        let capacity = capacity(&self.scene, &opts, self.grown);
         if capacity != self.capacity {
-            self.sized = Self::build_sized(
-                device,
-                &self.scene,
-                &self.passes,
-                &self.camera,
-                &self.ground,
-                &capacity,
-                &readback(self.queries.as_ref(), self.statistics.as_ref()),
-            )?;
-            self.capacity = capacity;
+            self.rebuild(device, capacity)?;
         }
         self.opts = opts;
         Ok(())
+    }
+
+    /// The view's own buffers rebuilt for `capacity` (the scene is kept).
+    fn rebuild(&mut self, device: &wgpu::Device, capacity: Capacity) -> Result<(), RenderError> {
+        self.sized = Self::build_sized(
+            device,
+            &self.scene,
+            &self.passes,
+            &self.camera,
+            &self.ground,
+            &capacity,
+            &readback(self.queries.as_ref(), self.statistics.as_ref()),
+        )?;
+        self.capacity = capacity;
+        Ok(())
+    }
+
+    /// Grow the stream after a frame that overflowed it (`stats`: that frame's counters), so
+    /// that later frames of such views fit: to the frame's estimated need plus an eighth
+    /// (its quads, the level-0 quads dropped, three per quad left unrefined), and at least
+    /// 1.5× the capacity, within [`crate::capacity::MAX_QUADS`] and the device's limits.
+    /// Nothing happens when the frame fit or the options fix the capacity
+    /// ([`RendererOptions::max_quads`]). Returns whether the buffers were rebuilt; the
+    /// overflowed frame itself is not redrawn. The stream never shrinks.
+    pub fn fit(&mut self, device: &wgpu::Device, stats: &FrameStats) -> Result<bool, RenderError> {
+        let overflow = u64::from(stats.overflow_cull) + 3 * u64::from(stats.overflow_refine);
+        if overflow == 0 || self.opts.max_quads.is_some() {
+            return Ok(false);
+        }
+        let need = u64::from(stats.quads) + overflow;
+        let limit = (device.limits().max_storage_buffer_binding_size
+            / std::mem::size_of::<Quad>() as u64)
+            .min(crate::capacity::MAX_QUADS);
+        let quads = (need + need / 8)
+            .max(u64::from(self.capacity.quads) * 3 / 2)
+            .min(limit) as u32;
+        if quads <= self.capacity.quads {
+            return Ok(false);
+        }
+        self.grown = quads;
+        self.rebuild(device, capacity(&self.scene, &self.opts, quads))?;
+        Ok(true)
     }
 
     /// The options the stream was built with (viewport: the last [`Self::resize`]).
@@ -581,6 +633,24 @@ impl QuadStream {
         self.encode(&mut enc, &target.colour_view, &target.depth_view);
         ctx.queue.submit([enc.finish()]);
         Ok(())
+    }
+
+    /// [`Self::render_frame`], drawn again while the frame overflows the stream and
+    /// [`Self::fit`] can grow it; the last frame's counters (waits for the GPU: front ends
+    /// that draw single frames, benchmarks).
+    pub fn render_fitted(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        target: &crate::target::Target,
+    ) -> Result<FrameStats, RenderError> {
+        loop {
+            self.render_frame(ctx, camera, target)?;
+            let stats = self.read_stats(ctx);
+            if !self.fit(&ctx.device, &stats)? {
+                return Ok(stats);
+            }
+        }
     }
 
     /// The crate's own frame: cull, refine, then the ground (with the sky background) and the

@@ -241,8 +241,9 @@ impl Bench {
     }
 
     /// Render `frames` + 1 frames of `method` (the first unmeasured: pipelines may compile
-    /// then; with `frames` = 0 the one frame is measured); the last frame's counters and the
-    /// median GPU frame time (cull + refine + draw).
+    /// then, and the stream grows to fit the view; with `frames` = 0 that one frame is
+    /// measured); the last frame's counters and the median GPU frame time (cull + refine +
+    /// draw).
     pub fn measure(
         &self,
         r: &mut ForestRenderer,
@@ -269,8 +270,12 @@ impl Bench {
         let mut times = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut stats = MethodStats::default();
         for f in 0..=frames {
-            r.render_frame(&self.ctx, cam, target)?;
-            stats = r.read_stats(&self.ctx);
+            stats = if f == 0 {
+                r.render_fitted(&self.ctx, cam, target)?
+            } else {
+                r.render_frame(&self.ctx, cam, target)?;
+                r.read_stats(&self.ctx)
+            };
             if f > 0 || frames == 0 {
                 let t = stats.times.unwrap_or_default();
                 times.0.push(t.cull_ms);
@@ -307,9 +312,7 @@ impl Bench {
         r.set_method(&self.ctx, method)?;
         r.set_background(Background::Transparent);
         r.set_pipeline_statistics(true);
-        let drawn = r
-            .render_frame(&self.ctx, cam, target)
-            .map(|()| r.read_stats(&self.ctx));
+        let drawn = r.render_fitted(&self.ctx, cam, target);
         r.set_background(background);
         r.set_pipeline_statistics(counting);
         let stats = drawn?;

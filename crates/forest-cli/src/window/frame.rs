@@ -103,6 +103,8 @@ impl Viewer {
             // Statistics arrive a few frames late and errors as wgpu reports them: the frame
             // loop never waits for the GPU.
             if let Some(stats) = g.renderer.poll_stats(&g.ctx.device, &g.ctx.queue) {
+                // A view that overflows the stream grows it for the frames after.
+                g.renderer.fit(&g.ctx.device, &stats)?;
                 self.stats = stats;
             }
             g.ctx.check_reported_errors()?;

@@ -20,7 +20,7 @@ impl Viewer {
             cam.viewport.1,
             g.config.format,
         )?;
-        g.renderer.render_frame(&g.ctx, &cam, &target)?;
+        g.renderer.render_fitted(&g.ctx, &cam, &target)?;
         let img = target.read(&g.ctx);
         g.ctx.check_errors()?;
         // The next number whose image and camera files are both free: earlier screenshots
