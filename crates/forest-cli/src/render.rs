@@ -115,6 +115,10 @@ pub struct MethodArgs {
     /// span less than ε pixels (drawn by default with their nearest aspect alone).
     #[arg(long)]
     pub far_blend: bool,
+    /// Quad stream: draw each slab of a tree that spans less than ε pixels as its own quad
+    /// (by default its slabs are composited into one quad, sampled through their parallax).
+    #[arg(long)]
+    pub far_slabs: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
     /// geometry; `auto`: where the quad stream runs out of levels, i.e. where a tree's finest
     /// quads project longer than ε (at least 1.5 px; it follows each tree's size, the view
@@ -147,6 +151,7 @@ impl MethodArgs {
             depth_error: self.depth_error,
             trim: !self.untrimmed,
             far_nearest: !self.far_blend,
+            far_composite: !self.far_slabs,
         }
     }
 

@@ -98,12 +98,17 @@ const FLAG_NEAREST: u32 = 2u;
 const FLAG_DEPTH_ERROR: u32 = 4u;
 const FLAG_UNTRIMMED: u32 = 8u;
 const FLAG_FAR_BLEND: u32 = 16u;
+const FLAG_FAR_SLABS: u32 = 32u;
+// A far tree's slabs drawn as one quad: level 0 at column 1, which level 0 lacks (mirrors
+// Quad::COMPOSITE_POS); its node is the root of the front-most slab present.
+const COMPOSITE_POS: u32 = 16u;
 const BLOCK: u32 = 512u;
 const NONE: u32 = 0xffffffffu;
 const NODE_TEX_WIDTH: u32 = 4096u;
 const PRESORT_TEX_WIDTH: u32 = 4096u;
 
 fn quad_level(q: Quad) -> u32 { return q.pos & 15u; }
+fn quad_composite(q: Quad) -> bool { return q.pos == COMPOSITE_POS; }
 fn quad_x(q: Quad) -> u32 { return (q.pos >> 4u) & 4095u; }
 fn quad_y(q: Quad) -> u32 { return (q.pos >> 16u) & 4095u; }
 fn quad_slab(q: Quad) -> u32 { return q.pos >> 28u; }
@@ -119,6 +124,12 @@ fn node_error(node: vec2<u32>) -> f32 {
         0.044194173, 0.0625, 0.088388346, 0.125, 0.17677669, 0.25, 0.35355338, 0.5,
         0.70710677, 1.0);
     return b[(node.x >> 24u) & 15u];
+}
+// Mean of a node's 4 corner depths, slab-relative.
+fn node_mean_depth(node: vec2<u32>) -> f32 {
+    let d = node.y;
+    let sum = (d & 255u) + ((d >> 8u) & 255u) + ((d >> 16u) & 255u) + (d >> 24u);
+    return f32(sum) / 1020.0;
 }
 fn unorm12(x: f32) -> u32 {
     return u32(floor(clamp(x, 0.0, 1.0) * 4095.0 + 0.5));

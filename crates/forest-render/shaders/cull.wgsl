@@ -92,14 +92,19 @@ fn visible(inst: Instance, sp: Species) -> bool {
     return true;
 }
 
+const SQRT3: f32 = 1.7320508;
+
 // Whether a tree of bounding radius `r` (world) centred at `c` spans less than ε pixels
-// across: its level-0 quads, as wide as the tree, are then never refined, and it is drawn
-// with its nearest aspect alone (one quad per slab instead of up to three), unless
-// FLAG_FAR_BLEND. Mirrored by `far_tree` in reference.rs, operation for operation.
+// across, seen at the depth of its nearest level-0 corner: its level-0 quads, as wide as the
+// tree, are then never refined, and it is drawn with its nearest aspect alone (its slabs
+// composited into one quad, unless FLAG_FAR_SLABS), unless FLAG_FAR_BLEND. Mirrored by
+// `far_tree` in reference.rs, operation for operation.
 fn far_tree(c: vec3<f32>, r: f32) -> bool {
     if ((stream_flags(camera) & FLAG_FAR_BLEND) != 0u) { return false; }
     let m = camera.view_proj;
-    let w = m[0].w * c.x + m[1].w * c.y + m[2].w * c.z + m[3].w;
+    // The nearest a level-0 quad's corner can be: the slab squares' corners lie within
+    // √3 r of the centre.
+    let w = m[0].w * c.x + m[1].w * c.y + m[2].w * c.z + m[3].w - SQRT3 * r;
     if (w <= 0.0) { return false; }
     let fy = m[0].y * m[0].y + m[1].y * m[1].y + m[2].y * m[2].y;
     let half = camera.viewport.y * 0.5;
@@ -128,8 +133,8 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
     return q;
 }
 
-// Level-0 quads of one tree, in drawing order: slabs back to front; within a slab the present
-// aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
+// Level-0 quads of one tree, in drawing order: slabs back to front (a far tree's slabs as one
+// composited quad, unless FLAG_FAR_SLABS); within a slab the present aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
 // weight (present or blank), which the draw pass turns into a dither interval or an "over"
 // alpha (hi − lo) / hi. Puts them from `out` on (skipping indices below `skip`) when `emit`
 // (`last`: see put_quad); returns the count.
@@ -144,7 +149,25 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 
     }
     let eye_obj = to_object_dir(inst, camera.eye.xyz - centre);
     let bl = blend(sp, eye_obj);
-    let w12 = aspect_weights(bl.w, far_tree(centre, sp.sphere.w * inst.scale));
+    let far = far_tree(centre, sp.sphere.w * inst.scale);
+    let w12 = aspect_weights(bl.w, far);
+    if (far && sp.slabs > 1u && (stream_flags(camera) & FLAG_FAR_SLABS) == 0u) {
+        // One quad for all the slabs of the nearest aspect, on the front-most slab's root.
+        var a = 0u;
+        if (w12.y > 0u) { a = 1u; }
+        if (w12.z > 0u) { a = 2u; }
+        var root = NONE;
+        for (var s = sp.slabs; s > 0u; s--) {
+            let r = roots[sp.layer_base + bl.idx[a] * sp.slabs + s - 1u];
+            if (r != NONE) { root = r; }
+        }
+        if (root == NONE) { return 0u; }
+        if (emit && out >= skip) {
+            put_quad(out - skip, Quad(inst_id, root, COMPOSITE_POS,
+                pack_dir(bl.idx[a], 0u, WEIGHT_ONE)), last);
+        }
+        return 1u;
+    }
     var n = 0u;
     for (var s = 0u; s < sp.slabs; s++) {
         let slab = sp.slabs - 1u - s;

@@ -29,6 +29,8 @@
 @group(0) @binding(5) var nodes: texture_2d<u32>;
 @group(0) @binding(6) var colour: texture_2d_array<f32>;
 @group(0) @binding(7) var colour_sampler: sampler;
+// Root node of every layer (NONE when blank): a composited quad's slabs.
+@group(0) @binding(9) var<storage, read> roots: array<u32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -40,6 +42,27 @@ struct VsOut {
     // Share [lo, hi) of the blend (x, y), the instance (z) and the tree's quad share (w, see
     // quad_share: below WEIGHT_ONE in the hybrid's transition band).
     @location(5) @interpolate(flat) share: vec4<u32>,
+    // Layers composited, front first from `layer` (a far tree's slabs; else 1).
+    @location(6) @interpolate(flat) slabs: u32,
+    // A composited quad's parallax: the uv shift per unit of stack depth behind its plane,
+    // along the view ray (0 for other quads).
+    @location(7) @interpolate(flat) parallax: vec2<f32>,
+    // Depths in the stack (0 front, 1 back) of the first four slabs' root planes (their
+    // corners' mean), where their images are sampled; 0.5 (the quad's plane) otherwise.
+    @location(8) @interpolate(flat) depths: vec4<f32>,
+}
+
+// 1 inside a slab image, 0 outside (a shifted sample must not repeat the edge texels).
+fn inside_image(uv: vec2<f32>) -> f32 {
+    return select(0.0, 1.0, all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)));
+}
+
+// Where slab k is sampled on a composited quad's plane (which lies at half the stack): at
+// its root plane's depth, shifted along the view ray; slabs after the fourth at the plane.
+fn slab_uv(in: VsOut, k: u32) -> vec2<f32> {
+    var d = 0.5;
+    if (k < 4u) { d = in.depths[k]; }
+    return in.uv + in.parallax * (d - 0.5);
 }
 
 // How far (in finest-quad widths) a finest-level quad reaches past its rectangle, so that
@@ -89,19 +112,51 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let sp = species[inst.species];
     let dir = quad_dir(q);
     let f = frames[sp.dir_base + dir];
-    let node = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).xyz;
+    var node = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).xyz;
     let level = quad_level(q);
     let size = 1.0 / f32(1u << level);
     let finest = 1.0 / f32(1u << (sp.levels - 1u));
     let corner = vec2<f32>(f32(vi & 1u), f32(vi >> 1u));
-    let d = vec4<f32>(f32(node.y & 255u), f32((node.y >> 8u) & 255u),
+    var d = vec4<f32>(f32(node.y & 255u), f32((node.y >> 8u) & 255u),
                       f32((node.y >> 16u) & 255u), f32(node.y >> 24u)) / 255.0;
+    let composite = quad_composite(q);
+    var qx = quad_x(q);
+    var slab = quad_slab(q);
+    var parallax = vec2<f32>(0.0);
+    var depths = vec4<f32>(0.5);
+    if (composite) {
+        // The view ray from the eye through the tree's centre in the direction's frame (the
+        // tree spans less than ε pixels: one ray stands for all): moving one unit of
+        // slab-relative depth (2r along −dir) shifts uv by (−a/c, b/c) (v runs down).
+        let ray = to_object_dir(inst, to_world(inst, sp.sphere.xyz) - camera.eye.xyz);
+        let c = min(dot(ray, f.dir.xyz), -0.2 * length(ray));
+        parallax = vec2<f32>(-dot(ray, f.right.xyz) / c, dot(ray, f.up.xyz) / c);
+        // All the slabs on the plane through the tree's centre (slab-relative depth of slab
+        // 0 reaching half the stack), over the union of their covered boxes.
+        qx = 0u;
+        slab = 0u;
+        d = vec4<f32>(0.5 * f32(sp.slabs));
+        var lo = vec2<u32>(255u);
+        var hi = vec2<u32>(0u);
+        for (var s = 0u; s < sp.slabs; s++) {
+            let r = roots[sp.layer_base + dir * sp.slabs + s];
+            if (r == NONE) { continue; }
+            let root = textureLoad(nodes, vec2<u32>(r % NODE_TEX_WIDTH, r / NODE_TEX_WIDTH), 0);
+            let z = root.z;
+            lo = min(lo, vec2<u32>(z & 255u, (z >> 8u) & 255u));
+            hi = max(hi, vec2<u32>((z >> 16u) & 255u, z >> 24u));
+            if (s < 4u) {
+                depths[s] = (f32(s) + node_mean_depth(root.xy)) / f32(sp.slabs);
+            }
+        }
+        node.z = lo.x | (lo.y << 8u) | (hi.x << 16u) | (hi.y << 24u);
+    }
     // The node's covered box (fractions of its side; see forest_format::trim), widened by
     // the fringe; the whole node when untrimmed.
     var box_lo = vec2<f32>(0.0);
     var box_hi = vec2<f32>(1.0);
     if ((stream_flags(camera) & FLAG_UNTRIMMED) == 0u) {
-        let px = node_min_extent(sp, f, inst, quad_slab(q), f32(quad_x(q)), f32(quad_y(q)), size, d);
+        let px = node_min_extent(sp, f, inst, slab, f32(qx), f32(quad_y(q)), size, d);
         // At least one texel too: magnified, the bilinear filter spreads half a texel.
         let texel = 1.0 / f32(max(sp.resolution >> level, 1u));
         let fringe = select(1.0, max(TRIM_FRINGE / px, texel), px > 0.0);
@@ -109,13 +164,19 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
                  vec2<f32>(0.0));
         box_hi = min(vec2<f32>(f32((node.z >> 16u) & 255u), f32(node.z >> 24u)) / 255.0 + fringe,
                  vec2<f32>(1.0));
+        // A composited quad reaches as far as its slabs' shifted boxes.
+        let far_slab = max(max(abs(depths.x - 0.5), abs(depths.y - 0.5)),
+                           max(abs(depths.z - 0.5), abs(depths.w - 0.5)));
+        let spread = abs(parallax) * far_slab;
+        box_lo = box_lo - select(vec2<f32>(0.0), spread, composite);
+        box_hi = box_hi + select(vec2<f32>(0.0), spread, composite);
     }
     let a = mix(box_lo, box_hi, corner);
-    let u0 = (f32(quad_x(q)) + a.x) * size;
+    let u0 = (f32(qx) + a.x) * size;
     let v0 = (f32(quad_y(q)) + a.y) * size;
     // The node's plane at `a`: bilinear in its corner depths (exact for a plane).
     let t0 = mix(mix(d.x, d.y, a.x), mix(d.z, d.w, a.x), a.y);
-    var w = to_world(inst, slab_point(sp, f, quad_slab(q), u0, v0, t0));
+    var w = to_world(inst, slab_point(sp, f, slab, u0, v0, t0));
     // Crack margin outwards on every side (finest level), as untrimmed: from a side that
     // reaches the node's edge it overlaps the neighbour's quad; from a trimmed side it only
     // covers the node's own blank texels.
@@ -123,13 +184,16 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let u = u0 + (corner.x * 2.0 - 1.0) * margin * finest;
     let v = v0 + (corner.y * 2.0 - 1.0) * margin * finest;
     if (margin > 0.0) {
-        w = to_world(inst, slab_point(sp, f, quad_slab(q), u, v, t0));
+        w = to_world(inst, slab_point(sp, f, slab, u, v, t0));
     }
     let flags = stream_flags(camera);
     var out: VsOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.uv = vec2<f32>(u, v);
-    out.layer = sp.layer_base + dir * sp.slabs + quad_slab(q);
+    out.layer = sp.layer_base + dir * sp.slabs + slab;
+    out.slabs = select(1u, sp.slabs, composite);
+    out.parallax = parallax;
+    out.depths = depths;
     let lo = quad_lo(q);
     let hi = quad_hi(q);
     out.alpha = select(0.0, f32(hi - lo) / f32(hi), hi > 0u);
@@ -167,7 +231,16 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 
 @fragment
 fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
-    let c = textureSample(colour, colour_sampler, in.uv, in.layer);
+    let uv0 = slab_uv(in, 0u);
+    var c = textureSample(colour, colour_sampler, uv0, in.layer) * inside_image(uv0);
+    // A composited quad: the slabs behind, "over" from the front (premultiplied colour).
+    let du = dpdx(in.uv);
+    let dv = dpdy(in.uv);
+    for (var k = 1u; k < in.slabs; k++) {
+        let uv = slab_uv(in, k);
+        let b = textureSampleGrad(colour, colour_sampler, uv, in.layer + k, du, dv);
+        c = c + b * inside_image(uv) * (1.0 - c.a);
+    }
     // Position inside the quad in quad widths and its screen derivative (before any branch).
     let g = in.uv * f32(1u << in.level);
     let px = max(fwidth(g), vec2<f32>(1e-6));

@@ -21,12 +21,6 @@ fn edge_long(a: vec4<f32>, b: vec4<f32>) -> bool {
     return dx * dx + dy * dy > lim * lim;
 }
 
-// Mean of a node's 4 corner depths, slab-relative.
-fn node_mean_depth(node: vec2<u32>) -> f32 {
-    let d = node.y;
-    let sum = (d & 255u) + ((d >> 8u) & 255u) + ((d >> 16u) & 255u) + (d >> 24u);
-    return f32(sum) / 1020.0;
-}
 
 // Whether the node's depth error, as a displacement along its sampling direction at the quad's
 // centre and mean depth, projects longer than ε pixels; reaching behind the eye counts as long.

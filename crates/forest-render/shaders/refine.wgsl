@@ -27,6 +27,8 @@ fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
 
 // 0: keep; otherwise the number of children refining it makes (1 + its extra quads).
 fn wants(q: Quad) -> u32 {
+    // A far tree's composited quad is never refined (its children would be one slab's).
+    if (quad_composite(q)) { return 0u; }
     let node = node_at(q.node);
     let mask = node.x >> 28u;
     if (mask == 0u) { return 0u; }

@@ -107,6 +107,14 @@ impl Quad {
     pub fn pack_pos(level: u32, x: u32, y: u32, slab: u32) -> u32 {
         level | (x << 4) | (y << 16) | (slab << 28)
     }
+    /// The position word of a far tree's composited quad: level 0 at column 1, which level 0
+    /// lacks, stands for all the tree's slabs drawn as one quad (see `StreamOptions::
+    /// far_composite`); its node is the root of the front-most slab present.
+    pub const COMPOSITE_POS: u32 = 1 << 4;
+    /// Whether this is a far tree's composited quad ([`Self::COMPOSITE_POS`]).
+    pub fn composite(&self) -> bool {
+        self.pos == Self::COMPOSITE_POS
+    }
     /// Quad level.
     pub fn level(&self) -> u32 {
         self.pos & 15

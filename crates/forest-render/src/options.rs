@@ -176,6 +176,10 @@ pub struct StreamOptions {
     /// with its nearest aspect alone: one quad per slab instead of up to three. On (the
     /// default); off blends every tree's aspects, as the paper does.
     pub far_nearest: bool,
+    /// Draw such a tree's slabs as one quad, composited in the fragment shader on the plane
+    /// through the tree's centre (its slabs' parallax is below ε there), instead of one quad
+    /// per slab. On (the default, with `far_nearest`); off draws each slab's quad.
+    pub far_composite: bool,
 }
 
 impl Default for StreamOptions {
@@ -185,6 +189,7 @@ impl Default for StreamOptions {
             depth_error: false,
             trim: true,
             far_nearest: true,
+            far_composite: true,
         }
     }
 }
@@ -199,6 +204,8 @@ pub const FLAG_DEPTH_ERROR: u32 = 4;
 pub const FLAG_UNTRIMMED: u32 = 8;
 /// See [`FLAG_DITHER`].
 pub const FLAG_FAR_BLEND: u32 = 16;
+/// See [`FLAG_DITHER`].
+pub const FLAG_FAR_SLABS: u32 = 32;
 
 impl StreamOptions {
     /// The flag bits written to the camera uniform's `viewport.w`.
@@ -216,6 +223,11 @@ impl StreamOptions {
             }
             | if self.trim { 0 } else { FLAG_UNTRIMMED }
             | if self.far_nearest { 0 } else { FLAG_FAR_BLEND }
+            | if self.far_composite {
+                0
+            } else {
+                FLAG_FAR_SLABS
+            }
     }
 }
 

@@ -8,7 +8,7 @@ use forest_format::QuadNode;
 use forest_format::node::ERROR_BOUNDS;
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE};
-use crate::options::{FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_NEAREST};
+use crate::options::{FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST};
 use crate::scene::SceneTables;
 
 /// Result of the reference: the final stream and the frame's counters.
@@ -75,13 +75,17 @@ pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
     w
 }
 
-/// Whether a tree spans less than ε pixels across (see `far_tree` in `shaders/cull.wgsl`).
+/// √3 in f32, as `SQRT3` in `shaders/cull.wgsl`.
+const SQRT3: f32 = 1.732_050_8;
+
+/// Whether a tree spans less than ε pixels across, seen at the depth of its nearest level-0
+/// corner (see `far_tree` in `shaders/cull.wgsl`).
 fn far_tree(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
     if flags(cam) & FLAG_FAR_BLEND != 0 {
         return false;
     }
     let m = &cam.view_proj;
-    let w = m[0][3] * c.x + m[1][3] * c.y + m[2][3] * c.z + m[3][3];
+    let w = m[0][3] * c.x + m[1][3] * c.y + m[2][3] * c.z + m[3][3] - SQRT3 * r;
     if w <= 0.0 {
         return false;
     }
@@ -136,6 +140,22 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let bl = blend(&dirs, &upper, &lower, eye_obj);
     let far = far_tree(cam, centre, sp.sphere[3] * inst.scale);
     let w12 = aspect_weights(bl.weight, flags(cam) | if far { FLAG_NEAREST } else { 0 });
+    if far && sp.slabs > 1 && flags(cam) & FLAG_FAR_SLABS == 0 {
+        // One quad for all the slabs of the nearest aspect, on the front-most slab's root.
+        let a = (0..3).rev().find(|&a| w12[a] > 0).unwrap_or(0);
+        let layer = |slab: u32| (sp.layer_base + bl.index[a] * sp.slabs + slab) as usize;
+        return (0..sp.slabs)
+            .map(|slab| t.roots[layer(slab)])
+            .find(|&r| r != u32::MAX)
+            .map(|root| Quad {
+                instance: inst_id,
+                node: root,
+                pos: Quad::COMPOSITE_POS,
+                dir_weight: Quad::pack_dir(bl.index[a], 0, WEIGHT_ONE),
+            })
+            .into_iter()
+            .collect();
+    }
     let mut out = Vec::new();
     for s in 0..sp.slabs {
         let slab = sp.slabs - 1 - s;
@@ -196,6 +216,9 @@ fn edge_long(cam: &GpuCamera, a: Vec4, b: Vec4) -> bool {
 
 /// 0: keep; else 1 + extra quads (see `wants` in `shaders/refine.wgsl`).
 fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
+    if q.composite() {
+        return 0;
+    }
     let node = t.nodes[q.node as usize];
     let mask = u32::from(node.mask());
     if mask == 0 {

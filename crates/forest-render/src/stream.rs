@@ -380,6 +380,7 @@ impl QuadStream {
                     wgpu::BindingResource::TextureView(&colour_view),
                     wgpu::BindingResource::Sampler(&sampler),
                     ground.as_entire_binding(),
+                    scene.roots.as_entire_binding(),
                 ]),
             })
         });

@@ -73,6 +73,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             depth_error: false,
             trim: false,
             far_nearest: false,
+            far_composite: false,
         },
         epsilon: EPS,
     };
@@ -114,6 +115,13 @@ fn variants(quick: bool) -> Vec<Variant> {
             "far trees blended",
             StreamOptions {
                 far_nearest: false,
+                ..default
+            },
+        ),
+        runtime(
+            "far slabs apart",
+            StreamOptions {
+                far_composite: false,
                 ..default
             },
         ),

@@ -9,7 +9,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
-/// ground.
+/// ground, layer roots.
 pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let storage = |binding| wgpu::BindGroupLayoutEntry {
@@ -65,6 +65,7 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             count: None,
         },
         uniform(8),
+        storage(9),
     ]
 }
 
