@@ -460,13 +460,15 @@ fn checked_frame(
     (s, quads, target.read(ctx))
 }
 
-/// Far trees' slabs drawn as one composited quad: one quad per far tree instead of at least
-/// one per slab, nearly the same image (FLIP ≤ 0.03), fewer vertices and fragments; GPU and
-/// CPU reference agree either way.
-#[test]
-fn far_trees_composite_their_slabs_into_one_quad() {
-    use forest_render::options::StreamOptions;
-
+/// A frame of a bird's-eye view at ε 16 over 300 small trees (most under ε pixels), over a
+/// transparent background with pipeline statistics, for each of two option sets.
+fn far_view(
+    options: [forest_render::options::StreamOptions; 2],
+) -> [(
+    forest_render::stats::FrameStats,
+    Vec<forest_render::gpu_types::Quad>,
+    image::RgbaImage,
+); 2] {
     let ctx = common::ctx();
     let forest = common::forest(300);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
@@ -481,20 +483,23 @@ fn far_trees_composite_their_slabs_into_one_quad() {
     let target = Target::new(&ctx, 160, 120);
     let side = forest.extent();
     let cam = common::camera(Vec3::new(0.0, side, side * 0.6), Vec3::ZERO, 16.0);
-    let mut run = |far_composite: bool| {
-        checked_frame(
-            &ctx,
-            &mut stream,
-            &cam,
-            &target,
-            StreamOptions {
-                far_composite,
-                ..Default::default()
-            },
-        )
-    };
-    let (slabs, slab_quads, slab_img) = run(false);
-    let (comp, comp_quads, comp_img) = run(true);
+    options.map(|o| checked_frame(&ctx, &mut stream, &cam, &target, o))
+}
+
+/// Far trees' slabs drawn as one composited quad: one quad per far tree instead of at least
+/// one per slab, nearly the same image (FLIP ≤ 0.03), fewer vertices and fragments; GPU and
+/// CPU reference agree either way.
+#[test]
+fn far_trees_composite_their_slabs_into_one_quad() {
+    use forest_render::options::StreamOptions;
+
+    let [(slabs, slab_quads, slab_img), (comp, comp_quads, comp_img)] = far_view([
+        StreamOptions {
+            far_composite: false,
+            ..Default::default()
+        },
+        StreamOptions::default(),
+    ]);
     let composited: std::collections::BTreeSet<u32> = comp_quads
         .iter()
         .filter(|q| q.composite())
@@ -553,33 +558,16 @@ fn far_trees_composite_their_slabs_into_one_quad() {
 fn trees_narrower_than_epsilon_draw_their_nearest_aspect_alone() {
     use forest_render::options::StreamOptions;
 
-    let ctx = common::ctx();
-    let forest = common::forest(300);
-    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-    let opts = RendererOptions {
-        viewport: (160, 120),
-        min_epsilon: 4.0,
-        background: Background::Transparent,
-        ..Default::default()
-    };
-    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
-    let target = Target::new(&ctx, 160, 120);
-    let side = forest.extent();
-    let cam = common::camera(Vec3::new(0.0, side, side * 0.6), Vec3::ZERO, 16.0);
-    let mut run = |far_nearest: bool| {
-        checked_frame(
-            &ctx,
-            &mut stream,
-            &cam,
-            &target,
-            StreamOptions {
-                far_nearest,
-                ..Default::default()
-            },
-        )
-    };
-    let (blended, blended_quads, blended_img) = run(false);
-    let (nearest, quads, nearest_img) = run(true);
+    let [
+        (blended, blended_quads, blended_img),
+        (nearest, quads, nearest_img),
+    ] = far_view([
+        StreamOptions {
+            far_nearest: false,
+            ..Default::default()
+        },
+        StreamOptions::default(),
+    ]);
     assert_eq!(nearest.visible_trees, blended.visible_trees);
     assert!(nearest.visible_trees > 0);
     // Trees drawn at level 0 alone, with one aspect: the far ones join them, with at most
