@@ -173,7 +173,7 @@ fn the_stream_counts_its_work() {
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let off = stream.read_stats(&ctx);
     assert_eq!(off.work.passes, None);
-    assert!(off.work.dispatches > 0 && off.work.draws == 1);
+    assert!(off.work.dispatches > 0 && off.work.draws == 2);
     stream.set_pipeline_statistics(true);
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let stats = stream.read_stats(&ctx);
@@ -188,7 +188,9 @@ fn the_stream_counts_its_work() {
     // final length.
     let iterations = stream.scene.tables.max_levels - 1;
     assert_eq!(w.dispatches, 5 + 3 * iterations + 1);
-    assert_eq!(w.draws, 1, "quads only over a transparent background");
+    // The stream's two draws (far trees' composited quads, then the others), no ground over
+    // a transparent background.
+    assert_eq!(w.draws, 2, "quads only over a transparent background");
     assert!(w.bytes >= stream.scene.bytes + stream.capacity.bytes());
     let Some(p) = w.passes else {
         eprintln!(
@@ -202,9 +204,10 @@ fn the_stream_counts_its_work() {
         p[work::REFINE as usize],
         p[work::DRAW as usize],
     );
-    // Every quad is a four-vertex strip: two triangles unless clipped.
-    assert_eq!(draw.vertex_invocations, 4 * u64::from(stats.quads));
-    assert!(draw.primitives > 0 && draw.primitives <= 4 * u64::from(stats.quads));
+    // Every quad is a four-vertex strip in each of the two draws (one of which puts it
+    // outside the clip volume): two triangles unless clipped.
+    assert_eq!(draw.vertex_invocations, 8 * u64::from(stats.quads));
+    assert!(draw.primitives > 0 && draw.primitives <= 2 * u64::from(stats.quads));
     // Every covered pixel was shaded at least once.
     let covered = target.read(&ctx).pixels().filter(|px| px[3] > 0).count() as u64;
     assert!(
@@ -287,10 +290,10 @@ fn every_method_counts_its_work() {
         ..Default::default()
     }));
     // The hybrid's work is both forms' work in one frame: the stream's dispatches and its
-    // one draw, the geometry's four dispatches and its draws, both renderers' memory.
+    // two draws, the geometry's four dispatches and its draws, both renderers' memory.
     let h = &hybrid.work;
     assert_eq!(h.dispatches, quads.work.dispatches + 4);
-    assert_eq!(h.draws, 1 + segments);
+    assert_eq!(h.draws, 2 + segments);
     assert_eq!(h.bytes, quads.work.bytes + gpu_bytes);
     if let (Some(t), Some(_)) = (h.total(), quads.work.passes) {
         assert!(t.compute_invocations > 0 && t.vertex_invocations > 0);

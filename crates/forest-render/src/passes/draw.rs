@@ -74,6 +74,8 @@ pub struct DrawPass {
     /// Bind-group layout (camera, scene tables, final stream, textures, ground).
     pub bind_layout: wgpu::BindGroupLayout,
     ground: wgpu::RenderPipeline,
+    /// Far trees' composited quads (drawn first).
+    composite: wgpu::RenderPipeline,
     quads: wgpu::RenderPipeline,
 }
 
@@ -128,6 +130,12 @@ impl DrawPass {
         };
         Self {
             ground: pipeline("vs_ground", "fs_ground", None, true),
+            composite: pipeline(
+                "vs_composite",
+                "fs_composite",
+                Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                false,
+            ),
             quads: pipeline(
                 "vs_quad",
                 "fs_quad",
@@ -138,7 +146,7 @@ impl DrawPass {
         }
     }
 
-    /// Record the ground (when `ground`) and the indirect quad draw, the latter inside the
+    /// Record the ground (when `ground`) and the two indirect quad draws, the latter inside the
     /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone).
     /// Returns the draws recorded.
     pub fn record(
@@ -154,14 +162,17 @@ impl DrawPass {
             pass.set_pipeline(&self.ground);
             pass.draw(0..4, 0..1);
         }
-        pass.set_pipeline(&self.quads);
         if let Some(set) = statistics {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
         }
-        pass.draw_indirect(args_buf, args::DRAW);
+        // The stream twice: far trees' composited quads, then the others (see draw.wgsl).
+        for p in [&self.composite, &self.quads] {
+            pass.set_pipeline(p);
+            pass.draw_indirect(args_buf, args::DRAW);
+        }
         if statistics.is_some() {
             pass.end_pipeline_statistics_query();
         }
-        1 + u32::from(ground)
+        2 + u32::from(ground)
     }
 }
