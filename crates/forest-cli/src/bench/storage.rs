@@ -172,7 +172,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         "allocated_bytes",
     ]);
     let mut needed = Series {
-        name: "needed (quads × 16 B × 2 buffers)".into(),
+        name: "needed (quads × 40 B: two stream buffers, two scan words)".into(),
         ..Default::default()
     };
     let mut allocated = Series {
@@ -195,7 +195,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 epsilon: 16.0,
             };
             let (s, _) = b.measure(&mut r, Method::Quads, &cam, &target, 1)?;
-            let need = s.primitives * 16 * 2;
+            let need = s.primitives * (2 * 16 + 2 * 4);
             let alloc = r.stream.capacity.bytes();
             needed
                 .points
@@ -244,11 +244,13 @@ pub fn run(b: &Bench) -> Result<Section> {
          as BC7, all species together) and the geometry methods their models ({:.2} MiB on \
          disk, {:.2} MiB on the GPU with LODs, leaf tables and billboards). Static impostors \
          bind the same atlas. Between the two largest forests each added tree costs {} B of GPU \
-         memory with the quad stream (instance, presorted orders and its share of the \
-         level-0 quad capacity) and {} B with the geometry methods (instance, classification \
-         key, visible-list slot): memory grows with the models, not the instances. The quad-stream buffers are sized by \
-         `Capacity` for every tree being visible at once plus what refinement can add; the \
-         last chart compares that with what the measured frames needed.",
+         memory with the quad stream (instance, presorted orders, a scan slot) and {} B with \
+         the geometry methods (instance, classification key, visible-list slot): memory grows \
+         with the models, not the instances. The quad-stream buffers start from `Capacity`'s \
+         estimate (the level-0 quads of the visible trees, at most a quarter of the screen's \
+         pixels, plus what refinement can add) and grow when a frame overflows them \
+         (`QuadStream::fit`, to the frame's need plus an eighth); the last chart compares the \
+         allocation after the measured frames with what they needed.",
         quad_total.0 as f64 / MB,
         quad_total.1 as f64 / MB,
         geo_total.0 as f64 / MB,
