@@ -763,6 +763,7 @@ impl QuadStream {
             &self.sized.bg_draw[(self.iterations % 2) as usize],
             &self.sized.args,
             ground && self.opts.background == Background::Sky,
+            self.options.far_nearest && self.options.far_composite,
             self.counting().map(|q| &q.set),
         );
         self.recorded.1.store(draws, Ordering::Relaxed);

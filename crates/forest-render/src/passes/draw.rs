@@ -146,15 +146,17 @@ impl DrawPass {
         }
     }
 
-    /// Record the ground (when `ground`) and the two indirect quad draws, the latter inside the
-    /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone).
-    /// Returns the draws recorded.
+    /// Record the ground (when `ground`) and the indirect quad draws, the latter inside the
+    /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone):
+    /// the composited far trees' draw when `composite` (the stream's options can make such
+    /// quads), then the others'. Returns the draws recorded.
     pub fn record(
         &self,
         pass: &mut wgpu::RenderPass,
         bind_group: &wgpu::BindGroup,
         args_buf: &wgpu::Buffer,
         ground: bool,
+        composite: bool,
         statistics: Option<&wgpu::QuerySet>,
     ) -> u32 {
         pass.set_bind_group(0, bind_group, &[]);
@@ -166,13 +168,18 @@ impl DrawPass {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
         }
         // The stream twice: far trees' composited quads, then the others (see draw.wgsl).
-        for p in [&self.composite, &self.quads] {
+        let pipelines = if composite {
+            vec![&self.composite, &self.quads]
+        } else {
+            vec![&self.quads]
+        };
+        for p in &pipelines {
             pass.set_pipeline(p);
             pass.draw_indirect(args_buf, args::DRAW);
         }
         if statistics.is_some() {
             pass.end_pipeline_statistics_query();
         }
-        2 + u32::from(ground)
+        pipelines.len() as u32 + u32::from(ground)
     }
 }
