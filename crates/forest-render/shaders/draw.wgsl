@@ -177,16 +177,23 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
             }
         }
         node.z = lo.x | (lo.y << 8u) | (hi.x << 16u) | (hi.y << 24u);
+    }
+    // The node's shortest screen extent (pixels), which sets the trim fringe and a
+    // composited quad's mip level.
+    let trimmed = (stream_flags(camera) & FLAG_UNTRIMMED) == 0u;
+    var px = 0.0;
+    if (trimmed || composite) {
+        px = node_min_extent(sp, f, inst, slab, f32(qx), f32(quad_y(q)), size, d);
+    }
+    if (composite) {
         // Texels of the slab image per pixel of its shortest edge on screen.
-        let px = node_min_extent(sp, f, inst, 0u, 0.0, 0.0, 1.0, d);
         depths.w = log2(max(f32(sp.resolution) / max(px, 1e-3), 1.0));
     }
     // The node's covered box (fractions of its side; see forest_format::trim), widened by
     // the fringe; the whole node when untrimmed.
     var box_lo = vec2<f32>(0.0);
     var box_hi = vec2<f32>(1.0);
-    if ((stream_flags(camera) & FLAG_UNTRIMMED) == 0u) {
-        let px = node_min_extent(sp, f, inst, slab, f32(qx), f32(quad_y(q)), size, d);
+    if (trimmed) {
         // At least one texel too: magnified, the bilinear filter spreads half a texel.
         let texel = 1.0 / f32(max(sp.resolution >> level, 1u));
         let fringe = select(1.0, max(TRIM_FRINGE / px, texel), px > 0.0);
@@ -194,11 +201,12 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
                  vec2<f32>(0.0));
         box_hi = min(vec2<f32>(f32((node.z >> 16u) & 255u), f32(node.z >> 24u)) / 255.0 + fringe,
                  vec2<f32>(1.0));
-        // A composited quad reaches as far as its slabs' shifted boxes.
+        // A composited quad reaches as far as its slabs' shifted boxes (other quads have no
+        // parallax).
         let far_slab = max(max(abs(depths.x - 0.5), abs(depths.y - 0.5)), abs(depths.z - 0.5));
         let spread = abs(parallax) * far_slab;
-        box_lo = box_lo - select(vec2<f32>(0.0), spread, composite);
-        box_hi = box_hi + select(vec2<f32>(0.0), spread, composite);
+        box_lo = box_lo - spread;
+        box_hi = box_hi + spread;
     }
     let a = mix(box_lo, box_hi, corner);
     let u0 = (f32(qx) + a.x) * size;

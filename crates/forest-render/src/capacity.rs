@@ -25,8 +25,11 @@ pub struct CapacityInput {
     pub min_epsilon: f32,
     /// Mean number of quad layers covering a pixel that refinement must afford.
     pub overdraw: f32,
-    /// Explicit quad capacity, overriding the formula.
+    /// Explicit quad capacity, overriding the formula (and `grown`).
     pub max_quads: Option<u32>,
+    /// Quads frames were found to need ([`crate::QuadStream::fit`]; 0 at first): the formula
+    /// gives at least this many.
+    pub grown: u32,
 }
 
 /// Buffer sizes in elements and bytes.
@@ -43,7 +46,7 @@ pub struct Capacity {
 
 impl Capacity {
     /// `Q = min(N · quads_per_tree, W · H / 4) + overdraw · W · H / (ε_min / 2)²`, at most
-    /// [`MAX_QUADS`], unless given.
+    /// and at least `grown`, at most [`MAX_QUADS`], unless given.
     ///
     /// The second term holds the quads refinement adds: each refined quad is at least `ε/2`
     /// pixels on a side, so a screen covered `overdraw` times holds at most that many. The
@@ -58,7 +61,9 @@ impl Capacity {
             let level0 = (u64::from(c.instances) * u64::from(c.quads_per_tree)).min(pixels / 4);
             let half = f64::from(c.min_epsilon.max(1.0)) / 2.0;
             let refine = f64::from(c.overdraw) * pixels as f64 / (half * half);
-            (level0 + refine as u64).clamp(1, MAX_QUADS) as u32
+            (level0 + refine as u64)
+                .max(u64::from(c.grown))
+                .clamp(1, MAX_QUADS) as u32
         });
         let items = quads.max(c.instances).max(1);
         Self {
@@ -113,27 +118,34 @@ mod tests {
 
     #[test]
     fn formula_matches_the_documentation() {
-        let c = Capacity::new(&CapacityInput {
+        let input = CapacityInput {
             instances: 100_000,
             quads_per_tree: 6,
             viewport: (800, 600),
             min_epsilon: 8.0,
             overdraw: 4.0,
             max_quads: None,
-        });
+            grown: 0,
+        };
+        let c = Capacity::new(&input);
         assert_eq!(c.quads, 120_000 + 120_000);
         assert_eq!(c.items, 240_000);
         assert_eq!(c.sums, 240_000u32.div_ceil(512));
         // Few trees: their level-0 quads, not the screen's quarter.
         let few = Capacity::new(&CapacityInput {
             instances: 10,
-            quads_per_tree: 6,
-            viewport: (800, 600),
-            min_epsilon: 8.0,
-            overdraw: 4.0,
-            max_quads: None,
+            ..input
         });
         assert_eq!(few.quads, 60 + 120_000);
+        // Grown past the formula by frames that needed more; never below it.
+        let grown = |quads| {
+            Capacity::new(&CapacityInput {
+                grown: quads,
+                ..input
+            })
+            .quads
+        };
+        assert_eq!((grown(1_000_000), grown(1_000)), (1_000_000, 240_000));
         let fixed = Capacity::new(&CapacityInput {
             max_quads: Some(10),
             instances: 3,
@@ -144,6 +156,7 @@ mod tests {
                 min_epsilon: 8.0,
                 overdraw: 1.0,
                 max_quads: None,
+                grown: 1_000,
             }
         });
         assert_eq!((fixed.quads, fixed.items), (10, 10));

@@ -116,20 +116,6 @@ fn buffer(
 /// The capacity of `opts`, and at least `grown` quads (what [`QuadStream::fit`] found frames
 /// need) unless the options fix it.
 fn capacity(scene: &GpuScene, opts: &RendererOptions, grown: u32) -> Capacity {
-    let formula = capacity_of(scene, opts);
-    if opts.max_quads.is_some() || formula.quads >= grown {
-        return formula;
-    }
-    capacity_of(
-        scene,
-        &RendererOptions {
-            max_quads: Some(grown),
-            ..opts.clone()
-        },
-    )
-}
-
-fn capacity_of(scene: &GpuScene, opts: &RendererOptions) -> Capacity {
     let t = &scene.tables;
     Capacity::new(&CapacityInput {
         instances: t.instances.len() as u32,
@@ -138,6 +124,7 @@ fn capacity_of(scene: &GpuScene, opts: &RendererOptions) -> Capacity {
         min_epsilon: opts.min_epsilon,
         overdraw: opts.overdraw,
         max_quads: opts.max_quads,
+        grown,
     })
 }
 

@@ -147,6 +147,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 min_epsilon: epsilon,
                 overdraw: 16.0,
                 max_quads: Some((most as f64 * 1.25).ceil() as u32),
+                grown: 0,
             });
         let levels = species[0].atlas.manifest.nodes_per_level.len();
         println!(

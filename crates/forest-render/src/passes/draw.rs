@@ -168,18 +168,15 @@ impl DrawPass {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
         }
         // The stream twice: far trees' composited quads, then the others (see draw.wgsl).
-        let pipelines = if composite {
-            vec![&self.composite, &self.quads]
-        } else {
-            vec![&self.quads]
-        };
-        for p in &pipelines {
+        let pipelines = [&self.composite, &self.quads];
+        let drawn = &pipelines[usize::from(!composite)..];
+        for p in drawn {
             pass.set_pipeline(p);
             pass.draw_indirect(args_buf, args::DRAW);
         }
         if statistics.is_some() {
             pass.end_pipeline_statistics_query();
         }
-        pipelines.len() as u32 + u32::from(ground)
+        drawn.len() as u32 + u32::from(ground)
     }
 }
