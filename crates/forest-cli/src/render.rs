@@ -371,6 +371,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     "view": name, "output": out.display().to_string(),
                     "adapter": ctx.adapter_info.name,
                     "visible_trees": stats.visible_trees, "quads": stats.quads,
+                    "composited_quads": stats.composites,
                     "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
                     "overflow_refine": stats.overflow_refine,
                     "capacity_quads": stream.capacity.quads,
@@ -381,9 +382,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             );
         } else {
             println!(
-                "{name}: {} visible trees, {} quads {:?}, overflow {}/{}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms ({}) -> {}",
+                "{name}: {} visible trees, {} quads ({} composited) {:?}, overflow {}/{}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms ({}) -> {}",
                 stats.visible_trees,
                 stats.quads,
+                stats.composites,
                 stats.per_level,
                 stats.overflow_cull,
                 stats.overflow_refine,

@@ -44,6 +44,16 @@ fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
             );
         }
         assert_eq!(gpu.len(), cpu.quads.len(), "{name}: stream length");
+        // Two lists: the kept composited quads lead the stream, and only they.
+        let kept = cpu.composites.saturating_sub(cpu.overflow_cull);
+        assert_eq!(stats.composites, kept, "{name}: composited quads");
+        assert!(
+            cpu.quads
+                .iter()
+                .enumerate()
+                .all(|(i, q)| q.composite() == (i < kept as usize)),
+            "{name}: composited quads lead the reference's stream"
+        );
         assert_eq!(stats.per_level, cpu.per_level, "{name}: quads per level");
         assert!(gpu.len() <= stream.capacity.quads as usize);
         summary.push((

@@ -44,13 +44,16 @@ struct StateAtomic {
     overflow_refine: atomic<u32>,
     visible: atomic<u32>,
     quads: atomic<u32>,
+    composites: atomic<u32>,
     per_level: array<atomic<u32>, 16>,
 }
 
 fn set_args(n: u32) {
     args.items = vec4<u32>((n + WG - 1u) / WG, 1u, 1u, 0u);
     args.blocks = vec4<u32>((n + BLOCK - 1u) / BLOCK, 1u, 1u, 0u);
-    args.draw = vec4<u32>(4u, n, 0u, 0u);
+    let c = kept_composites(atomicLoad(&state.composites), atomicLoad(&state.overflow_cull));
+    args.draw = vec4<u32>(4u, n - c, 0u, 0u);
+    args.draw_composite = vec4<u32>(4u, c, 0u, 0u);
 }
 
 fn node_at(i: u32) -> vec2<u32> {

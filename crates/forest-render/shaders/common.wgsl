@@ -80,14 +80,22 @@ struct State {
     overflow_refine: u32, // quads left unrefined for lack of room
     visible: u32,       // trees passing the frustum test
     quads: u32,         // quads in the final stream
+    composites: u32,    // far trees' composited quads at level 0, before any are dropped
     per_level: array<u32, 16>,
+}
+
+// Composited quads at the front of the stream: those of `composites` not dropped for room
+// (the dropped quads are the stream's first).
+fn kept_composites(composites: u32, overflow_cull: u32) -> u32 {
+    return composites - min(composites, overflow_cull);
 }
 
 // Dispatch arguments (x, y, z) for each kind of dispatch, and the draw arguments.
 struct Args {
     items: vec4<u32>,   // ceil(n / 256) workgroups (w unused)
     blocks: vec4<u32>,  // ceil(n / 512)
-    draw: vec4<u32>,    // vertex count 4, instance count n, 0, 0
+    draw: vec4<u32>,    // plain quads: vertex count 4, instance count n − kept composites, 0, 0
+    draw_composite: vec4<u32>, // composited quads: 4, kept composites, 0, 0
 }
 
 const WG: u32 = 256u;

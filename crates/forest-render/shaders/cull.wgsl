@@ -4,6 +4,13 @@
 // first. Compaction keeps the order: cull_count writes per-tree counts and block sums,
 // cull_top scans the block sums, cull_down turns the counts into offsets, cull_emit writes
 // each tree's quads at its offset (scan.wgsl). With frame_setup: five dispatches.
+//
+// The level-0 stream is two lists, each in presorted order: the far trees' composited quads
+// first, then every other quad. A tree's count packs both (TREE_COMPOSITE per composited
+// quad above the plain count, which is at most 3 · 16 slabs, so a block's plain sum stays
+// below 2^16), and the two scans run side by side: block sums [0, B) plain, [B, 2B)
+// composited, B the blocks of trees. Refinement never moves a composited quad (its wish is
+// 0), so the final stream keeps them at its front and the draw pass draws each list alone.
 
 // Blend of the species' directions for an object-space view vector (unnormalised), exactly as
 // forest_format::directions::blend. Returns indices in .idx and weights in .w.
@@ -137,7 +144,10 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
 // composited quad, unless FLAG_FAR_SLABS); within a slab the present aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
 // weight (present or blank), which the draw pass turns into a dither interval or an "over"
 // alpha (hi − lo) / hi. Puts them from `out` on (skipping indices below `skip`) when `emit`
-// (`last`: see put_quad); returns the count.
+// (`last`: see put_quad); returns the count, a composited quad counted as TREE_COMPOSITE.
+// One composited quad in a tree's packed count (plain quads count 1).
+const TREE_COMPOSITE: u32 = 65536u;
+
 fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 {
     let inst = instances[inst_id];
     let sp = species[inst.species];
@@ -166,7 +176,7 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 
             put_quad(out - skip, Quad(inst_id, root, COMPOSITE_POS,
                 pack_dir(bl.idx[a], 0u, WEIGHT_ONE)), last);
         }
-        return 1u;
+        return TREE_COMPOSITE;
     }
     var n = 0u;
     for (var s = 0u; s < sp.slabs; s++) {
@@ -212,10 +222,12 @@ fn frame_setup(@builtin(local_invocation_index) t: u32) {
     atomicStore(&state.overflow_refine, 0u);
     atomicStore(&state.visible, 0u);
     atomicStore(&state.quads, 0u);
+    atomicStore(&state.composites, 0u);
     for (var l = 0u; l < 16u; l++) { atomicStore(&state.per_level[l], 0u); }
 }
 
-// Level-0 quads of the i-th tree in presorted order (0 past the end or outside the frustum).
+// Level-0 quads of the i-th tree in presorted order, packed (0 past the end or outside the
+// frustum).
 fn tree_count(i: u32) -> u32 {
     if (i >= scene.instances) { return 0u; }
     let inst_id = instance_in_order(i);
@@ -225,7 +237,11 @@ fn tree_count(i: u32) -> u32 {
     return tree_quads(inst_id, false, 0u, 0u, false);
 }
 
-// Each tree's quad count, and each block's sum (two trees a thread, a block a workgroup).
+// Blocks of trees: B.
+fn tree_blocks() -> u32 { return (scene.instances + BLOCK - 1u) / BLOCK; }
+
+// Each tree's packed quad count, and each block's plain and composited sums (two trees a
+// thread, a block a workgroup).
 @compute @workgroup_size(256)
 fn cull_count(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
     let i0 = wg.x * BLOCK + 2u * t;
@@ -234,42 +250,81 @@ fn cull_count(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     if (i0 < scene.instances) { data[i0] = a; }
     if (i0 + 1u < scene.instances) { data[i0 + 1u] = c; }
     let excl = wg_exclusive(t, a + c);
-    if (t == WG - 1u) { atomicStore(&sums[wg.x], excl + a + c); }
+    if (t == WG - 1u) {
+        let sum = excl + a + c;
+        atomicStore(&sums[wg.x], sum % TREE_COMPOSITE);
+        atomicStore(&sums[tree_blocks() + wg.x], sum / TREE_COMPOSITE);
+    }
 }
 
-// The scan of the block sums; the level-0 stream's length. When the level-0 quads exceed the
-// capacity, the farthest trees' quads are dropped (the first `total − capacity` of the
-// stream), so the near trees stay.
+// The scans of the block sums; the level-0 stream's length, C composited quads then P plain
+// ones. When the level-0 quads exceed the capacity, the farthest trees' quads are dropped
+// (the first `total − capacity` of the stream: composited ones first), so the near trees
+// stay.
 @compute @workgroup_size(256)
 fn cull_top(@builtin(local_invocation_index) t: u32) {
-    let total = scan_block_sums(t, (scene.instances + BLOCK - 1u) / BLOCK);
+    let blocks = tree_blocks();
+    let plain = scan_block_sums(t, 0u, blocks);
+    let composites = scan_block_sums(t, blocks, blocks);
     if (t == 0u) {
+        let total = plain + composites;
         let n = min(total, scene.capacity);
         atomicStore(&state.overflow_cull, total - n);
         atomicStore(&state.n, n);
+        atomicStore(&state.composites, composites);
         atomicStore(&state.total, 0u);
         atomicStore(&state.pmin, NONE);
     }
 }
 
-// Each tree's first quad in the stream (before dropping).
+// Each tree's first quad in the stream (before dropping): its composited quad's place in
+// [0, C), or its plain quads' from C on. Clears the block's two sums.
 @compute @workgroup_size(256)
 fn cull_down(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) t: u32) {
     let i0 = wg.x * BLOCK + 2u * t;
     var v = vec2<u32>(0u);
     if (i0 < scene.instances) { v.x = data[i0]; }
     if (i0 + 1u < scene.instances) { v.y = data[i0 + 1u]; }
-    let p = block_prefix(wg.x, t, v.x, v.y);
-    if (i0 < scene.instances) { data[i0] = p.x; }
-    if (i0 + 1u < scene.instances) { data[i0 + 1u] = p.y; }
+    let c_sum = tree_blocks() + wg.x;
+    let base = vec2<u32>(atomicLoad(&state.composites) + atomicLoad(&sums[wg.x]),
+                         atomicLoad(&sums[c_sum]));
+    let excl = wg_exclusive(t, v.x + v.y);
+    storageBarrier();
+    if (t == 0u) {
+        atomicStore(&sums[wg.x], 0u);
+        atomicStore(&sums[c_sum], 0u);
+    }
+    let e = vec2<u32>(excl, excl + v.x);
+    for (var k = 0u; k < 2u; k++) {
+        let i = i0 + k;
+        if (i >= scene.instances) { continue; }
+        if (v[k] >= TREE_COMPOSITE) {
+            data[i] = base.y + e[k] / TREE_COMPOSITE;
+        } else {
+            data[i] = base.x + e[k] % TREE_COMPOSITE;
+        }
+    }
 }
+
+var<workgroup> wg_first_plain: atomic<u32>;
 
 fn cull_emit_body(wg: u32, t: u32, last: bool) {
     let skip = atomicLoad(&state.overflow_cull);
+    let composites = atomicLoad(&state.composites);
     let first = wg * BLOCK;
-    var first_out = 0u;
-    if (first < scene.instances) { first_out = max(data[first], skip) - skip; }
-    emit_begin(t, first_out);
+    // The bins of block sums follow the workgroup's run of plain quads (composited ones
+    // add nothing: they are never refined), which starts at its first tree that is not
+    // composited.
+    if (t == 0u) { atomicStore(&wg_first_plain, NONE); }
+    workgroupBarrier();
+    for (var k = 0u; k < 2u; k++) {
+        let i = first + 2u * t + k;
+        if (i < scene.instances && data[i] >= composites) {
+            atomicMin(&wg_first_plain, data[i]);
+        }
+    }
+    workgroupBarrier();
+    emit_begin(t, max(atomicLoad(&wg_first_plain), skip) - skip);
     for (var k = 0u; k < 2u; k++) {
         let i = first + 2u * t + k;
         if (i >= scene.instances) { continue; }

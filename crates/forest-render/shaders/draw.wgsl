@@ -31,6 +31,8 @@
 @group(0) @binding(7) var colour_sampler: sampler;
 // Root node of every layer (NONE when blank): a composited quad's slabs.
 @group(0) @binding(9) var<storage, read> roots: array<u32>;
+// The frame's counters: where the plain quads start in the stream.
+@group(0) @binding(10) var<storage, read> state: State;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -107,30 +109,21 @@ fn node_min_extent(sp: Species, f: Frame, inst: Instance, slab: u32, x: f32, y: 
                min(distance(s[0], s[2]), distance(s[1], s[3])));
 }
 
-// The stream is drawn twice, in order: far trees' composited quads (vs_composite,
-// fs_composite), then every other quad (vs_quad, fs_quad); each pass's vertex shader puts the
-// other pass's quads outside the clip volume. Two pipelines keep the single texture sample of
-// fs_quad free of the composite's loop (a branch around texture samples slowed every fragment
-// by 30–120 % on a CPU rasteriser). A composited tree thus lies under every other tree's quads:
-// exact where it is behind them, as far trees almost always are.
+// The stream is two lists (cull.wgsl): far trees' composited quads at its front, then every
+// other quad; each has its own draw, in that order (vs_composite and fs_composite over the
+// first `draw_composite` instances, vs_quad and fs_quad over the rest). Two pipelines keep the
+// single texture sample of fs_quad free of the composite's loop (a branch around texture
+// samples slowed every fragment by 30–120 % on a CPU rasteriser). A composited tree thus lies
+// under every other tree's quads: exact where it is behind them, as far trees almost always
+// are.
 @vertex
 fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
-    if (quad_composite(quads[qi])) { return outside(); }
-    return quad_vertex(vi, qi);
+    return quad_vertex(vi, kept_composites(state.composites, state.overflow_cull) + qi);
 }
 
 @vertex
 fn vs_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
-    if (!quad_composite(quads[qi])) { return outside(); }
     return quad_vertex(vi, qi);
-}
-
-// A vertex beyond the clip volume's right side: the pass draws nothing of this quad.
-fn outside() -> VsOut {
-    var out: VsOut;
-    out.clip = vec4<f32>(2.0, 0.0, 0.5, 1.0);
-    out.slabs = 1u;
-    return out;
 }
 
 fn quad_vertex(vi: u32, qi: u32) -> VsOut {

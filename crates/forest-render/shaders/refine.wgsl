@@ -108,7 +108,7 @@ fn refine_top(@builtin(local_invocation_index) t: u32) {
         atomicStore(&state.pmin, NONE);
         set_args(n);
     }
-    let total = scan_block_sums(t, (n + BLOCK - 1u) / BLOCK);
+    let total = scan_block_sums(t, 0u, (n + BLOCK - 1u) / BLOCK);
     if (t == 0u) { atomicStore(&state.total, total); }
 }
 

@@ -34,20 +34,20 @@ fn share(t: u32, v: u32) -> u32 {
     return workgroupUniformLoad(&wg_uniform);
 }
 
-// Exclusive scan of sums[0..blocks) in place by one workgroup; returns the total.
-fn scan_block_sums(t: u32, blocks_of_thread0: u32) -> u32 {
+// Exclusive scan of sums[first..first + blocks) in place by one workgroup; returns the total.
+fn scan_block_sums(t: u32, first: u32, blocks_of_thread0: u32) -> u32 {
     let blocks = share(t, blocks_of_thread0);
     var carry = 0u;
     for (var c = 0u; c < blocks; c = c + BLOCK) {
         let i0 = c + 2u * t;
         var a = 0u;
         var b = 0u;
-        if (i0 < blocks) { a = atomicLoad(&sums[i0]); }
-        if (i0 + 1u < blocks) { b = atomicLoad(&sums[i0 + 1u]); }
+        if (i0 < blocks) { a = atomicLoad(&sums[first + i0]); }
+        if (i0 + 1u < blocks) { b = atomicLoad(&sums[first + i0 + 1u]); }
         let excl = wg_exclusive(t, a + b);
         let chunk = wg_sum[WG - 1u];
-        if (i0 < blocks) { atomicStore(&sums[i0], carry + excl); }
-        if (i0 + 1u < blocks) { atomicStore(&sums[i0 + 1u], carry + excl + a); }
+        if (i0 < blocks) { atomicStore(&sums[first + i0], carry + excl); }
+        if (i0 + 1u < blocks) { atomicStore(&sums[first + i0 + 1u], carry + excl + a); }
         carry = carry + chunk;
         workgroupBarrier();
     }

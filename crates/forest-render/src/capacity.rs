@@ -40,7 +40,8 @@ pub struct Capacity {
     /// Elements of the first scan-data buffer (tree counts, then quads): `max(N, Q)`; the
     /// second holds `Q`.
     pub items: u32,
-    /// Elements of the scan's block-sum buffer: `ceil(items/512)`.
+    /// Elements of the scan's block-sum buffer: `ceil(items/512)`, and at least two per
+    /// block of trees (the cull scans its plain and composited counts side by side).
     pub sums: u32,
 }
 
@@ -69,7 +70,7 @@ impl Capacity {
         Self {
             quads,
             items,
-            sums: items.div_ceil(BLOCK),
+            sums: items.div_ceil(BLOCK).max(2 * c.instances.div_ceil(BLOCK)),
         }
     }
 
@@ -160,6 +161,16 @@ mod tests {
             }
         });
         assert_eq!((fixed.quads, fixed.items), (10, 10));
+        // Many trees, a small stream: the cull's two block sums per block of trees.
+        let many = Capacity::new(&CapacityInput {
+            max_quads: Some(10),
+            instances: 100_000,
+            ..input
+        });
+        assert_eq!(
+            (many.items, many.sums),
+            (100_000, 2 * 100_000u32.div_ceil(512))
+        );
         let g = GeometryCapacity::new(1000, 2, 12);
         assert_eq!((g.segments, g.instances), (24, 1000));
         assert_eq!(g.bytes(), 8000 + 24 * 24);

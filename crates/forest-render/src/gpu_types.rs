@@ -154,7 +154,7 @@ impl Quad {
     }
 }
 
-/// Frame state written by the GPU (96 bytes).
+/// Frame state written by the GPU (100 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct GpuState {
@@ -174,11 +174,14 @@ pub struct GpuState {
     pub visible: u32,
     /// Quads drawn.
     pub quads: u32,
+    /// Far trees' composited quads at level 0 (before any were dropped for room); those kept
+    /// lead the stream.
+    pub composites: u32,
     /// Quads per level in the final stream.
     pub per_level: [u32; 16],
 }
 
-/// Indirect arguments (80 bytes).
+/// Indirect arguments (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct GpuArgs {
@@ -186,8 +189,10 @@ pub struct GpuArgs {
     pub items: [u32; 4],
     /// Per-block dispatches: one workgroup per 512 quads.
     pub blocks: [u32; 4],
-    /// Draw: vertex count, instance count, first vertex, first instance.
+    /// Draw of the plain quads: vertex count, instance count, first vertex, first instance.
     pub draw: [u32; 4],
+    /// Draw of the composited quads (the stream's first).
+    pub draw_composite: [u32; 4],
 }
 
 /// Scene constants (16 bytes), written once.

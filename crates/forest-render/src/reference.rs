@@ -26,6 +26,9 @@ pub struct Reference {
     pub overflow_cull: u32,
     /// Quads left unrefined for lack of room.
     pub overflow_refine: u32,
+    /// Far trees' composited quads at level 0, before any were dropped (those kept lead the
+    /// stream).
+    pub composites: u32,
 }
 
 fn to_world(inst: &GpuInstance, p: Vec3) -> Vec3 {
@@ -299,8 +302,9 @@ pub fn run_with(t: &SceneTables, cam: &GpuCamera, capacity: u32, iterations: u32
         presort: presort as u32,
         ..Default::default()
     };
-    // Pass 1.
+    // Pass 1: two lists in presorted order, the composited quads first.
     let mut level0 = Vec::new();
+    let mut plain = Vec::new();
     for i in 0..n {
         let id = if n == 0 {
             0
@@ -310,9 +314,17 @@ pub fn run_with(t: &SceneTables, cam: &GpuCamera, capacity: u32, iterations: u32
         let inst = &t.instances[id as usize];
         if visible(cam, inst, &t.species[inst.species as usize]) {
             r.visible += 1;
-            level0.extend(tree_quads(t, cam, id));
+            for q in tree_quads(t, cam, id) {
+                if q.composite() {
+                    level0.push(q);
+                } else {
+                    plain.push(q);
+                }
+            }
         }
     }
+    r.composites = level0.len() as u32;
+    level0.extend(plain);
     let total = level0.len() as u32;
     let skip = total.saturating_sub(capacity);
     r.overflow_cull = skip;

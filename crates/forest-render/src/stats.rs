@@ -33,6 +33,8 @@ pub struct FrameStats {
     pub visible_trees: u32,
     /// Quads drawn.
     pub quads: u32,
+    /// Of those, far trees' composited quads (the stream's first).
+    pub composites: u32,
     /// Quads per level.
     pub per_level: Vec<u32>,
     /// Level-0 quads dropped for lack of room.

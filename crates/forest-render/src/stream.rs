@@ -368,6 +368,7 @@ impl QuadStream {
                     wgpu::BindingResource::Sampler(&sampler),
                     ground.as_entire_binding(),
                     scene.roots.as_entire_binding(),
+                    state.as_entire_binding(),
                 ]),
             })
         });
@@ -797,6 +798,7 @@ impl QuadStream {
             presort: s.presort,
             visible_trees: s.visible,
             quads: s.quads,
+            composites: s.composites - s.composites.min(s.overflow_cull),
             per_level: s.per_level[..levels].to_vec(),
             overflow_cull: s.overflow_cull,
             overflow_refine: s.overflow_refine,

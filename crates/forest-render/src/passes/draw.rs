@@ -9,7 +9,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
-/// ground, layer roots.
+/// ground, layer roots, the frame's state (where the plain quads start).
 pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let storage = |binding| wgpu::BindGroupLayoutEntry {
@@ -66,6 +66,7 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         },
         uniform(8),
         storage(9),
+        storage(10),
     ]
 }
 
@@ -167,12 +168,16 @@ impl DrawPass {
         if let Some(set) = statistics {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
         }
-        // The stream twice: far trees' composited quads, then the others (see draw.wgsl).
-        let pipelines = [&self.composite, &self.quads];
-        let drawn = &pipelines[usize::from(!composite)..];
-        for p in drawn {
-            pass.set_pipeline(p);
-            pass.draw_indirect(args_buf, args::DRAW);
+        // The stream's two lists, each drawn alone: far trees' composited quads at its
+        // front, then the others (see draw.wgsl).
+        let draws = [
+            (&self.composite, args::DRAW_COMPOSITE),
+            (&self.quads, args::DRAW),
+        ];
+        let drawn = &draws[usize::from(!composite)..];
+        for (pipeline, offset) in drawn {
+            pass.set_pipeline(pipeline);
+            pass.draw_indirect(args_buf, *offset);
         }
         if statistics.is_some() {
             pass.end_pipeline_statistics_query();

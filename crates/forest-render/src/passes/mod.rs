@@ -221,6 +221,8 @@ pub mod args {
     pub const ITEMS: u64 = 0;
     /// `ceil(n/512)`.
     pub const BLOCKS: u64 = 16;
-    /// Draw arguments.
+    /// Draw arguments of the plain quads.
     pub const DRAW: u64 = 32;
+    /// Draw arguments of the composited quads.
+    pub const DRAW_COMPOSITE: u64 = 48;
 }

@@ -118,6 +118,7 @@ pub fn shared() -> Vec<Expect> {
                 ("items", offset_of!(GpuArgs, items)),
                 ("blocks", offset_of!(GpuArgs, blocks)),
                 ("draw", offset_of!(GpuArgs, draw)),
+                ("draw_composite", offset_of!(GpuArgs, draw_composite)),
             ],
         ),
     ]
@@ -133,6 +134,7 @@ pub fn state_members() -> Vec<(&'static str, usize)> {
         ("overflow_refine", offset_of!(GpuState, overflow_refine)),
         ("visible", offset_of!(GpuState, visible)),
         ("quads", offset_of!(GpuState, quads)),
+        ("composites", offset_of!(GpuState, composites)),
         ("per_level", offset_of!(GpuState, per_level)),
     ]
 }
