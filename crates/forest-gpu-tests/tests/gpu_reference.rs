@@ -7,14 +7,27 @@ use forest_render::reference;
 use forest_render::target::Target;
 use forest_render::{GpuScene, QuadStream};
 
-fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
+/// Per view: (name, quads, visible trees, overflow, composited quads, refined quads).
+type Summary = (String, usize, u32, u32, u32, u32);
+
+fn check(trees: u32, max_quads: Option<u32>) -> Vec<Summary> {
     let ctx = common::ctx();
     let forest = common::forest(trees);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
     let (mut stream, target) = common::small_stream(&ctx, scene, max_quads);
     let side = forest.extent();
     let mut summary = Vec::new();
-    for (name, cam) in common::cameras(side) {
+    let mut views = common::cameras(side);
+    // Along the ground at a coarse ε: the far trees are composited, the near ones refined.
+    views.push((
+        "horizon_coarse",
+        common::camera(
+            glam::Vec3::new(-side * 0.7, 0.5, 0.0),
+            glam::Vec3::new(0.0, 0.6, 0.0),
+            16.0,
+        ),
+    ));
+    for (name, cam) in views {
         stream.render_frame(&ctx, &cam, &target).unwrap();
         let gpu = stream.read_quads(&ctx);
         let stats = stream.read_stats(&ctx);
@@ -61,6 +74,8 @@ fn check(trees: u32, max_quads: Option<u32>) -> Vec<(String, usize, u32, u32)> {
             gpu.len(),
             stats.visible_trees,
             stats.overflow_refine + stats.overflow_cull,
+            stats.composites,
+            stats.per_level.iter().skip(1).sum(),
         ));
     }
     summary
@@ -82,6 +97,10 @@ fn gpu_stream_equals_the_cpu_reference() {
         s.iter().all(|x| x.3 == 0),
         "no overflow at the formula's capacity"
     );
+    // A view that composites far trees and refines near ones: refinement runs over the
+    // plain quads behind the composited ones.
+    let coarse = get("horizon_coarse");
+    assert!(coarse.4 > 0 && coarse.5 > 0, "{coarse:?}");
 }
 
 #[test]
@@ -92,6 +111,8 @@ fn overflow_keeps_to_the_capacity_and_matches_the_reference() {
         s.iter().any(|x| x.3 > 0),
         "a small stream overflows somewhere"
     );
+    // Also where composited quads lead the stream and refinement runs behind them.
+    assert!(s.iter().any(|x| x.3 > 0 && x.4 > 0 && x.5 > 0), "{s:?}");
     assert!(s.iter().all(|x| x.1 <= 700));
 }
 

@@ -26,7 +26,9 @@ struct SceneConsts {
 @group(0) @binding(12) var<storage, read_write> data: array<u32>;
 // One sum per block of BLOCK items (scan.wgsl).
 @group(0) @binding(13) var<storage, read_write> sums: array<atomic<u32>>;
-@group(0) @binding(14) var<storage, read> quads_in: array<Quad>;
+// The cull writes far trees' composited quads to both stream buffers (refinement never
+// touches them), so quads_in is writable too.
+@group(0) @binding(14) var<storage, read_write> quads_in: array<Quad>;
 @group(0) @binding(15) var<storage, read_write> quads_out: array<Quad>;
 
 // The indirect arguments are a separate group: a buffer may not be bound for writing in the
@@ -48,11 +50,19 @@ struct StateAtomic {
     per_level: array<atomic<u32>, 16>,
 }
 
+// The composited quads leading a stream of any step: refinement runs over the rest.
+fn stream_front() -> u32 {
+    return kept_composites(atomicLoad(&state.composites), atomicLoad(&state.overflow_cull));
+}
+
+// Arguments for a stream of n quads: the per-item and per-block dispatches over its plain
+// quads, and both draws.
 fn set_args(n: u32) {
-    args.items = vec4<u32>((n + WG - 1u) / WG, 1u, 1u, 0u);
-    args.blocks = vec4<u32>((n + BLOCK - 1u) / BLOCK, 1u, 1u, 0u);
-    let c = kept_composites(atomicLoad(&state.composites), atomicLoad(&state.overflow_cull));
-    args.draw = vec4<u32>(4u, n - c, 0u, 0u);
+    let c = stream_front();
+    let m = n - c;
+    args.items = vec4<u32>((m + WG - 1u) / WG, 1u, 1u, 0u);
+    args.blocks = vec4<u32>((m + BLOCK - 1u) / BLOCK, 1u, 1u, 0u);
+    args.draw = vec4<u32>(4u, m, 0u, 0u);
     args.draw_composite = vec4<u32>(4u, c, 0u, 0u);
 }
 

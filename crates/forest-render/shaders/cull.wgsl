@@ -143,12 +143,13 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
 // Level-0 quads of one tree, in drawing order: slabs back to front (a far tree's slabs as one
 // composited quad, unless FLAG_FAR_SLABS); within a slab the present aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
 // weight (present or blank), which the draw pass turns into a dither interval or an "over"
-// alpha (hi − lo) / hi. Puts them from `out` on (skipping indices below `skip`) when `emit`
-// (`last`: see put_quad); returns the count, a composited quad counted as TREE_COMPOSITE.
+// alpha (hi − lo) / hi. Puts them from `out` on (skipping indices below `skip`; plain quads
+// after the `front` kept composited ones) when `emit` (`last`: see put_quad); returns the
+// count, a composited quad counted as TREE_COMPOSITE.
 // One composited quad in a tree's packed count (plain quads count 1).
 const TREE_COMPOSITE: u32 = 65536u;
 
-fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 {
+fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, front: u32, last: bool) -> u32 {
     let inst = instances[inst_id];
     let sp = species[inst.species];
     let centre = to_world(inst, sp.sphere.xyz);
@@ -173,8 +174,10 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 
         }
         if (root == NONE) { return 0u; }
         if (emit && out >= skip) {
-            put_quad(out - skip, Quad(inst_id, root, COMPOSITE_POS,
-                pack_dir(bl.idx[a], 0u, WEIGHT_ONE)), last);
+            // In both stream buffers: no refinement step moves it (refine.wgsl).
+            let q = Quad(inst_id, root, COMPOSITE_POS, pack_dir(bl.idx[a], 0u, WEIGHT_ONE));
+            quads_out[out - skip] = q;
+            quads_in[out - skip] = q;
         }
         return TREE_COMPOSITE;
     }
@@ -191,8 +194,9 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, last: bool) -> u32 
             let root = roots[layer];
             if (root == NONE) { continue; }
             if (emit && out + n >= skip) {
-                put_quad(out + n - skip, Quad(inst_id, root, pack_pos(0u, 0u, 0u, slab),
-                    pack_dir(bl.idx[a], lo, acc)), last);
+                put_quad(front, out + n - skip - front,
+                    Quad(inst_id, root, pack_pos(0u, 0u, 0u, slab), pack_dir(bl.idx[a], lo, acc)),
+                    last);
             }
             n = n + 1u;
         }
@@ -234,7 +238,7 @@ fn tree_count(i: u32) -> u32 {
     let inst = instances[inst_id];
     if (!visible(inst, species[inst.species])) { return 0u; }
     atomicAdd(&state.visible, 1u);
-    return tree_quads(inst_id, false, 0u, 0u, false);
+    return tree_quads(inst_id, false, 0u, 0u, 0u, false);
 }
 
 // Blocks of trees: B.
@@ -324,14 +328,15 @@ fn cull_emit_body(wg: u32, t: u32, last: bool) {
         }
     }
     workgroupBarrier();
-    emit_begin(t, max(atomicLoad(&wg_first_plain), skip) - skip);
+    let front = stream_front();
+    emit_begin(t, max(atomicLoad(&wg_first_plain), skip + front) - skip - front);
     for (var k = 0u; k < 2u; k++) {
         let i = first + 2u * t + k;
         if (i >= scene.instances) { continue; }
         let inst_id = instance_in_order(i);
         let inst = instances[inst_id];
         if (visible(inst, species[inst.species])) {
-            _ = tree_quads(inst_id, true, data[i], skip, last);
+            _ = tree_quads(inst_id, true, data[i], skip, front, last);
         }
     }
     emit_end(t);

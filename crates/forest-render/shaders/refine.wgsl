@@ -15,6 +15,11 @@
 //                 the levels of the final stream instead.
 // A quad's entry in data / data_next: its wish w (3 bits: 0 keep, else its child count)
 // before the scan, (prefix << 3) | w after it.
+//
+// The far trees' composited quads that lead the stream (stream_front) are never refined:
+// the cull wrote them to both stream buffers, and every step runs over the plain quads
+// after them alone. Indices into data, data_next and the block sums count from the first
+// plain quad; the stream buffers are indexed from the front (quads_in[front + i]).
 
 // Clip-space position of corner c (0 TL, 1 TR, 2 BL, 3 BR) of a quad.
 fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
@@ -77,8 +82,9 @@ fn emit_begin(t: u32, first_out: u32) {
     workgroupBarrier();
 }
 
-fn put_quad(out: u32, q: Quad, last: bool) {
-    quads_out[out] = q;
+// Plain quad `out` (counted from the first plain quad; `front` composited quads before it).
+fn put_quad(front: u32, out: u32, q: Quad, last: bool) {
+    quads_out[front + out] = q;
     if (last) {
         atomicAdd(&wg_level[quad_level(q)], 1u);
         return;
@@ -108,7 +114,8 @@ fn refine_top(@builtin(local_invocation_index) t: u32) {
         atomicStore(&state.pmin, NONE);
         set_args(n);
     }
-    let total = scan_block_sums(t, 0u, (n + BLOCK - 1u) / BLOCK);
+    let m = n - stream_front();
+    let total = scan_block_sums(t, 0u, (m + BLOCK - 1u) / BLOCK);
     if (t == 0u) { atomicStore(&state.total, total); }
 }
 
@@ -128,15 +135,16 @@ fn refine_down(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_i
         atomicStore(&wg_unrefined, 0u);
     }
     let n = atomicLoad(&state.n);
+    let m = n - stream_front();
     let total = atomicLoad(&state.total);
     let i0 = wg.x * BLOCK + 2u * t;
     var w = vec2<u32>(0u);
-    if (i0 < n) { w.x = data[i0] & 7u; }
-    if (i0 + 1u < n) { w.y = data[i0 + 1u] & 7u; }
+    if (i0 < m) { w.x = data[i0] & 7u; }
+    if (i0 + 1u < m) { w.y = data[i0 + 1u] & 7u; }
     let p = block_prefix(wg.x, t, extra_of(w.x), extra_of(w.y));
     for (var k = 0u; k < 2u; k++) {
         let i = i0 + k;
-        if (i >= n) { continue; }
+        if (i >= m) { continue; }
         data[i] = (p[k] << 3u) | w[k];
         if (refined(w[k], p[k], n, total)) {
             atomicMin(&wg_pmin, p[k]);
@@ -161,19 +169,21 @@ fn refined_out(i: u32, prefix: u32, pmin: u32) -> u32 {
 
 fn refine_emit_body(wg: u32, t: u32, last: bool) {
     let n = atomicLoad(&state.n);
+    let front = stream_front();
+    let m = n - front;
     let total = atomicLoad(&state.total);
     let pmin = atomicLoad(&state.pmin);
     let first = wg * WG;
-    emit_begin(t, refined_out(first, data[min(first, n - 1u)] >> 3u, pmin));
+    emit_begin(t, refined_out(first, data[min(first, m - 1u)] >> 3u, pmin));
     let i = first + t;
-    if (i < n) {
+    if (i < m) {
         let entry = data[i];
         let prefix = entry >> 3u;
         let w = entry & 7u;
         var out = refined_out(i, prefix, pmin);
-        let q = quads_in[i];
+        let q = quads_in[front + i];
         if (!refined(w, prefix, n, total)) {
-            put_quad(out, q, last);
+            put_quad(front, out, q, last);
         } else {
             let inst = instances[q.instance];
             let node_base = species[inst.species].node_base;
@@ -185,8 +195,8 @@ fn refine_emit_body(wg: u32, t: u32, last: bool) {
                 if ((mask & (1u << c)) == 0u) { continue; }
                 let x = quad_x(q) * 2u + (c & 1u);
                 let y = quad_y(q) * 2u + (c >> 1u);
-                put_quad(out, Quad(q.instance, child, pack_pos(level, x, y, quad_slab(q)),
-                    q.dir_weight), last);
+                put_quad(front, out, Quad(q.instance, child,
+                    pack_pos(level, x, y, quad_slab(q)), q.dir_weight), last);
                 out = out + 1u;
                 child = child + 1u;
             }
@@ -206,12 +216,14 @@ fn refine_emit_last(@builtin(workgroup_id) wg: vec3<u32>,
     refine_emit_body(wg.x, t, true);
 }
 
-// After the last step: the final stream's length, in the statistics and the draw arguments.
+// After the last step: the final stream's length, in the statistics and the draw arguments;
+// the composited quads' level (0), which no emitter counted.
 @compute @workgroup_size(1)
 fn refine_finish() {
     let n = advance();
     atomicStore(&state.n, n);
     atomicStore(&state.pmin, NONE);
     atomicStore(&state.quads, n);
+    atomicAdd(&state.per_level[0], stream_front());
     set_args(n);
 }

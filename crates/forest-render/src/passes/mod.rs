@@ -73,7 +73,7 @@ pub const COMPUTE_SLOTS: [Slot; 16] = [
     Slot::ReadWrite,   // 11 data of the next step (the emitters' wishes)
     Slot::ReadWrite,   // 12 data (counts, wishes, prefixes)
     Slot::ReadWrite,   // 13 block sums
-    Slot::Read,        // 14 quads in
+    Slot::ReadWrite,   // 14 quads in (the cull writes composited quads to both buffers)
     Slot::ReadWrite,   // 15 quads out
 ];
 
