@@ -4,103 +4,166 @@ mod common;
 
 use forest_render::options::RendererOptions;
 use forest_render::reference;
+use forest_render::scene::SpeciesData;
 use forest_render::target::Target;
-use forest_render::{GpuScene, QuadStream};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
-/// Per view: (name, quads, visible trees, overflow, composited quads, refined quads).
-type Summary = (String, usize, u32, u32, u32, u32);
+/// What one compared view drew.
+#[derive(Clone, Debug)]
+struct Summary {
+    name: String,
+    quads: usize,
+    visible: u32,
+    /// Level-0 quads dropped plus quads left unrefined.
+    overflow: u32,
+    overflow_cull: u32,
+    /// Far trees' composited quads at level 0, before any were dropped.
+    composites_all: u32,
+    /// Composited quads drawn (leading the stream).
+    composites: u32,
+    /// Quads below level 0.
+    refined: u32,
+}
 
-fn check(trees: u32, max_quads: Option<u32>) -> Vec<Summary> {
+/// Along the ground at a coarse ε: the far trees are composited, the near ones refined.
+fn coarse_view(side: f32) -> Camera {
+    common::camera(
+        glam::Vec3::new(-side * 0.7, 0.5, 0.0),
+        glam::Vec3::new(0.0, 0.6, 0.0),
+        16.0,
+    )
+}
+
+/// Render one view and require the GPU's stream and counters to equal the reference's, run
+/// with the stream's capacity and iterations.
+fn compare(
+    ctx: &GpuContext,
+    stream: &mut QuadStream,
+    target: &Target,
+    name: &str,
+    cam: &Camera,
+) -> Summary {
+    stream.render_frame(ctx, cam, target).unwrap();
+    let gpu = stream.read_quads(ctx);
+    let stats = stream.read_stats(ctx);
+    let cpu = reference::run_with(
+        &stream.scene.tables,
+        &cam.to_gpu(),
+        stream.capacity.quads,
+        stream.iterations(),
+    );
+    assert_eq!(
+        ctx.take_errors(),
+        Vec::<String>::new(),
+        "{name}: wgpu errors"
+    );
+    assert_eq!(stats.presort, cpu.presort, "{name}: presort direction");
+    assert_eq!(stats.visible_trees, cpu.visible, "{name}: visible trees");
+    assert_eq!(
+        stats.overflow_cull, cpu.overflow_cull,
+        "{name}: cull overflow"
+    );
+    assert_eq!(
+        stats.overflow_refine, cpu.overflow_refine,
+        "{name}: refine overflow"
+    );
+    if let Some(i) = gpu.iter().zip(&cpu.quads).position(|(a, b)| a != b) {
+        panic!(
+            "{name}: quad {i} of {}/{} differs: GPU {:?} CPU {:?}",
+            gpu.len(),
+            cpu.quads.len(),
+            gpu[i],
+            cpu.quads[i]
+        );
+    }
+    assert_eq!(gpu.len(), cpu.quads.len(), "{name}: stream length");
+    // Two lists: the kept composited quads lead the stream, and only they.
+    let kept = cpu.composites.saturating_sub(cpu.overflow_cull);
+    assert_eq!(stats.composites, kept, "{name}: composited quads");
+    assert!(
+        cpu.quads
+            .iter()
+            .enumerate()
+            .all(|(i, q)| q.composite() == (i < kept as usize)),
+        "{name}: composited quads lead the reference's stream"
+    );
+    assert_eq!(stats.per_level, cpu.per_level, "{name}: quads per level");
+    assert_eq!(stats.quads as usize, gpu.len(), "{name}: quads counted");
+    assert!(gpu.len() <= stream.capacity.quads as usize);
+    Summary {
+        name: name.to_string(),
+        quads: gpu.len(),
+        visible: stats.visible_trees,
+        overflow: stats.overflow_refine + stats.overflow_cull,
+        overflow_cull: stats.overflow_cull,
+        composites_all: cpu.composites,
+        composites: stats.composites,
+        refined: stats.per_level.iter().skip(1).sum(),
+    }
+}
+
+/// The shared cameras and the coarse view over a forest of `trees` of `species`.
+fn check_species(species: &[SpeciesData], trees: u32, max_quads: Option<u32>) -> Vec<Summary> {
     let ctx = common::ctx();
     let forest = common::forest(trees);
-    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let scene = GpuScene::new(&ctx, species, &forest).unwrap();
     let (mut stream, target) = common::small_stream(&ctx, scene, max_quads);
     let side = forest.extent();
-    let mut summary = Vec::new();
     let mut views = common::cameras(side);
-    // Along the ground at a coarse ε: the far trees are composited, the near ones refined.
-    views.push((
-        "horizon_coarse",
-        common::camera(
-            glam::Vec3::new(-side * 0.7, 0.5, 0.0),
-            glam::Vec3::new(0.0, 0.6, 0.0),
-            16.0,
-        ),
-    ));
-    for (name, cam) in views {
-        stream.render_frame(&ctx, &cam, &target).unwrap();
-        let gpu = stream.read_quads(&ctx);
-        let stats = stream.read_stats(&ctx);
-        let cpu = reference::run(&stream.scene.tables, &cam.to_gpu(), stream.capacity.quads);
-        assert_eq!(
-            ctx.take_errors(),
-            Vec::<String>::new(),
-            "{name}: wgpu errors"
-        );
-        assert_eq!(stats.presort, cpu.presort, "{name}: presort direction");
-        assert_eq!(stats.visible_trees, cpu.visible, "{name}: visible trees");
-        assert_eq!(
-            stats.overflow_cull, cpu.overflow_cull,
-            "{name}: cull overflow"
-        );
-        assert_eq!(
-            stats.overflow_refine, cpu.overflow_refine,
-            "{name}: refine overflow"
-        );
-        if let Some(i) = gpu.iter().zip(&cpu.quads).position(|(a, b)| a != b) {
-            panic!(
-                "{name}: quad {i} of {}/{} differs: GPU {:?} CPU {:?}",
-                gpu.len(),
-                cpu.quads.len(),
-                gpu[i],
-                cpu.quads[i]
-            );
-        }
-        assert_eq!(gpu.len(), cpu.quads.len(), "{name}: stream length");
-        // Two lists: the kept composited quads lead the stream, and only they.
-        let kept = cpu.composites.saturating_sub(cpu.overflow_cull);
-        assert_eq!(stats.composites, kept, "{name}: composited quads");
-        assert!(
-            cpu.quads
-                .iter()
-                .enumerate()
-                .all(|(i, q)| q.composite() == (i < kept as usize)),
-            "{name}: composited quads lead the reference's stream"
-        );
-        assert_eq!(stats.per_level, cpu.per_level, "{name}: quads per level");
-        assert!(gpu.len() <= stream.capacity.quads as usize);
-        summary.push((
-            name.to_string(),
-            gpu.len(),
-            stats.visible_trees,
-            stats.overflow_refine + stats.overflow_cull,
-            stats.composites,
-            stats.per_level.iter().skip(1).sum(),
-        ));
-    }
-    summary
+    views.push(("horizon_coarse", coarse_view(side)));
+    views
+        .iter()
+        .map(|(name, cam)| compare(&ctx, &mut stream, &target, name, cam))
+        .collect()
+}
+
+fn check(trees: u32, max_quads: Option<u32>) -> Vec<Summary> {
+    check_species(&common::species(), trees, max_quads)
+}
+
+fn find<'a>(s: &'a [Summary], name: &str) -> &'a Summary {
+    s.iter().find(|x| x.name == name).unwrap()
 }
 
 #[test]
 fn gpu_stream_equals_the_cpu_reference() {
     let s = check(300, None);
     eprintln!("{s:?}");
-    let get = |n: &str| s.iter().find(|x| x.0 == n).unwrap().clone();
-    assert!(get("inside").1 > 0 && get("birds_eye").1 > 0 && get("horizon").1 > 0);
-    assert_eq!(get("culled").1, 0, "nothing visible");
-    assert_eq!(get("culled").2, 0);
+    let get = |n: &str| find(&s, n);
+    assert!(get("inside").quads > 0 && get("birds_eye").quads > 0 && get("horizon").quads > 0);
+    assert_eq!(get("culled").quads, 0, "nothing visible");
+    assert_eq!(get("culled").visible, 0);
     assert!(
-        get("birds_eye").2 > get("inside").2,
+        get("birds_eye").visible > get("inside").visible,
         "a bird's eye sees more trees"
     );
     assert!(
-        s.iter().all(|x| x.3 == 0),
+        s.iter().all(|x| x.overflow == 0),
         "no overflow at the formula's capacity"
     );
     // A view that composites far trees and refines near ones: refinement runs over the
     // plain quads behind the composited ones.
     let coarse = get("horizon_coarse");
-    assert!(coarse.4 > 0 && coarse.5 > 0, "{coarse:?}");
+    assert!(coarse.composites > 0 && coarse.refined > 0, "{coarse:?}");
+}
+
+/// Refinement alternates the stream buffers, so the final stream lies in the second buffer
+/// after an odd number of steps: the composited quads, which no step writes, must be there
+/// too (the test atlases' 5 levels give an even 4 steps; 64 px with 8-px finest quads give 4
+/// levels, 3 steps).
+#[test]
+fn an_odd_number_of_refinement_steps_keeps_the_composited_quads() {
+    let species = common::species_with(&forest_format::BakeParams {
+        directions: 5,
+        resolution: 64,
+        min_quad: 8,
+        spp: 2,
+        ..forest_format::BakeParams::default()
+    });
+    let s = check_species(&species, 300, None);
+    eprintln!("{s:?}");
+    let coarse = find(&s, "horizon_coarse");
+    assert!(coarse.composites > 0 && coarse.refined > 0, "{coarse:?}");
 }
 
 #[test]
@@ -108,12 +171,46 @@ fn overflow_keeps_to_the_capacity_and_matches_the_reference() {
     let s = check(300, Some(700));
     eprintln!("{s:?}");
     assert!(
-        s.iter().any(|x| x.3 > 0),
+        s.iter().any(|x| x.overflow > 0),
         "a small stream overflows somewhere"
     );
     // Also where composited quads lead the stream and refinement runs behind them.
-    assert!(s.iter().any(|x| x.3 > 0 && x.4 > 0 && x.5 > 0), "{s:?}");
-    assert!(s.iter().all(|x| x.1 <= 700));
+    assert!(
+        s.iter()
+            .any(|x| x.overflow > 0 && x.composites > 0 && x.refined > 0),
+        "{s:?}"
+    );
+    assert!(s.iter().all(|x| x.quads <= 700));
+}
+
+/// A level-0 stream longer than the capacity loses its first quads: the composited ones, then
+/// the farthest trees' plain quads. Capacities chosen from the view's level-0 counts drop
+/// part of the composited list, then all of it and some plain quads.
+#[test]
+fn cull_overflow_drops_the_composited_quads_first() {
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    let cam = coarse_view(forest.extent());
+    let species = common::species();
+    let level0 = {
+        let scene = GpuScene::new(&ctx, &species, &forest).unwrap();
+        reference::run_with(&scene.tables, &cam.to_gpu(), u32::MAX, 0)
+    };
+    let (total, all) = (level0.quads.len() as u32, level0.composites);
+    assert!(
+        all > 4 && total > all + 4,
+        "{total} level-0 quads, {all} composited"
+    );
+    for (capacity, kept) in [(total - all / 2, all - all / 2), (total - all - 4, 0)] {
+        let scene = GpuScene::new(&ctx, &species, &forest).unwrap();
+        let (mut stream, target) = common::small_stream(&ctx, scene, Some(capacity));
+        let s = compare(&ctx, &mut stream, &target, "horizon_coarse", &cam);
+        assert_eq!(
+            (s.overflow_cull, s.composites_all, s.composites),
+            (total - capacity, all, kept),
+            "capacity {capacity}"
+        );
+    }
 }
 
 #[test]
@@ -129,23 +226,17 @@ fn static_impostors_are_the_level0_stream() {
     let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
     assert_eq!(stream.iterations(), 0);
     let target = Target::new(&ctx, 160, 120);
-    for (name, cam) in common::cameras(forest.extent()) {
-        stream.render_frame(&ctx, &cam, &target).unwrap();
-        let gpu = stream.read_quads(&ctx);
-        let cpu = reference::run_with(
-            &stream.scene.tables,
-            &cam.to_gpu(),
-            stream.capacity.quads,
-            0,
-        );
-        assert_eq!(gpu, cpu.quads, "{name}");
-        assert!(
-            gpu.iter().all(|q| q.level() == 0),
-            "{name}: only level-0 quads"
-        );
+    let mut views = common::cameras(forest.extent());
+    views.push(("horizon_coarse", coarse_view(forest.extent())));
+    let mut composited = 0;
+    for (name, cam) in views {
+        let s = compare(&ctx, &mut stream, &target, name, &cam);
+        assert_eq!(s.refined, 0, "{name}: only level-0 quads");
+        composited += s.composites;
         let _ = target.read(&ctx);
         assert_eq!(ctx.take_errors(), Vec::<String>::new());
     }
+    assert!(composited > 0, "some view composites far trees");
 }
 
 /// Long streams: the block sums of 1M trees (1954 blocks) and of their level-0 quads take the

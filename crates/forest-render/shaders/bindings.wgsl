@@ -20,7 +20,8 @@ struct SceneConsts {
 @group(0) @binding(8) var presort: texture_2d<u32>;
 @group(0) @binding(9) var nodes: texture_2d<u32>;
 @group(0) @binding(10) var<storage, read_write> state: StateAtomic;
-// Per item of the step being run: tree counts then offsets (cull), or each quad's wish then
+// Per item of the step being run: packed tree counts then offsets (cull), or each plain quad's
+// wish then
 // (prefix << 3) | wish (refine); the emitters write the next step's wishes to data_next.
 @group(0) @binding(11) var<storage, read_write> data_next: array<u32>;
 @group(0) @binding(12) var<storage, read_write> data: array<u32>;

@@ -76,7 +76,7 @@ struct State {
     n: u32,             // quads in the stream being refined (then in the final stream)
     total: u32,         // scan total
     pmin: u32,          // refine: smallest prefix among refined quads (0xffffffff: none)
-    overflow_cull: u32, // level-0 quads dropped (farthest trees first)
+    overflow_cull: u32, // level-0 quads dropped (composited ones, then the farthest trees')
     overflow_refine: u32, // quads left unrefined for lack of room
     visible: u32,       // trees passing the frustum test
     quads: u32,         // quads in the final stream
@@ -92,8 +92,8 @@ fn kept_composites(composites: u32, overflow_cull: u32) -> u32 {
 
 // Dispatch arguments (x, y, z) for each kind of dispatch, and the draw arguments.
 struct Args {
-    items: vec4<u32>,   // ceil(n / 256) workgroups (w unused)
-    blocks: vec4<u32>,  // ceil(n / 512)
+    items: vec4<u32>,   // ceil(m / 256) workgroups, m the plain quads (w unused)
+    blocks: vec4<u32>,  // ceil(m / 512)
     draw: vec4<u32>,    // plain quads: vertex count 4, instance count n − kept composites, 0, 0
     draw_composite: vec4<u32>, // composited quads: 4, kept composites, 0, 0
 }

@@ -9,8 +9,9 @@
 // first, then every other quad. A tree's count packs both (TREE_COMPOSITE per composited
 // quad above the plain count, which is at most 3 · 16 slabs, so a block's plain sum stays
 // below 2^16), and the two scans run side by side: block sums [0, B) plain, [B, 2B)
-// composited, B the blocks of trees. Refinement never moves a composited quad (its wish is
-// 0), so the final stream keeps them at its front and the draw pass draws each list alone.
+// composited, B the blocks of trees. The composited quads go to both stream buffers and
+// refinement never visits them (refine.wgsl), so the final stream keeps them at its front
+// and the draw pass draws each list alone.
 
 // Blend of the species' directions for an object-space view vector (unnormalised), exactly as
 // forest_format::directions::blend. Returns indices in .idx and weights in .w.
@@ -262,9 +263,9 @@ fn cull_count(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
 }
 
 // The scans of the block sums; the level-0 stream's length, C composited quads then P plain
-// ones. When the level-0 quads exceed the capacity, the farthest trees' quads are dropped
-// (the first `total − capacity` of the stream: composited ones first), so the near trees
-// stay.
+// ones. When the level-0 quads exceed the capacity, the first `total − capacity` of the
+// stream are dropped: the far trees' composited quads, then the farthest trees' plain ones,
+// so the near trees stay.
 @compute @workgroup_size(256)
 fn cull_top(@builtin(local_invocation_index) t: u32) {
     let blocks = tree_blocks();

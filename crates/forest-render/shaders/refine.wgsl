@@ -1,7 +1,7 @@
 // Pass 2, refine (run l − 1 times, input quads_in -> output quads_out): a quad whose
 // screen-projected edge is longer than ε pixels is replaced by its existing children (blank
 // ones were dropped at bake). Order is kept by a prefix sum over each quad's extra output.
-// When the output would overflow, the quads nearest the front of the stream (the nearest
+// When the output would overflow, the quads nearest the end of the stream (the nearest
 // trees) are refined first and the rest stay as they are, counted in state.overflow_refine.
 //
 // Three dispatches a step, the scan's phases fused into them (scan.wgsl):
@@ -32,7 +32,9 @@ fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
 
 // 0: keep; otherwise the number of children refining it makes (1 + its extra quads).
 fn wants(q: Quad) -> u32 {
-    // A far tree's composited quad is never refined (its children would be one slab's).
+    // A far tree's composited quad is never refined (its children would be one slab's). The
+    // steps never visit one (they start after the stream's front); the cull asks this of
+    // every quad it writes, so the rule stands here too, as in the CPU reference.
     if (quad_composite(q)) { return 0u; }
     let node = node_at(q.node);
     let mask = node.x >> 28u;

@@ -4,8 +4,9 @@
 //      `sums` (cull_count writes it; the emitters add each value with `add_to_block`);
 //   2. one workgroup scans the block sums in place (`scan_block_sums`), serially in chunks
 //      of 512 with a running carry, so any number of blocks fits;
-//   3. each block scans its own values and adds its block's offset (`block_prefix`), and
-//      clears its block sum for the next scan.
+//   3. each block scans its own values and adds its block's offset (`block_prefix`; the
+//      cull's packed two-list version is cull_down's own), and clears its block sum for the
+//      next scan.
 // Integer sums in a fixed order: the same values give the same prefixes on any GPU, and the
 // CPU reference (reference.rs) computes the same. Between scans every block sum is zero
 // (frame_setup clears them all; each block clears its own after reading it).

@@ -54,8 +54,9 @@ impl Capacity {
     /// first holds the level-0 quads of the visible trees, which no screen bound limits (a
     /// bird's-eye view sees every tree): it is an estimate, and a stream whose frames
     /// overflow it grows to what they need ([`crate::QuadStream::fit`]). When a frame needs
-    /// more than the stream holds, the overflow policy applies (farthest trees and quads
-    /// first) and counters report it; nothing is written out of bounds.
+    /// more than the stream holds, the overflow policy applies (far trees' composited quads,
+    /// then the farthest trees' quads first; refinement for the nearest) and counters report
+    /// it; nothing is written out of bounds.
     pub fn new(c: &CapacityInput) -> Self {
         let quads = c.max_quads.unwrap_or_else(|| {
             let pixels = u64::from(c.viewport.0) * u64::from(c.viewport.1);

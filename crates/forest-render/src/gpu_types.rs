@@ -185,9 +185,9 @@ pub struct GpuState {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct GpuArgs {
-    /// Per-item dispatches: one workgroup per 256 quads.
+    /// Per-item dispatches: one workgroup per 256 plain quads.
     pub items: [u32; 4],
-    /// Per-block dispatches: one workgroup per 512 quads.
+    /// Per-block dispatches: one workgroup per 512 plain quads.
     pub blocks: [u32; 4],
     /// Draw of the plain quads: vertex count, instance count, first vertex, first instance.
     pub draw: [u32; 4],

@@ -21,16 +21,21 @@ pub fn atlases() -> &'static [Atlas] {
             spp: 2,
             ..BakeParams::default()
         };
-        ["bush", "pine"]
-            .iter()
-            .map(|s| {
-                let p = root().join(format!("assets/trees/{s}/{s}.obj"));
-                forest_bake::bake_file(&p, &params, &|_, _| {})
-                    .unwrap()
-                    .atlas
-            })
-            .collect()
+        bake(&params)
     })
+}
+
+/// Bush and pine baked with `params`.
+fn bake(params: &BakeParams) -> Vec<Atlas> {
+    ["bush", "pine"]
+        .iter()
+        .map(|s| {
+            let p = root().join(format!("assets/trees/{s}/{s}.obj"));
+            forest_bake::bake_file(&p, params, &|_, _| {})
+                .unwrap()
+                .atlas
+        })
+        .collect()
 }
 
 pub fn root() -> PathBuf {
@@ -38,13 +43,19 @@ pub fn root() -> PathBuf {
 }
 
 pub fn species() -> Vec<SpeciesData> {
-    atlases()
-        .iter()
-        .map(|a| SpeciesData {
-            layers: a.decode_layers(Path::new("test")).unwrap(),
-            atlas: a.clone(),
-        })
-        .collect()
+    atlases().iter().map(species_data).collect()
+}
+
+fn species_data(a: &Atlas) -> SpeciesData {
+    SpeciesData {
+        layers: a.decode_layers(Path::new("test")).unwrap(),
+        atlas: a.clone(),
+    }
+}
+
+/// Bush and pine baked with `params` (not cached).
+pub fn species_with(params: &BakeParams) -> Vec<SpeciesData> {
+    bake(params).iter().map(species_data).collect()
 }
 
 pub fn forest(trees: u32) -> Forest {

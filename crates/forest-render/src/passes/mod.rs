@@ -217,9 +217,9 @@ pub struct StreamBindings<'a> {
 
 /// Byte offsets of the dispatch arguments in the args buffer (see `GpuArgs`).
 pub mod args {
-    /// `ceil(n/256)` workgroups.
+    /// `ceil(m/256)` workgroups, `m` the plain quads (the composited ones are never refined).
     pub const ITEMS: u64 = 0;
-    /// `ceil(n/512)`.
+    /// `ceil(m/512)`.
     pub const BLOCKS: u64 = 16;
     /// Draw arguments of the plain quads.
     pub const DRAW: u64 = 32;
