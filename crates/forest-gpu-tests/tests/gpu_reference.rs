@@ -78,7 +78,7 @@ fn compare(
     }
     assert_eq!(gpu.len(), cpu.quads.len(), "{name}: stream length");
     // Two lists: the kept composited quads lead the stream, and only they.
-    let kept = cpu.composites.saturating_sub(cpu.overflow_cull);
+    let kept = cpu.kept_composites();
     assert_eq!(stats.composites, kept, "{name}: composited quads");
     assert!(
         cpu.quads

@@ -30,12 +30,10 @@ fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
     return quad_clip_at(q, u, v, t);
 }
 
-// 0: keep; otherwise the number of children refining it makes (1 + its extra quads).
+// 0: keep; otherwise the number of children refining it makes (1 + its extra quads). Asked
+// of plain quads only: a far tree's composited quad, never refined, is written by the cull
+// itself and no step visits it (the CPU reference, whose stream holds both lists, gives it 0).
 fn wants(q: Quad) -> u32 {
-    // A far tree's composited quad is never refined (its children would be one slab's). The
-    // steps never visit one (they start after the stream's front); the cull asks this of
-    // every quad it writes, so the rule stands here too, as in the CPU reference.
-    if (quad_composite(q)) { return 0u; }
     let node = node_at(q.node);
     let mask = node.x >> 28u;
     if (mask == 0u) { return 0u; }
@@ -116,8 +114,9 @@ fn refine_top(@builtin(local_invocation_index) t: u32) {
         atomicStore(&state.pmin, NONE);
         set_args(n);
     }
-    let m = n - stream_front();
-    let total = scan_block_sums(t, 0u, (m + BLOCK - 1u) / BLOCK);
+    var plain_blocks = 0u;
+    if (t == 0u) { plain_blocks = (n - stream_front() + BLOCK - 1u) / BLOCK; }
+    let total = scan_block_sums(t, 0u, plain_blocks);
     if (t == 0u) { atomicStore(&state.total, total); }
 }
 

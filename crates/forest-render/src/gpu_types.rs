@@ -154,6 +154,12 @@ impl Quad {
     }
 }
 
+/// Composited quads leading a stream whose level 0 had `composites` of them and dropped its
+/// first `overflow_cull` quads for room (`kept_composites` in common.wgsl).
+pub fn kept_composites(composites: u32, overflow_cull: u32) -> u32 {
+    composites.saturating_sub(overflow_cull)
+}
+
 /// Frame state written by the GPU (100 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]

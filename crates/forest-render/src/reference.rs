@@ -7,7 +7,7 @@ use glam::{Vec3, Vec4};
 use forest_format::QuadNode;
 use forest_format::node::ERROR_BOUNDS;
 
-use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE};
+use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE, kept_composites};
 use crate::options::{FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST};
 use crate::scene::SceneTables;
 
@@ -29,6 +29,13 @@ pub struct Reference {
     /// Far trees' composited quads at level 0, before any were dropped (those kept lead the
     /// stream).
     pub composites: u32,
+}
+
+impl Reference {
+    /// Composited quads leading the final stream.
+    pub fn kept_composites(&self) -> u32 {
+        kept_composites(self.composites, self.overflow_cull)
+    }
 }
 
 fn to_world(inst: &GpuInstance, p: Vec3) -> Vec3 {
@@ -219,6 +226,7 @@ fn edge_long(cam: &GpuCamera, a: Vec4, b: Vec4) -> bool {
 
 /// 0: keep; else 1 + extra quads (see `wants` in `shaders/refine.wgsl`).
 fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
+    // A far tree's composited quad is never refined (the GPU's steps never visit one).
     if q.composite() {
         return 0;
     }

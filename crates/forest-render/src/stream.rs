@@ -798,7 +798,7 @@ impl QuadStream {
             presort: s.presort,
             visible_trees: s.visible,
             quads: s.quads,
-            composites: s.composites - s.composites.min(s.overflow_cull),
+            composites: crate::gpu_types::kept_composites(s.composites, s.overflow_cull),
             per_level: s.per_level[..levels].to_vec(),
             overflow_cull: s.overflow_cull,
             overflow_refine: s.overflow_refine,
