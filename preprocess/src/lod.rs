@@ -558,8 +558,17 @@ pub fn billboard_images(
 /// Give blank texels (alpha 0) the colour of a covered neighbour, ring by ring, so that
 /// bilinear filtering and mip-mapping at silhouettes average only real colours.
 pub fn dilate_colour(img: &mut image::RgbaImage) {
+    dilate_colour_from(img, 1);
+}
+
+/// [`dilate_colour`] from the texels whose alpha is at least `min_alpha` (1..=255): every
+/// other texel takes the colour of the nearest such texel, ring by ring. With 128 only the
+/// texels that pass a 0.5 alpha test keep their colour (an alpha-tested texture's fringe of
+/// faint texels, often matted against another colour, never shows).
+pub fn dilate_colour_from(img: &mut image::RgbaImage, min_alpha: u8) {
     let (w, h) = img.dimensions();
-    let mut known: Vec<bool> = img.pixels().map(|p| p[3] > 0).collect();
+    let min_alpha = min_alpha.max(1);
+    let mut known: Vec<bool> = img.pixels().map(|p| p[3] >= min_alpha).collect();
     if !known.iter().any(|k| *k) {
         return;
     }

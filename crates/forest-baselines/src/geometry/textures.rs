@@ -47,11 +47,20 @@ pub(super) fn material_layer(
     out
 }
 
-/// Mip chain of an RGBA8 (sRGB) image down to 1×1, level 0 first, concatenated. Each level is
-/// filtered (triangle) from the one before in linear light, as the atlas's mips are, and
-/// encoded back to sRGB. Alpha is rescaled per level so that the share of texels passing the
-/// 0.5 alpha test stays that of level 0 (Castaño's coverage-preserving mips): plain averaging
-/// erodes alpha-tested leaves into nothing at a distance.
+/// Mip chain of an RGBA8 (sRGB) image down to 1×1, level 0 first, concatenated.
+///
+/// The geometry methods alpha-test every texture at 0.5, so a texel either shows its own
+/// colour or nothing. Each level's colour is therefore the mean, in linear light, of the
+/// level-0 texels under it that pass the test (triangle-filtered level by level with those
+/// texels as weights; the bake's point samples see the same colours), encoded back to sRGB;
+/// where no passing texel lies under a texel, it keeps the filtered colour of the dilated
+/// image (the nearest passing texel's). Averaging the colours of failing texels instead
+/// (blank, or the faint fringe that leaf textures carry, often matted against white or sky
+/// blue) tints distant foliage with them.
+///
+/// Alpha is rescaled per level so that the share of texels passing the 0.5 alpha test stays
+/// that of level 0 (Castaño's coverage-preserving mips): plain averaging erodes alpha-tested
+/// leaves into nothing at a distance.
 pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     use forest_format::shading::{srgb_decode_table, srgb_encode};
     let coverage = |m: &image::RgbaImage, scale: f32| {
@@ -63,26 +72,41 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     let target = coverage(img, 1.0);
     let mut data = Vec::new();
     let mut dilated = img.clone();
-    // Filtering must not mix in the colour of transparent texels (the bake never sees them).
-    forest_bake::lod::dilate_colour(&mut dilated);
+    // Level 0's bilinear filter must not mix in the colour of failing texels either.
+    forest_bake::lod::dilate_colour_from(&mut dilated, ALPHA_TEST_BYTE);
     let table = srgb_decode_table();
-    let mut linear = image::Rgba32FImage::from_fn(img.width(), img.height(), |x, y| {
+    let linear = |x: u32, y: u32| {
         let p = dilated.get_pixel(x, y).0;
-        image::Rgba([
+        [
             table[p[0] as usize],
             table[p[1] as usize],
             table[p[2] as usize],
-            f32::from(p[3]) / 255.0,
-        ])
+        ]
+    };
+    // Colour and alpha as filtered; and colour × pass weight, with the weight in alpha.
+    let mut plain = image::Rgba32FImage::from_fn(img.width(), img.height(), |x, y| {
+        let [r, g, b] = linear(x, y);
+        image::Rgba([r, g, b, f32::from(img.get_pixel(x, y)[3]) / 255.0])
     });
-    let encode = |m: &image::Rgba32FImage| {
+    let mut passing = image::Rgba32FImage::from_fn(img.width(), img.height(), |x, y| {
+        let w = f32::from(u8::from(img.get_pixel(x, y)[3] >= ALPHA_TEST_BYTE));
+        let [r, g, b] = linear(x, y);
+        image::Rgba([r * w, g * w, b * w, w])
+    });
+    let encode = |plain: &image::Rgba32FImage, passing: &image::Rgba32FImage| {
         let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-        image::RgbaImage::from_fn(m.width(), m.height(), |x, y| {
-            let p = m.get_pixel(x, y).0;
+        image::RgbaImage::from_fn(plain.width(), plain.height(), |x, y| {
+            let p = plain.get_pixel(x, y).0;
+            let q = passing.get_pixel(x, y).0;
+            let c = if q[3] > 1e-4 {
+                [q[0] / q[3], q[1] / q[3], q[2] / q[3]]
+            } else {
+                [p[0], p[1], p[2]]
+            };
             image::Rgba([
-                byte(srgb_encode(p[0])),
-                byte(srgb_encode(p[1])),
-                byte(srgb_encode(p[2])),
+                byte(srgb_encode(c[0])),
+                byte(srgb_encode(c[1])),
+                byte(srgb_encode(c[2])),
                 byte(p[3]),
             ])
         })
@@ -94,8 +118,10 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
             (img.width() >> level).max(1),
             (img.height() >> level).max(1),
         );
-        linear = image::imageops::resize(&linear, w, h, image::imageops::FilterType::Triangle);
-        let mut m = encode(&linear);
+        use image::imageops::{FilterType, resize};
+        plain = resize(&plain, w, h, FilterType::Triangle);
+        passing = resize(&passing, w, h, FilterType::Triangle);
+        let mut m = encode(&plain, &passing);
         if target > 0.0 && target < 1.0 {
             // Bisect the alpha scale whose coverage matches level 0's.
             let (mut lo, mut hi) = (0.0f32, 8.0f32);
@@ -115,6 +141,9 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     }
     (data, mips)
 }
+
+/// The smallest alpha byte that passes the geometry shaders' 0.5 alpha test.
+const ALPHA_TEST_BYTE: u8 = 128;
 
 /// An sRGB RGBA8 2D-array texture with mips from square layers of side `size`.
 pub(super) fn layered_texture(
@@ -183,5 +212,24 @@ mod tests {
         let last = &data[data.len() - 4..];
         assert!((186..=190).contains(&last[0]), "{last:?}");
         assert_eq!(last[3], 255);
+    }
+
+    #[test]
+    fn mip_colour_is_that_of_the_texels_passing_the_alpha_test() {
+        // Left half opaque red; then a faint white fringe (alpha 100, never drawn) and blank
+        // sky-blue texels. Every level shows red alone, as the alpha-tested texels do.
+        let img = image::RgbaImage::from_fn(4, 4, |x, _| match x {
+            0 | 1 => image::Rgba([255, 0, 0, 255]),
+            2 => image::Rgba([255, 255, 255, 100]),
+            _ => image::Rgba([80, 110, 115, 0]),
+        });
+        let (data, mips) = mip_chain(&img);
+        assert_eq!(mips, 3);
+        for (level, texel) in data.chunks_exact(4).enumerate() {
+            assert_eq!(texel[..3], [255, 0, 0], "texel {level}: {texel:?}");
+        }
+        // Half the texels pass at every level (Castaño), so the 1×1 level passes.
+        let last = &data[data.len() - 4..];
+        assert!(last[3] >= 128, "{last:?}");
     }
 }
