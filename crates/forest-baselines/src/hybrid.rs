@@ -17,22 +17,24 @@ use forest_render::forms::{FORMS_GEOMETRY, GEOMETRY_ALWAYS};
 use crate::geometry::MeshMethod;
 use forest_render::context::RenderError;
 
-/// [`Near::Auto`] switches where the finest quads project longer than ε, but never below
-/// this many pixels: nearer than that the quad stream is as accurate as full geometry at 1×.
+/// [`Near::Auto`] switches where a tree's finest quads project this many pixels: nearer, the
+/// quad stream is less accurate than full geometry at 1× at every ε.
 pub const AUTO_MIN_PIXELS: f32 = 1.5;
 
 /// Where the near trees end.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Near {
-    /// Where the quad stream's error exceeds ε because it has run out of levels: the distance
-    /// below which a tree's finest quads project longer than `max(ε, AUTO_MIN_PIXELS)`
-    /// pixels, `2 R · focal / (2^(levels−1) · max(ε, 1.5))` for a crown of radius `R` (it
-    /// follows the tree's size, the viewport, the field of view and ε). Measured on the
-    /// bundled oak, pine and aspen (400×300, 60°, 8 levels, ε 1 and 2 alike, since the stream
-    /// is out of levels there), the quad stream's FLIP against the 4×4 reference falls below
-    /// that of full geometry at 1× beyond 3, 2 and 2.2 crown radii: where the finest quads
-    /// project 1.35–2 px. At 400×300 the switch is 2.7 crown radii for ε ≤ 1.5, 2 at ε = 2,
-    /// 1 at ε = 4.
+    /// Where the quad stream, out of levels, becomes less accurate than the tree's own
+    /// triangles: the distance below which a tree's finest quads project longer than
+    /// [`AUTO_MIN_PIXELS`], `2 R · focal / (2^(levels−1) · 1.5)` for a crown of radius `R` (it
+    /// follows the tree's size, the viewport and the field of view; 2.7 crown radii at
+    /// 400×300 and 60° with 8 levels). Measured on the bundled oak, pine and aspen (400×300,
+    /// 60°, 8 levels), the quad stream's FLIP against the 4×4 reference falls below that of
+    /// full geometry at 1× beyond 3, 2 and 2.2 crown radii: where the finest quads project
+    /// 1.35–2 px. ε does not move the switch: a coarser ε makes the near trees' quads
+    /// coarser still, not better, and the walkthrough's error is theirs (an ε-scaled switch,
+    /// 2.7 radii / max(ε/1.5, 1), left the hybrid at ε 8–32 less accurate than the discrete
+    /// LODs at the same time).
     Auto,
     /// A fixed distance in metres from the eye to a tree's bounding-sphere centre: 0 draws
     /// every tree as quads, infinity every tree as geometry.
@@ -97,10 +99,10 @@ impl Hybrid {
 }
 
 /// [`Near::Auto`]'s switch distance in crown radii: where the finest quads of a hierarchy of
-/// `levels` levels, `2R / 2^(levels−1)` wide, project to `max(ε, AUTO_MIN_PIXELS)` pixels.
+/// `levels` levels, `2R / 2^(levels−1)` wide, project to [`AUTO_MIN_PIXELS`] pixels.
 pub fn auto_radii(camera: &Camera, levels: u32) -> f32 {
     let finest = (1u64 << levels.clamp(1, 32).saturating_sub(1)) as f32;
-    2.0 * camera.focal_pixels() / (finest * camera.epsilon.max(AUTO_MIN_PIXELS))
+    2.0 * camera.focal_pixels() / (finest * AUTO_MIN_PIXELS)
 }
 
 #[cfg(test)]
@@ -121,19 +123,22 @@ mod tests {
     }
 
     #[test]
-    fn auto_switch_is_where_the_finest_quads_project_to_epsilon() {
+    fn auto_switch_is_where_the_finest_quads_project_to_one_and_a_half_pixels() {
         let c = cam(2.0);
         let k = auto_radii(&c, 8);
         // A crown of radius 5 m: finest quads 10/128 m wide, seen from k·5 m away.
         let px = (10.0 / 128.0) * c.focal_pixels() / (k * 5.0);
-        assert!((px - 2.0).abs() < 1e-4, "{px}");
-        // 400×300 at 60°: focal 259.8 px, so 2·259.8/(128·2) ≈ 2.03 crown radii at ε = 2.
-        assert!((k - 259.8076 / 128.0).abs() < 1e-3, "{k}");
-        assert!((auto_radii(&cam(4.0), 8) - k / 2.0).abs() < 1e-5);
-        // Below AUTO_MIN_PIXELS, ε no longer moves the switch.
-        let floor = auto_radii(&cam(AUTO_MIN_PIXELS), 8);
-        assert_eq!(auto_radii(&cam(0.5), 8), floor);
-        assert!((floor - k * 2.0 / AUTO_MIN_PIXELS).abs() < 1e-5);
+        assert!((px - AUTO_MIN_PIXELS).abs() < 1e-4, "{px}");
+        // 400×300 at 60°: focal 259.8 px, so 2·259.8/(128·1.5) ≈ 2.71 crown radii.
+        assert!((k - 2.0 * 259.8076 / (128.0 * 1.5)).abs() < 1e-3, "{k}");
+        // ε does not move it; the viewport and the levels do.
+        for e in [0.5, 1.0, 4.0, 32.0] {
+            assert_eq!(auto_radii(&cam(e), 8), k);
+        }
+        assert!((auto_radii(&c, 9) - k / 2.0).abs() < 1e-5);
+        let mut wide = c;
+        wide.viewport = (800, 600);
+        assert!((auto_radii(&wide, 8) - 2.0 * k).abs() < 1e-4);
     }
 
     #[test]

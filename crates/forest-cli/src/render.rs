@@ -120,9 +120,9 @@ pub struct MethodArgs {
     #[arg(long)]
     pub far_slabs: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
-    /// geometry; `auto`: where the quad stream runs out of levels, i.e. where a tree's finest
-    /// quads project longer than ε (at least 1.5 px; it follows each tree's size, the view
-    /// and ε).
+    /// geometry; `auto`: where the quad stream, out of levels, becomes less accurate than
+    /// the tree's triangles, i.e. where a tree's finest quads project longer than 1.5 px (it
+    /// follows each tree's size and the view, not ε).
     #[arg(long, default_value = "auto", value_parser = parse_near)]
     pub near: Near,
     /// Hybrid: width of the transition band, as a fraction of the switch distance (a tree

@@ -70,6 +70,13 @@ pub struct BenchArgs {
     /// Frames measured per setting (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub frames: u32,
+    /// Accuracy suite: measure only these views (comma-separated; default: all). Use with
+    /// its own --out: the CSV, charts and report then hold these views alone.
+    #[arg(long, value_delimiter = ',', value_parser = ["close-up", "mid-range", "birds-eye", "walkthrough"])]
+    pub views: Vec<String>,
+    /// Accuracy suite: measure only these methods (comma-separated; default: all).
+    #[arg(long, value_delimiter = ',', value_parser = ["quads", "impostor", "geometry", "stochastic", "lods", "hybrid"])]
+    pub methods: Vec<String>,
 }
 
 /// What every suite works with.
@@ -93,6 +100,10 @@ pub struct Bench {
     pub quick: bool,
     /// Frames measured per setting.
     pub frames: u32,
+    /// Accuracy suite: the views to measure (empty: all).
+    pub views: Vec<String>,
+    /// Accuracy suite: the methods to measure (empty: all).
+    pub methods: Vec<String>,
 }
 
 /// The median (the lower middle for even counts); 0 for none.
@@ -164,6 +175,8 @@ impl Bench {
             out: args.out.clone(),
             quick: args.quick,
             frames: if args.quick { 1 } else { args.frames.max(1) },
+            views: args.views.clone(),
+            methods: args.methods.clone(),
         })
     }
 
