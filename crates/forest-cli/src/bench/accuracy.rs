@@ -265,7 +265,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             let mut work = Vec::new();
             for (cam, reference) in cams.iter().zip(&references) {
                 let mut c = *cam;
-                c.epsilon = epsilon_of(&param);
+                c.epsilon = epsilon_of(param);
                 let (s, t) = b.measure(&mut r, method, &c, &target, b.frames_for(method))?;
                 // The measured frames gathered statistics (set below); the background is
                 // transparent, so the image's alpha is the coverage.
