@@ -21,7 +21,7 @@ for s in oak ash aspen pine bush; do
   fi
   species+=("$atlas")
 done
-$forest scene --trees 100000 --area-per-tree 10 --species "$(IFS=,; echo "${species[*]}")" --seed 1 -o out/forest-100k.forest
+$forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${species[*]}")" --seed 1 -o out/forest-100k.forest
 $forest render out/forest-100k.forest -o out/render/forest.png --view inside --view birds-eye --size 800x600
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-birds-eye.png"

@@ -23,6 +23,7 @@ fn the_example_matches_forest_render() {
     }
     ok(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "60",
         "--species",

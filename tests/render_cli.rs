@@ -33,6 +33,7 @@ fn bake_scene_render_end_to_end() {
     let species = format!("{},{}", p("bush.atlas"), p("aspen.atlas"));
     let text = ok(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "200",
         "--species",
@@ -71,6 +72,7 @@ fn bake_scene_render_end_to_end() {
     // A JSON forest written by `forest scene` renders the same way.
     ok(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "20",
         "--species",
@@ -318,6 +320,7 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
     bake_small("bush", &d.join("bush.atlas"), 32, 5);
     ok(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "20",
         "--species",
@@ -409,6 +412,7 @@ fn outputs_that_would_destroy_inputs_are_refused_before_any_work() {
     // A scene `render` would refuse is refused by `scene`, and nothing is written.
     let e = err(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "20",
         "--species",
@@ -460,6 +464,7 @@ fn an_interrupted_scene_leaves_no_temporary_file() {
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_forest"))
         .args([
             "scene",
+            "--model-sizes",
             "--trees",
             "3000000",
             "--species",
@@ -498,5 +503,68 @@ fn an_interrupted_scene_leaves_no_temporary_file() {
         assert!(!names.contains(&"big.forest".to_string()), "{names:?}");
     } else {
         assert!(code.success(), "{code:?}");
+    }
+}
+
+#[test]
+fn scene_gives_trees_their_species_heights() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    bake_small("bush", &d.join("bush.atlas"), 32, 3);
+    let top = forest_format::atlas::Atlas::load(&d.join("bush.atlas"))
+        .unwrap()
+        .manifest
+        .model_top();
+    // The bake records the model's top (the bundled bush is about 3 m tall).
+    assert!((2.5..3.5).contains(&top), "{top}");
+    let heights = |file: &str| -> Vec<f32> {
+        let f = forest_format::forest::Forest::load(&d.join(file)).unwrap();
+        f.instances.iter().map(|i| i.scale * top).collect()
+    };
+    let scene = |extra: &[&str], out: &str| {
+        let mut a = vec!["scene", "--trees", "60", "--species"];
+        let s = p("bush.atlas");
+        let o = p(out);
+        a.push(&s);
+        a.extend_from_slice(extra);
+        a.extend_from_slice(&["-o", &o]);
+        forest(&a)
+    };
+    // Given heights, then the built-in table (bush 1–3 m), then the model's own size.
+    let text = ok(&scene(&["--heights", "bush=2-2.5"], "given.json"));
+    assert!(text.contains("bush: 2-2.5 m tall"), "{text}");
+    assert!(
+        heights("given.json")
+            .iter()
+            .all(|h| (1.999..=2.501).contains(h))
+    );
+    ok(&scene(&[], "table.json"));
+    let table = heights("table.json");
+    assert!(
+        table.iter().all(|h| (0.999..=3.001).contains(h)),
+        "{table:?}"
+    );
+    assert!(table.iter().any(|h| *h < 2.0) && table.iter().any(|h| *h > 2.0));
+    ok(&scene(&["--model-sizes"], "model.json"));
+    assert!(
+        heights("model.json")
+            .iter()
+            .all(|h| (0.8 * top - 1e-3..=1.25 * top + 1e-3).contains(h))
+    );
+    // Bad heights: one line naming the cause, nothing written.
+    for (args, says) in [
+        (vec!["--heights", "oak=15-25"], "--heights names 'oak'"),
+        (vec!["--heights", "bush=3-2"], "MIN <= MAX"),
+        (vec!["--heights", "bush15-25"], "expected NAME=MIN-MAX"),
+        (
+            vec!["--heights", "bush=2-3", "--model-sizes"],
+            "cannot be used with",
+        ),
+    ] {
+        let out = scene(&args, "bad.json");
+        let e = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(!out.status.success() && e.contains(says), "{args:?}: {e}");
+        assert!(!d.join("bad.json").exists());
     }
 }

@@ -166,6 +166,7 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     }
     ok(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "300",
         "--area-per-tree",
@@ -386,6 +387,7 @@ fn without_a_display_the_viewer_says_what_to_do() {
     bake_small("bush", &dir.path().join("bush.atlas"), 32, 3);
     ok(&forest(&[
         "scene",
+        "--model-sizes",
         "--trees",
         "10",
         "--species",

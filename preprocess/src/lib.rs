@@ -205,6 +205,14 @@ pub fn bake_mesh(
         triangles: mesh.tris.len() as u64,
         degenerate_triangles: mesh.degenerate,
         materials: mesh.materials.iter().map(|m| m.name.clone()).collect(),
+        top: Some(
+            mesh.tris
+                .iter()
+                .flat_map(|t| t.p)
+                .map(|p| p.y)
+                .fold(f32::NEG_INFINITY, f32::max),
+        )
+        .filter(|t| t.is_finite()),
     };
     let manifest = manifest_for(*params, source, sphere, layer_roots, nodes_per_level);
     let layers = Layers {

@@ -11,8 +11,12 @@ use anyhow::{Context, Result, bail};
 /// The bundled species, in the demo forest's species order.
 pub const SPECIES: [&str; 5] = ["oak", "ash", "aspen", "pine", "bush"];
 
-/// Trees in the viewer's demo forest (10 m² each: about 450 m across).
+/// Trees in the viewer's demo forest.
 pub const TREES: u32 = 20_000;
+
+/// Ground per tree in the demo forests (m²): a closed stand of trees at their species'
+/// heights (about 1.1 km across for [`TREES`]; `scripts/demo.sh` uses the same).
+pub const AREA_PER_TREE: &str = "60";
 
 /// The demo forest file and the OBJ models of its species (for the geometry-based methods).
 pub struct Demo {
@@ -114,7 +118,7 @@ fn prepare_in(root: &Path, bake_args: &[&str]) -> Result<Demo> {
             "--trees",
             &trees,
             "--area-per-tree",
-            "10",
+            AREA_PER_TREE,
             "--species",
             &species,
             "--seed",

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::Args;
-use forest_format::generate::{GenerateParams, generate};
+use forest_format::generate::{GenerateParams, generate, species_height};
 
 /// Arguments of `forest scene`.
 #[derive(Args, Debug)]
@@ -27,6 +27,15 @@ pub struct SceneArgs {
     /// Presort directions.
     #[arg(long, default_value_t = 15)]
     pub presort_directions: u32,
+    /// Tree heights per species, `NAME=MIN-MAX` in metres (comma-separated; NAME is the
+    /// atlas folder's name without `.atlas`), drawn uniformly per tree. They override the
+    /// built-in table (oak and ash 15-25, pine 20-35, aspen 12-20, bush 1-3); a species in
+    /// neither keeps its model's size, varied ×0.8-1.25.
+    #[arg(long, value_delimiter = ',', value_parser = parse_height)]
+    pub heights: Vec<(String, f32, f32)>,
+    /// Keep every model's own size, varied ×0.8-1.25, instead of the species' heights.
+    #[arg(long, conflicts_with = "heights")]
+    pub model_sizes: bool,
     /// Output: binary forest, or JSON when the name ends in .json.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -48,6 +57,79 @@ fn stored_path(atlas: &Path, forest: &Path) -> Result<String> {
         .unwrap_or_else(|_| abs.display().to_string()))
 }
 
+/// `NAME=MIN-MAX` (metres) of `--heights`.
+fn parse_height(s: &str) -> Result<(String, f32, f32), String> {
+    let usage = || format!("'{s}': expected NAME=MIN-MAX in metres, for example oak=15-25");
+    let (name, range) = s.split_once('=').ok_or_else(usage)?;
+    let (lo, hi) = range.split_once('-').ok_or_else(usage)?;
+    let (lo, hi): (f32, f32) = (
+        lo.trim().parse().map_err(|_| usage())?,
+        hi.trim().parse().map_err(|_| usage())?,
+    );
+    if name.trim().is_empty() || !(lo > 0.0 && hi >= lo && hi <= 1000.0) {
+        return Err(format!(
+            "'{s}': a species name and heights with 0 < MIN <= MAX <= 1000 m"
+        ));
+    }
+    Ok((name.trim().to_string(), lo, hi))
+}
+
+/// Scale ranges, one per species (empty: every model at its own size, ×0.8–1.25).
+type ScaleRanges = Vec<(f32, f32)>;
+
+/// Each species' scale range, and a line per species saying what was chosen.
+fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
+    let names: Vec<String> = args
+        .species
+        .iter()
+        .map(|p| {
+            p.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        })
+        .collect();
+    if let Some((n, _, _)) = args
+        .heights
+        .iter()
+        .find(|(n, _, _)| !names.iter().any(|m| m.eq_ignore_ascii_case(n)))
+    {
+        bail!(
+            "--heights names '{n}', which is none of the species ({})",
+            names.join(", ")
+        );
+    }
+    if args.model_sizes {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let mut scales = Vec::new();
+    let mut lines = Vec::new();
+    for (path, name) in args.species.iter().zip(&names) {
+        let given = args
+            .heights
+            .iter()
+            .rev()
+            .find(|(n, _, _)| n.eq_ignore_ascii_case(name))
+            .map(|&(_, lo, hi)| (lo, hi));
+        let Some((lo, hi)) = given.or_else(|| species_height(name)) else {
+            scales.push((0.8, 1.25));
+            lines.push(format!(
+                "  {name}: not in the height table, its model's own size ×0.8-1.25 (--heights {name}=MIN-MAX sets one)"
+            ));
+            continue;
+        };
+        let top = forest_format::atlas::Atlas::load(path)?
+            .manifest
+            .model_top();
+        scales.push((lo / top, hi / top));
+        lines.push(format!(
+            "  {name}: {lo}-{hi} m tall (model {top:.2} m: scale {:.2}-{:.2})",
+            lo / top,
+            hi / top
+        ));
+    }
+    Ok((scales, lines))
+}
+
 /// Run `forest scene`.
 pub fn run(args: &SceneArgs) -> Result<()> {
     crate::guard::not_an_input(&args.output, "output", &args.species)?;
@@ -61,6 +143,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         }
         species.push(stored_path(s, &args.output)?);
     }
+    let (species_scale, size_lines) = species_scales(args)?;
     // Millions of trees take seconds to place and sort: say so while it runs.
     let spinner = indicatif::ProgressBar::new_spinner();
     if args.trees >= 100_000 {
@@ -79,6 +162,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         clump_size: args.clump_size,
         seed: args.seed,
         presort_directions: args.presort_directions,
+        species_scale,
         ..GenerateParams::default()
     })
     .map_err(anyhow::Error::msg)?;
@@ -95,5 +179,8 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         forest.presort.directions.len(),
         args.output.display()
     );
+    for l in size_lines {
+        println!("{l}");
+    }
     Ok(())
 }

@@ -21,6 +21,10 @@ pub struct GenerateParams {
     pub clump_size: f32,
     /// Uniform scale range.
     pub scale: (f32, f32),
+    /// Uniform scale range per species, in species order, instead of `scale` (empty: `scale`
+    /// for every species). `forest scene` sets it from each species' height range
+    /// ([`species_height`]) and its model's height.
+    pub species_scale: Vec<(f32, f32)>,
     /// Random seed.
     pub seed: u64,
     /// Presort directions.
@@ -35,10 +39,30 @@ impl Default for GenerateParams {
             area_per_tree: 30.0,
             clump_size: 60.0,
             scale: (0.8, 1.25),
+            species_scale: Vec::new(),
             seed: 1,
             presort_directions: crate::forest::DEFAULT_PRESORT_DIRECTIONS,
         }
     }
+}
+
+/// Mature height ranges (metres) of common tree species, by name: what `forest scene` gives
+/// the trees of a species of that name unless told otherwise (typical heights of grown trees
+/// in a closed stand: oak and ash 15–25 m, Scots pine 20–35 m, aspen 12–20 m, shrubs 1–3 m).
+pub const SPECIES_HEIGHTS: [(&str, f32, f32); 5] = [
+    ("oak", 15.0, 25.0),
+    ("ash", 15.0, 25.0),
+    ("aspen", 12.0, 20.0),
+    ("pine", 20.0, 35.0),
+    ("bush", 1.0, 3.0),
+];
+
+/// The [`SPECIES_HEIGHTS`] range of a species name (case-insensitive), if listed.
+pub fn species_height(name: &str) -> Option<(f32, f32)> {
+    SPECIES_HEIGHTS
+        .iter()
+        .find(|(n, _, _)| n.eq_ignore_ascii_case(name))
+        .map(|&(_, lo, hi)| (lo, hi))
 }
 
 /// SplitMix64: a small, fast, well-mixed generator (deterministic across platforms).
@@ -122,8 +146,22 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
     if !(p.clump_size.is_finite() && p.clump_size > 0.0) {
         return Err(format!("clump size = {}: must be positive", p.clump_size));
     }
-    if !(p.scale.0 > 0.0 && p.scale.1 >= p.scale.0 && p.scale.1.is_finite()) {
+    let good = |(lo, hi): (f32, f32)| lo > 0.0 && hi >= lo && hi.is_finite();
+    if !good(p.scale) {
         return Err(format!("scale range {:?}: must be 0 < min ≤ max", p.scale));
+    }
+    if !p.species_scale.is_empty() && p.species_scale.len() != p.species.len() {
+        return Err(format!(
+            "{} per-species scale ranges for {} species",
+            p.species_scale.len(),
+            p.species.len()
+        ));
+    }
+    if let Some((i, r)) = p.species_scale.iter().enumerate().find(|(_, r)| !good(**r)) {
+        return Err(format!(
+            "scale range {r:?} of species {}: must be 0 < min ≤ max",
+            p.species[i]
+        ));
     }
     if !(1..=256).contains(&p.presort_directions) {
         return Err(format!(
@@ -155,10 +193,15 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
             .floor()
             .clamp(0.0, (p.species.len() - 1) as f32) as u32;
+        let (lo, hi) = p
+            .species_scale
+            .get(pick as usize)
+            .copied()
+            .unwrap_or(p.scale);
         instances.push(Instance {
             position: [x, 0.0, z],
             rotation: rng.next_f32() * std::f32::consts::TAU,
-            scale: p.scale.0 + (p.scale.1 - p.scale.0) * rng.next_f32(),
+            scale: lo + (hi - lo) * rng.next_f32(),
             species: pick,
         });
     }
@@ -208,6 +251,36 @@ mod tests {
         let mean = counts.iter().sum::<f64>() / counts.len() as f64;
         let var = counts.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / counts.len() as f64;
         assert!(var > 3.0 * mean, "variance {var:.1} vs mean {mean:.1}");
+    }
+
+    #[test]
+    fn per_species_scales_apply_to_their_species_only() {
+        let plain = generate(&params(400, 5)).unwrap();
+        let mut p = params(400, 5);
+        p.species_scale = vec![(3.0, 4.0), (0.5, 0.5), (1.0, 2.0)];
+        let sized = generate(&p).unwrap();
+        for (a, b) in plain.instances.iter().zip(&sized.instances) {
+            // Same places, species and rotations: only the scales differ.
+            assert_eq!(
+                (a.position, a.species, a.rotation),
+                (b.position, b.species, b.rotation)
+            );
+            let (lo, hi) = p.species_scale[b.species as usize];
+            assert!(b.scale >= lo && b.scale <= hi, "{b:?}");
+            // The same draw, mapped onto the species' range.
+            let u = (a.scale - 0.8) / (1.25 - 0.8);
+            assert!((b.scale - (lo + (hi - lo) * u)).abs() < 1e-4, "{a:?} {b:?}");
+        }
+        p.species_scale.pop();
+        assert!(
+            generate(&p)
+                .unwrap_err()
+                .contains("2 per-species scale ranges for 3")
+        );
+        p.species_scale = vec![(1.0, 2.0), (2.0, 1.0), (1.0, 1.0)];
+        assert!(generate(&p).unwrap_err().contains("of species b"));
+        assert_eq!(species_height("Pine"), Some((20.0, 35.0)));
+        assert_eq!(species_height("baobab"), None);
     }
 
     #[test]

@@ -96,6 +96,7 @@ fn atlas_round_trip(params: BakeParams, pixels: &[(u8, [u8; 3])], nodes: Vec<Qua
             triangles: 1,
             degenerate_triangles: 0,
             materials: vec![],
+            top: Some(6.5),
         },
         Sphere {
             center: Vec3::new(0.5, 2.0, -1.0),

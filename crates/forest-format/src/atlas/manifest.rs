@@ -14,7 +14,7 @@ use crate::slab::{DirectionFrame, Sphere};
 use super::*;
 
 /// Where the baked model came from.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SourceInfo {
     /// File name of the OBJ (no folder, so that bakes are reproducible anywhere).
     pub file: String,
@@ -26,6 +26,11 @@ pub struct SourceInfo {
     pub degenerate_triangles: u64,
     /// Material names.
     pub materials: Vec<String>,
+    /// Height of the model's highest vertex above y = 0 (metres; a tree stands on y = 0).
+    /// Absent in atlases baked before it was recorded: [`AtlasManifest::model_top`] then
+    /// falls back to the top of the bounding sphere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub top: Option<f32>,
 }
 
 /// The manifest of an atlas (`manifest.json`).
@@ -61,6 +66,15 @@ pub struct AtlasManifest {
 }
 
 impl AtlasManifest {
+    /// Height of the model's top above y = 0 (metres): the recorded [`SourceInfo::top`], else
+    /// the top of the bounding sphere (an overestimate of up to the crown's half-width).
+    pub fn model_top(&self) -> f32 {
+        self.source
+            .top
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .unwrap_or(self.bounding_sphere.center.y + self.bounding_sphere.radius)
+    }
+
     /// Bytes the runtime puts in GPU textures for this atlas: the colour layers as BC7 (16
     /// bytes per 4×4 block) with mips down to 4×4, plus the node texture (8 bytes per texel,
     /// [`NODE_TEXTURE_WIDTH`] wide, rows rounded up).

@@ -41,6 +41,7 @@ fn synthetic(colour: ColourEncoding) -> (Atlas, Layers) {
             triangles: 1,
             degenerate_triangles: 0,
             materials: vec!["leaf".into()],
+            top: Some(6.5),
         },
         Sphere {
             center: glam::Vec3::Y,
