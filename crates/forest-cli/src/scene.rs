@@ -111,7 +111,7 @@ fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
             .find(|(n, _, _)| n.eq_ignore_ascii_case(name))
             .map(|&(_, lo, hi)| (lo, hi));
         let Some((lo, hi)) = given.or_else(|| species_height(name)) else {
-            scales.push((0.8, 1.25));
+            scales.push(GenerateParams::default().scale);
             lines.push(format!(
                 "  {name}: not in the height table, its model's own size ×0.8-1.25 (--heights {name}=MIN-MAX sets one)"
             ));
