@@ -31,7 +31,10 @@ pub enum Near {
     /// 400×300 and 60° with 8 levels). Measured on the bundled oak, pine and aspen (400×300,
     /// 60°, 8 levels), the quad stream's FLIP against the 4×4 reference falls below that of
     /// full geometry at 1× beyond 3, 2 and 2.2 crown radii: where the finest quads project
-    /// 1.35–2 px. ε does not move the switch: a coarser ε makes the near trees' quads
+    /// 1.35–2 px. Re-measured for all five bundled species (`scripts/crossover.py`, against
+    /// the quad stream at ε 2) the crossover lies at 1.8 (pine) to 3.0 (oak, ash) crown
+    /// radii, median 2.5: one switch for every species is a compromise that a per-species
+    /// switch would remove. ε does not move the switch: a coarser ε makes the near trees' quads
     /// coarser still, not better, and the walkthrough's error is theirs (an ε-scaled switch,
     /// 2.7 radii / max(ε/1.5, 1), left the hybrid at ε 8–32 less accurate than the discrete
     /// LODs at the same time).

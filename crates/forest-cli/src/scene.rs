@@ -117,9 +117,7 @@ fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
             ));
             continue;
         };
-        let top = forest_format::atlas::Atlas::load(path)?
-            .manifest
-            .model_top();
+        let top = forest_format::atlas::Atlas::load_manifest(path)?.model_top();
         scales.push((lo / top, hi / top));
         lines.push(format!(
             "  {name}: {lo}-{hi} m tall (model {top:.2} m: scale {:.2}-{:.2})",

@@ -258,16 +258,7 @@ impl Atlas {
 
     /// Read and check an atlas folder. Every error names the file and what is wrong.
     pub fn load(path: &Path) -> Result<Self, FormatError> {
-        if !path.is_dir() {
-            return Err(FormatError::invalid(
-                path,
-                if path.exists() {
-                    "is not an atlas folder (bake one with `forest bake MODEL.obj -o NAME.atlas`)"
-                } else {
-                    "no such atlas (bake one with `forest bake MODEL.obj -o NAME.atlas`)"
-                },
-            ));
-        }
+        check_folder(path)?;
         let read = |file: &str| {
             let limit = if file == MANIFEST_FILE {
                 crate::bounded::limit::TEXT
@@ -279,6 +270,17 @@ impl Atlas {
         Self::from_files(path, &read)
     }
 
+    /// Read and check an atlas folder's manifest alone (what was baked and how, the
+    /// bounding sphere, the model's top), without reading its images or nodes.
+    pub fn load_manifest(path: &Path) -> Result<AtlasManifest, FormatError> {
+        check_folder(path)?;
+        let mpath = path.join(MANIFEST_FILE);
+        parse_manifest(
+            &mpath,
+            &crate::bounded::read(&mpath, crate::bounded::limit::TEXT)?,
+        )
+    }
+
     /// [`Atlas::load`] from the folder's files as `read(file name)` returns them (the files
     /// of the folder `path`, which errors name). The manifest is read and checked first, so
     /// no other file is read for an atlas whose manifest is refused.
@@ -287,12 +289,7 @@ impl Atlas {
         read: &dyn Fn(&str) -> Result<Vec<u8>, FormatError>,
     ) -> Result<Self, FormatError> {
         let mpath = path.join(MANIFEST_FILE);
-        let manifest: AtlasManifest =
-            serde_json::from_slice(&read(MANIFEST_FILE)?).map_err(|source| FormatError::Json {
-                path: mpath.clone(),
-                source,
-            })?;
-        manifest.check(&mpath)?;
+        let manifest = parse_manifest(&mpath, &read(MANIFEST_FILE)?)?;
         let colour_file = read(manifest.params.colour.file_name())?;
         let alpha_file = read(ALPHA_FILE)?;
         let npath = path.join(NODES_FILE);
@@ -355,6 +352,32 @@ impl Atlas {
         atlas.decode_layers(path)?;
         Ok(atlas)
     }
+}
+
+/// An atlas path must name a folder; the error says how to make one.
+fn check_folder(path: &Path) -> Result<(), FormatError> {
+    if path.is_dir() {
+        return Ok(());
+    }
+    Err(FormatError::invalid(
+        path,
+        if path.exists() {
+            "is not an atlas folder (bake one with `forest bake MODEL.obj -o NAME.atlas`)"
+        } else {
+            "no such atlas (bake one with `forest bake MODEL.obj -o NAME.atlas`)"
+        },
+    ))
+}
+
+/// Parse and check the manifest read from `mpath` (which errors name).
+fn parse_manifest(mpath: &Path, bytes: &[u8]) -> Result<AtlasManifest, FormatError> {
+    let manifest: AtlasManifest =
+        serde_json::from_slice(bytes).map_err(|source| FormatError::Json {
+            path: mpath.to_path_buf(),
+            source,
+        })?;
+    manifest.check(mpath)?;
+    Ok(manifest)
 }
 
 #[cfg(test)]

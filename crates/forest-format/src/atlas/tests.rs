@@ -141,3 +141,25 @@ fn blank_pixels_are_filled_and_alpha_is_packed() {
     assert_eq!(back.into_raw(), a);
     assert_eq!((png[24], png[25]), (1, 3));
 }
+
+#[test]
+fn the_manifest_loads_alone_and_is_checked_as_in_a_full_load() {
+    let (atlas, _) = synthetic(ColourEncoding::Png);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.atlas");
+    atlas.save(&path).unwrap();
+    // The images and nodes are not read: the manifest loads without them.
+    std::fs::remove_file(path.join(NODES_FILE)).unwrap();
+    std::fs::remove_file(path.join(ALPHA_FILE)).unwrap();
+    assert_eq!(Atlas::load_manifest(&path).unwrap(), atlas.manifest);
+    assert!(Atlas::load(&path).is_err());
+    let manifest = path.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 2", "\"version\": 7")).unwrap();
+    let e = Atlas::load_manifest(&path).unwrap_err().to_string();
+    assert!(e.contains("atlas version 7"), "{e}");
+    let e = Atlas::load_manifest(&dir.path().join("none.atlas"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no such atlas"), "{e}");
+}
