@@ -7,6 +7,7 @@
 //   <species>/<species>.obj   y-up, metres, trunk base at the origin
 //   <species>/<species>.mtl   materials `bark` and `leaves`
 //   <species>/bark_*.jpg, <species>/leaves_*.png   (downscaled copies)
+//   <species>/<species>.glb   the same tree as binary glTF 2.0 (glb.mjs)
 //   LICENSE.md                provenance, licence text and a summary table
 //
 // Options:
@@ -21,6 +22,7 @@ import { createHash } from 'node:crypto';
 import { mkdirSync, readFileSync, writeFileSync, statSync, existsSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { objToGlb } from './glb.mjs';
 
 // ez-tree loads its textures through THREE.TextureLoader at import time, which
 // needs `document.createElementNS('img')`. A stub is enough: we only need the
@@ -428,6 +430,8 @@ for (const sp of SPECIES) {
 
   const check = verify(objPath);
   if (check.nf !== bark.written + leaves.written) throw new Error(`${sp.name}: face count mismatch`);
+  const glb = objToGlb(sp.name);
+  if (glb.triangles !== check.nf) throw new Error(`${sp.name}: GLB triangle count mismatch`);
 
   const files = [`${sp.name}.obj`, `${sp.name}.mtl`, barkFile, leafFile].map((f) => {
     const buf = readFileSync(join(dir, f));
@@ -485,6 +489,7 @@ version ${PKG.version} (MIT licence, reproduced below), and exported to OBJ/MTL 
 cd assets/trees/ez-tree
 npm ci            # exact versions from package-lock.json (ez-tree ${PKG.version}, three ${THREE_PKG.version}, sharp)
 node export.mjs   # rewrites assets/trees/<species>/ and this LICENSE.md
+node glb.mjs      # only re-converts the OBJ folders to GLB (no dependencies)
 \`\`\`
 
 The output is deterministic (ez-tree uses its own seeded RNG).
@@ -505,6 +510,11 @@ The output is deterministic (ez-tree uses its own seeded RNG).
 - Leaves are alpha-tested cards (\`map_d\` = alpha of the leaf PNG; ez-tree uses an
   alpha test of 0.5, 0.3 for pine) and should be drawn double-sided. Each leaf is two
   crossed quads ("double" billboard).
+- \`<species>.glb\` is the same tree as binary glTF 2.0, converted from the OBJ folder by
+  [\`ez-tree/glb.mjs\`](ez-tree/glb.mjs): one primitive per material, TEXCOORD_0 = (u, 1 − v),
+  baseColorFactor = \`Kd\` decoded to linear, the textures embedded unchanged; the leaves are
+  alphaMode MASK with alphaCutoff 0.5 (the test the OBJ's bake applies) and double-sided,
+  the bark OPAQUE: the same tree, material for material.
 - Only the bark colour maps are exported; the package also has AO, normal and
   roughness maps for each bark, which the MTL does not reference.
 - ${texNote}
