@@ -9,6 +9,7 @@
 
 pub mod contact_sheet;
 pub mod error;
+pub mod gltf_mesh;
 pub mod ldi;
 pub mod lod;
 pub mod mesh;

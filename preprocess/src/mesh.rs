@@ -1,4 +1,5 @@
-//! Loading a tree model (OBJ + MTL + textures) into flat triangles for the ray tracer.
+//! Loading a tree model (OBJ + MTL + textures; glTF in [`crate::gltf_mesh`]) into flat
+//! triangles for the ray tracer.
 //!
 //! Polygons are triangulated by tobj. Texture alpha comes from `map_d` (its alpha channel, or
 //! its grey level when it has none) or else from the alpha channel of `map_Kd`; a material with
@@ -71,7 +72,8 @@ pub fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
     }
     h
 }
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+/// FNV-1a 64-bit offset basis.
+pub(crate) const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
 /// Refuse face (`f`, `l`) indices that name no vertex, texture coordinate or normal defined
 /// before them: tobj 4 overflows on such indices (a panic with overflow checks, a wrong
@@ -139,14 +141,30 @@ fn texture_path(obj_dir: &Path, spec: &str) -> PathBuf {
     obj_dir.join(file.replace('\\', "/"))
 }
 
+/// The error of a model left with no triangle (none at all, or `degenerate` of zero area).
+pub(crate) fn no_triangles(path: &Path, degenerate: u64) -> BakeError {
+    BakeError::Model {
+        path: path.into(),
+        what: if degenerate > 0 {
+            format!("all {degenerate} triangles are degenerate (zero area)")
+        } else {
+            "no faces: the model has no triangles to bake".into()
+        },
+    }
+}
+
 /// The largest vertex coordinate (absolute value, model units) a model may have: beyond it,
 /// areas of the model's triangles (fourth powers of coordinates in the zero-area test)
 /// overflow `f32`. NaN and infinities are refused by the same test.
 pub const MAX_MODEL_COORDINATE: f32 = 1e6;
 
 impl Mesh {
-    /// Load an OBJ file with its materials and textures.
+    /// Load a model with its materials and textures: OBJ, or glTF 2.0 (`.gltf`, `.glb`; see
+    /// [`crate::gltf_mesh`]) by the file's extension.
     pub fn load(path: &Path) -> Result<Self, BakeError> {
+        if crate::gltf_mesh::is_gltf(path) {
+            return crate::gltf_mesh::load(path);
+        }
         let obj_bytes = bounded::read(path, bounded::limit::DATA)?;
         let mut hash = fnv1a(FNV_OFFSET, &obj_bytes);
         let obj_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
@@ -358,14 +376,7 @@ impl Mesh {
             }
         }
         if tris.is_empty() {
-            return Err(BakeError::Model {
-                path: path.into(),
-                what: if degenerate > 0 {
-                    format!("all {degenerate} triangles are degenerate (zero area)")
-                } else {
-                    "no faces: the model has no triangles to bake".into()
-                },
-            });
+            return Err(no_triangles(path, degenerate));
         }
         Ok(Self {
             tris,
@@ -398,6 +409,9 @@ impl Mesh {
 /// Front ends use it to refuse outputs that would overwrite the model's own files. Unreadable
 /// libraries are skipped here (the loader reports them).
 pub fn source_files(obj: &Path) -> Result<Vec<PathBuf>, BakeError> {
+    if crate::gltf_mesh::is_gltf(obj) {
+        return crate::gltf_mesh::source_files(obj);
+    }
     let bytes = bounded::read(obj, bounded::limit::DATA)?;
     let dir = obj.parent().unwrap_or(Path::new("."));
     let mut files = vec![obj.to_path_buf()];

@@ -9,7 +9,7 @@ use forest_format::{Atlas, BakeParams, ColourEncoding};
 /// Arguments of `forest bake`.
 #[derive(Args, Debug)]
 pub struct BakeArgs {
-    /// The tree model: an OBJ file with its MTL and textures beside it.
+    /// The tree model: an OBJ file with its MTL and textures beside it, or glTF 2.0 (`.gltf`, `.glb`).
     pub model: PathBuf,
     /// Output atlas folder (conventionally NAME.atlas); an existing atlas there is replaced.
     #[arg(short, long)]

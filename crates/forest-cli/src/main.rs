@@ -42,7 +42,7 @@ pub(crate) fn gpu_context() -> Result<forest_render::GpuContext, forest_render::
 #[derive(Parser)]
 #[command(name = "forest", version, about, long_about = None)]
 enum Cli {
-    /// Bake a tree model (OBJ + MTL + textures) into a quad-stream atlas.
+    /// Bake a tree model (OBJ + MTL + textures, or glTF 2.0) into a quad-stream atlas.
     Bake(bake::BakeArgs),
     /// Check an atlas and print its summary.
     Info(bake::InfoArgs),

@@ -74,7 +74,7 @@ pub struct MethodArgs {
     /// rest as the quad stream). The last four need --models.
     #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
-    /// OBJ models of the forest's species, in its species order (geometry-based methods).
+    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods).
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<PathBuf>,
     /// Full geometry: draw trees in submission order instead of nearest distance band first.
@@ -212,7 +212,7 @@ impl MethodArgs {
         let m = self.method(&self.method)?;
         if m.is_some() && self.models.len() != species {
             bail!(
-                "--method {} needs --models with one OBJ per species ({} given, the forest has {species})",
+                "--method {} needs --models with one model per species ({} given, the forest has {species})",
                 self.method,
                 self.models.len()
             );

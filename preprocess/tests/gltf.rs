@@ -1,0 +1,177 @@
+//! glTF input: the same tree from OBJ and GLB bakes to the same atlas, node transforms and
+//! alpha modes mean what the glTF specification says, unsupported features are named.
+
+use std::path::{Path, PathBuf};
+
+use forest_bake::Mesh;
+use forest_format::{BakeParams, ColourEncoding};
+use glam::Vec3;
+
+fn tree(name: &str, ext: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../assets/trees/{name}/{name}.{ext}"))
+}
+
+/// All layers of an atlas, stacked into one image.
+fn layers_image(atlas: &forest_format::Atlas) -> image::RgbaImage {
+    let l = atlas.decode_layers(Path::new("unused")).unwrap();
+    image::RgbaImage::from_raw(l.resolution, l.resolution * l.count, l.rgba).unwrap()
+}
+
+#[test]
+fn the_bundled_glb_bakes_to_the_atlas_of_its_obj() {
+    let params = BakeParams {
+        directions: 5,
+        resolution: 64,
+        min_quad: 4,
+        spp: 2,
+        colour: ColourEncoding::Png,
+        ..BakeParams::default()
+    };
+    let obj = forest_bake::bake_file(&tree("bush", "obj"), &params, &|_, _| {}).unwrap();
+    let glb = forest_bake::bake_file(&tree("bush", "glb"), &params, &|_, _| {}).unwrap();
+    let (a, b) = (&obj.atlas.manifest, &glb.atlas.manifest);
+    assert_eq!(a.source.triangles, b.source.triangles);
+    assert_eq!(a.source.materials, b.source.materials);
+    assert!((a.bounding_sphere.radius - b.bounding_sphere.radius).abs() < 1e-4);
+    let m = forest_metrics::compare(&layers_image(&obj.atlas), &layers_image(&glb.atlas)).unwrap();
+    eprintln!("OBJ against GLB layers: mean FLIP {}", m.flip_mean);
+    assert!(
+        m.flip_mean <= 0.01,
+        "FLIP {} between the OBJ's and the GLB's layers",
+        m.flip_mean
+    );
+    // Node counts follow the images: a different alpha test would change them a lot.
+    let (na, nb) = (a.node_count as f64, b.node_count as f64);
+    assert!((na - nb).abs() / na < 0.01, "{na} nodes against {nb}");
+}
+
+#[test]
+fn the_bundled_glb_loads_the_triangles_and_materials_of_its_obj() {
+    for name in ["oak", "pine"] {
+        let o = Mesh::load(&tree(name, "obj")).unwrap();
+        let g = Mesh::load(&tree(name, "glb")).unwrap();
+        assert_eq!(o.tris.len(), g.tris.len(), "{name}");
+        let names = |m: &Mesh| {
+            m.materials
+                .iter()
+                .map(|m| m.name.clone())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(names(&o), names(&g));
+        for (a, b) in o.materials.iter().zip(&g.materials) {
+            assert!(
+                (a.kd - b.kd).abs().max_element() < 1e-5,
+                "{name} {}",
+                a.name
+            );
+            assert_eq!(a.alpha.is_some(), b.alpha.is_some(), "{name} {}", a.name);
+        }
+        // Same triangles in the same order, texture coordinates in the OBJ's convention.
+        for (a, b) in o.tris.iter().zip(&g.tris) {
+            for k in 0..3 {
+                assert!((a.p[k] - b.p[k]).abs().max_element() < 1e-5);
+                assert!((a.uv[k] - b.uv[k]).abs().max_element() < 1e-5);
+            }
+            assert_eq!(a.material, b.material);
+        }
+    }
+}
+
+/// A glTF file (JSON, buffer as a file next to it) holding one triangle per given node.
+fn write_gltf(dir: &Path, extra: &str, nodes: &str, material: &str) -> PathBuf {
+    let tri: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes: Vec<u8> = tri.iter().flat_map(|x| x.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), &bytes).unwrap();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},{extra}"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{nodes}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],
+        "materials":[{material}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "buffers":[{{"uri":"tri.bin","byteLength":36}}]}}"#
+    );
+    let path = dir.join("t.gltf");
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn node_transforms_are_applied_parent_first() {
+    let dir = tempfile::tempdir().unwrap();
+    // The parent moves up 2 m; its child scales by 2 and turns 90° about y.
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let nodes = format!(
+        r#"{{"children":[1],"translation":[0,2,0]}},
+           {{"mesh":0,"scale":[2,2,2],"rotation":[0,{s},0,{s}]}}"#
+    );
+    let path = write_gltf(dir.path(), "", &nodes, r#"{"name":"m"}"#);
+    let mesh = Mesh::load(&path).unwrap();
+    assert_eq!(mesh.tris.len(), 1);
+    let p = mesh.tris[0].p;
+    let want = [
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(0.0, 2.0, -2.0),
+        Vec3::new(0.0, 4.0, 0.0),
+    ];
+    for (a, b) in p.iter().zip(want) {
+        assert!((*a - b).length() < 1e-5, "{a} against {b}");
+    }
+    // No NORMAL: the face normal, turned with the node (+z becomes +x).
+    assert!(
+        (mesh.tris[0].n[0] - Vec3::X).length() < 1e-5,
+        "{}",
+        mesh.tris[0].n[0]
+    );
+    assert_eq!(mesh.materials[0].name, "m");
+    assert!(mesh.materials[0].alpha.is_none());
+}
+
+#[test]
+fn unsupported_gltf_features_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = |extra: &str, nodes: &str| {
+        let path = write_gltf(dir.path(), extra, nodes, "{}");
+        Mesh::load(&path).unwrap_err().to_string()
+    };
+    let mesh = r#"{"mesh":0}"#;
+    let e = err(
+        r#""extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],"#,
+        mesh,
+    );
+    assert!(
+        e.contains("KHR_draco_mesh_compression") && e.contains("does not support"),
+        "{e}"
+    );
+    let e = err(r#""extensionsUsed":["KHR_texture_transform"],"#, mesh);
+    assert!(e.contains("KHR_texture_transform"), "{e}");
+    let e = err("", r#"{"children":[]}"#);
+    assert!(e.contains("no mesh"), "{e}");
+    // Points, not triangles.
+    let path = write_gltf(dir.path(), "", mesh, "{}");
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(
+        &path,
+        text.replace(r#""material":0"#, r#""material":0,"mode":0"#),
+    )
+    .unwrap();
+    let e = Mesh::load(&path).unwrap_err().to_string();
+    assert!(e.contains("only triangles"), "{e}");
+    // A data: URI buffer.
+    std::fs::write(
+        &path,
+        text.replace("tri.bin", "data:application/octet-stream;base64,AAAA"),
+    )
+    .unwrap();
+    let e = Mesh::load(&path).unwrap_err().to_string();
+    assert!(e.contains("data: URI"), "{e}");
+    // A missing buffer file names the file.
+    std::fs::remove_file(dir.path().join("tri.bin")).unwrap();
+    std::fs::write(&path, &text).unwrap();
+    let e = Mesh::load(&path).unwrap_err().to_string();
+    assert!(e.contains("tri.bin"), "{e}");
+    // Not glTF at all.
+    std::fs::write(&path, "solid cube").unwrap();
+    let e = Mesh::load(&path).unwrap_err().to_string();
+    assert!(e.contains("glTF"), "{e}");
+}
