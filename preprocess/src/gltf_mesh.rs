@@ -107,13 +107,9 @@ fn remap_alpha(a: u8, c: f32) -> u8 {
     }
 }
 
-/// Load a glTF 2.0 model (see the module docs for what is read and what is refused).
-pub fn load(path: &Path) -> Result<Mesh, BakeError> {
-    let bytes = bounded::read(path, bounded::limit::DATA)?;
-    let mut hash = fnv1a(FNV_OFFSET, &bytes);
-    // Unsupported extensions are named before validation, which would call them invalid.
-    let doc = gltf::Gltf::from_slice_without_validation(&bytes)
-        .map_err(|e| parse_err(path, e.to_string()))?;
+/// Refuse the extensions the loader cannot honour: any required one, and
+/// `KHR_texture_transform` (it moves texture coordinates).
+fn refuse_extensions(path: &Path, doc: &gltf::Document) -> Result<(), BakeError> {
     let required: Vec<&str> = doc.extensions_required().collect();
     if !required.is_empty() {
         return Err(parse_err(
@@ -128,11 +124,28 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
         return Err(parse_err(
             path,
             "uses KHR_texture_transform, which the loader does not support (it moves texture \
-             coordinates)",
+         coordinates)",
         ));
     }
+    Ok(())
+}
 
-    let doc = gltf::Gltf::from_slice(&bytes).map_err(|e| parse_err(path, e.to_string()))?;
+/// Load a glTF 2.0 model (see the module docs for what is read and what is refused).
+pub fn load(path: &Path) -> Result<Mesh, BakeError> {
+    let bytes = bounded::read(path, bounded::limit::DATA)?;
+    let mut hash = fnv1a(FNV_OFFSET, &bytes);
+    // Validation calls an unsupported required extension invalid: on failure, the file is
+    // parsed again without it so that the message can name the extension.
+    let doc = match gltf::Gltf::from_slice(&bytes) {
+        Ok(doc) => doc,
+        Err(e) => {
+            if let Ok(doc) = gltf::Gltf::from_slice_without_validation(&bytes) {
+                refuse_extensions(path, &doc)?;
+            }
+            return Err(parse_err(path, e.to_string()));
+        }
+    };
+    refuse_extensions(path, &doc)?;
 
     // Buffers: the GLB's binary chunk, or files; each at least as long as it says.
     let mut buffers: Vec<Vec<u8>> = Vec::new();
@@ -284,15 +297,9 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
         });
         material_of.push(Some(materials.len() as u32 - 1));
     }
-    // glTF's default material (white, opaque) for primitives that name none.
+    // glTF's default material (white, opaque) for primitives that name none: added after
+    // the others when a primitive uses it.
     let default_material = materials.len() as u32;
-    materials.push(Material {
-        name: "default".into(),
-        kd: Vec3::ONE,
-        colour: None,
-        alpha: None,
-        translucency: 0.0,
-    });
 
     // Triangles in world space.
     let scene = doc
@@ -372,8 +379,14 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             }
         }
     }
-    if !raw.iter().any(|t| t.3 == default_material) {
-        materials.pop();
+    if raw.iter().any(|t| t.3 == default_material) {
+        materials.push(Material {
+            name: "default".into(),
+            kd: Vec3::ONE,
+            colour: None,
+            alpha: None,
+            translucency: 0.0,
+        });
     }
     if meshes == 0 {
         return Err(parse_err(path, "the scene has no mesh: nothing to bake"));
@@ -395,20 +408,14 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             extent = extent.max(x.abs());
         }
     }
-    let min_area2 = (extent * 1e-7).powi(4);
+    let min_area2 = crate::mesh::min_area2(extent);
     let mut tris = Vec::with_capacity(raw.len());
     let mut degenerate = 0u64;
     for (p, uv, n, material) in raw {
-        let cross = (p[1] - p[0]).cross(p[2] - p[0]);
-        if cross.length_squared() <= min_area2 || !cross.is_finite() {
-            degenerate += 1;
-            continue;
+        match Tri::new(p, uv, n, material, min_area2) {
+            Some(t) => tris.push(t),
+            None => degenerate += 1,
         }
-        let face_n = cross.normalize();
-        let n = n
-            .unwrap_or([face_n; 3])
-            .map(|v| v.try_normalize().unwrap_or(face_n));
-        tris.push(Tri { p, uv, n, material });
     }
     if tris.is_empty() {
         return Err(crate::mesh::no_triangles(path, degenerate));

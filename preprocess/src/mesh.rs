@@ -141,6 +141,35 @@ fn texture_path(obj_dir: &Path, spec: &str) -> PathBuf {
     obj_dir.join(file.replace('\\', "/"))
 }
 
+/// The squared-area threshold below which a triangle of a model reaching `extent` model units
+/// from the origin counts as degenerate (relative to the model's size).
+pub(crate) fn min_area2(extent: f32) -> f32 {
+    (extent * 1e-7).powi(4)
+}
+
+impl Tri {
+    /// A triangle, or None when it is degenerate (squared cross product at most `min_area2`,
+    /// or not finite). Missing normals (`n` None) and normals that do not normalise take the
+    /// face normal.
+    pub(crate) fn new(
+        p: [Vec3; 3],
+        uv: [Vec2; 3],
+        n: Option<[Vec3; 3]>,
+        material: u32,
+        min_area2: f32,
+    ) -> Option<Self> {
+        let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+        if cross.length_squared() <= min_area2 || !cross.is_finite() {
+            return None;
+        }
+        let face_n = cross.normalize();
+        let n = n
+            .unwrap_or([face_n; 3])
+            .map(|v| v.try_normalize().unwrap_or(face_n));
+        Some(Self { p, uv, n, material })
+    }
+}
+
 /// The error of a model left with no triangle (none at all, or `degenerate` of zero area).
 pub(crate) fn no_triangles(path: &Path, degenerate: u64) -> BakeError {
     BakeError::Model {
@@ -332,7 +361,7 @@ impl Mesh {
             }
         }
         // Zero-area test relative to the model's size.
-        let min_area2 = (extent * 1e-7).powi(4);
+        let min_area2 = min_area2(extent);
         for model in &models {
             let mesh = &model.mesh;
             let pos = |i: u32| {
@@ -348,13 +377,6 @@ impl Mesh {
             let material = mesh.material_id.filter(|&m| m < mats.len()).unwrap_or(0) as u32;
             for f in mesh.indices.chunks_exact(3) {
                 let f: [u32; 3] = [f[0], f[1], f[2]];
-                let p = f.map(pos);
-                let cross = (p[1] - p[0]).cross(p[2] - p[0]);
-                if cross.length_squared() <= min_area2 || !cross.is_finite() {
-                    degenerate += 1;
-                    continue;
-                }
-                let face_n = cross.normalize();
                 let uv = f.map(|i| {
                     let i = i as usize * 2;
                     if has_uv {
@@ -363,16 +385,16 @@ impl Mesh {
                         Vec2::ZERO
                     }
                 });
-                let n = f.map(|i| {
-                    let i = i as usize * 3;
-                    let n = if has_n {
+                let n = has_n.then(|| {
+                    f.map(|i| {
+                        let i = i as usize * 3;
                         Vec3::new(mesh.normals[i], mesh.normals[i + 1], mesh.normals[i + 2])
-                    } else {
-                        face_n
-                    };
-                    n.try_normalize().unwrap_or(face_n)
+                    })
                 });
-                tris.push(Tri { p, uv, n, material });
+                match Tri::new(f.map(pos), uv, n, material, min_area2) {
+                    Some(t) => tris.push(t),
+                    None => degenerate += 1,
+                }
             }
         }
         if tris.is_empty() {
