@@ -13,6 +13,24 @@
 // Options:
 //   --texture-size N   longest texture side in pixels (default 512);
 //                      0 copies the package's original 1024² files unchanged.
+//   --out DIR          write the species folders (and LICENSE.md) under DIR
+//                      instead of assets/trees/ (e.g. to check a re-run against
+//                      the committed files without touching them).
+//   --heavy            write only one extra, "production-size" tree for
+//                      profiling the bake: DIR/oak-heavy/ (oak-heavy.obj, .mtl,
+//                      .glb, textures), about 280k triangles. Needs --out DIR,
+//                      and refuses assets/trees/ itself: it is not a bundled
+//                      model, never touches the five species folders or
+//                      LICENSE.md, and is not for committing (the OBJ is
+//                      ~30 MB, the GLB ~20 MB). It is ez-tree's
+//                      "Oak Large" preset (its own seed) with more twigs, rounder
+//                      branches and many more, smaller leaves; see HEAVY below.
+//                      Its vertex count is past the 16-bit indices ez-tree
+//                      builds its geometry with, so the script re-indexes the
+//                      meshes with 32-bit indices (and recomputes the leaf
+//                      normals as ez-tree does) before exporting them.
+//
+//   node export.mjs --heavy --out /tmp/heavy    ->  /tmp/heavy/oak-heavy/
 //
 // The output is deterministic: ez-tree uses its own seeded RNG, all numbers are
 // rounded to a fixed number of decimals, and the textures are re-encoded with
@@ -20,7 +38,7 @@
 
 import { createHash } from 'node:crypto';
 import { mkdirSync, readFileSync, writeFileSync, statSync, existsSync } from 'node:fs';
-import { dirname, join } from 'node:path';
+import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { objToGlb } from './glb.mjs';
 
@@ -59,19 +77,41 @@ const SPECIES = [
   { name: 'bush', preset: 'Bush 2', seed: 45590 },
 ];
 
+// --heavy: one dense tree for profiling, never a bundled species. "Oak Large"
+// (10 m) with its own seed; the overrides are applied over the preset with
+// TreeOptions.copy. Twigs per level-2 branch 3 -> 6 (420 twigs instead of 240),
+// radial segments per level raised (trunk 12 -> 24, ...; segments do not change
+// the tree's shape or its random sequence), and 150 leaves per twig instead of
+// 10, at 2 units (20 cm) instead of 4.5: 253,680 leaf triangles (63,420 leaves
+// of two crossed quads) and ~26k bark triangles.
+const HEAVY = {
+  name: 'oak-heavy',
+  preset: 'Oak Large',
+  seed: 23399,
+  overrides: {
+    branch: { children: { 2: 6 }, segments: { 0: 24, 1: 10, 2: 6, 3: 4 } },
+    leaves: { count: 150, size: 2 },
+  },
+};
+
 const SCALE = 0.1; // ez-tree units -> metres (trees are ~50-100 units tall)
 const POS_DECIMALS = 4; // 0.1 mm
 const NRM_DECIMALS = 4;
 const UV_DECIMALS = 4;
 
 function parseArgs(argv) {
-  const args = { textureSize: 512 };
+  const args = { textureSize: 512, out: null, heavy: false };
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === '--texture-size') {
       args.textureSize = Number(argv[++i]);
       if (!Number.isInteger(args.textureSize) || args.textureSize < 0) {
         throw new Error('--texture-size expects a non-negative integer');
       }
+    } else if (argv[i] === '--out') {
+      args.out = argv[++i];
+      if (!args.out) throw new Error('--out expects a directory');
+    } else if (argv[i] === '--heavy') {
+      args.heavy = true;
     } else {
       throw new Error(`unknown argument ${argv[i]}`);
     }
@@ -81,7 +121,12 @@ function parseArgs(argv) {
 const ARGS = parseArgs(process.argv.slice(2));
 
 const HERE = dirname(fileURLToPath(import.meta.url));
-const OUT_ROOT = join(HERE, '..'); // assets/trees
+const TREES = resolve(HERE, '..'); // assets/trees
+const OUT_ROOT = ARGS.out === null ? TREES : resolve(ARGS.out);
+if (ARGS.heavy && (ARGS.out === null || OUT_ROOT === TREES)) {
+  throw new Error('--heavy needs --out DIR, not assets/trees itself (the heavy tree is not a bundled model)');
+}
+const LIST = ARGS.heavy ? [HEAVY] : SPECIES;
 const PKG_DIR = join(HERE, 'node_modules', '@dgreenheck', 'ez-tree');
 const PKG = JSON.parse(readFileSync(join(PKG_DIR, 'package.json'), 'utf8'));
 const THREE_PKG = JSON.parse(readFileSync(join(HERE, 'node_modules', 'three', 'package.json'), 'utf8'));
@@ -216,6 +261,22 @@ function meshToObj(mesh, tables, stats) {
   return { faces, source: index.count / 3, written, degenerate, flipped, uvMatrix: uvMatrix.elements };
 }
 
+/**
+ * ez-tree stores its indices in a Uint16Array, which wraps past 65,535 vertices
+ * (the heavy tree's leaves). If the geometry's index is not ez-tree's own index
+ * list, re-index with 32 bits; the leaf normals, which ez-tree computes from the
+ * index (computeVertexNormals), are recomputed the same way. Returns whether it did.
+ */
+function widenIndex(mesh, raw, recomputeNormals) {
+  const index = mesh.geometry.getIndex();
+  let same = index.array.length === raw.length;
+  for (let i = 0; same && i < raw.length; i++) same = index.array[i] === raw[i];
+  if (same) return false;
+  mesh.geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(raw), 1));
+  if (recomputeNormals) mesh.geometry.computeVertexNormals();
+  return true;
+}
+
 /** Writes a (possibly downscaled) copy of a texture; returns the file name. */
 async function writeTexture(src, dstDir, dstName, kind) {
   const dst = join(dstDir, dstName);
@@ -320,14 +381,21 @@ function verify(objPath) {
 
 const results = [];
 
-for (const sp of SPECIES) {
+for (const sp of LIST) {
   const preset = TreePreset[sp.preset];
   if (!preset) throw new Error(`unknown preset ${sp.preset}`);
 
+  const t0 = performance.now();
   const tree = new Tree();
   tree.options.copy(structuredClone(preset));
   tree.options.seed = sp.seed;
+  if (sp.overrides) tree.options.copy(structuredClone(sp.overrides));
   tree.generate();
+  const widened = [
+    widenIndex(tree.branchesMesh, tree.branches.indices, false) && 'bark',
+    widenIndex(tree.leavesMesh, tree.leaves.indices, true) && 'leaves',
+  ].filter(Boolean);
+  const tGenerated = performance.now();
   tree.updateMatrixWorld(true);
   for (const m of [tree, tree.branchesMesh, tree.leavesMesh]) {
     if (!m.matrixWorld.equals(new THREE.Matrix4())) {
@@ -376,8 +444,10 @@ for (const sp of SPECIES) {
   if (leaves.flipped) throw new Error(`${sp.name}: ${leaves.flipped} leaf triangles wound against their normals`);
 
   const height = stats.max.y; // trunk base is at y = 0
+  const overrides = sp.overrides ? `# Preset overrides: ${JSON.stringify(sp.overrides)}\n` : '';
   const header =
     `# ${sp.name}: ez-tree ${PKG.version} preset "${sp.preset}", seed ${sp.seed}\n` +
+    overrides +
     `# Generated by assets/trees/ez-tree/export.mjs (three ${THREE_PKG.version}); do not edit.\n` +
     `# Units: metres (ez-tree units x ${SCALE}), y up, trunk base at the origin.\n` +
     `# Faces are counter-clockwise seen from the front (normal side).\n` +
@@ -399,6 +469,7 @@ for (const sp of SPECIES) {
 
   const mtl =
     `# ${sp.name}: ez-tree ${PKG.version} preset "${sp.preset}", seed ${sp.seed}\n` +
+    overrides +
     `# Generated by assets/trees/ez-tree/export.mjs; do not edit.\n` +
     `# Kd is the preset's tint (sRGB, multiplied with the texture).\n` +
     `\n` +
@@ -430,8 +501,10 @@ for (const sp of SPECIES) {
 
   const check = verify(objPath);
   if (check.nf !== bark.written + leaves.written) throw new Error(`${sp.name}: face count mismatch`);
-  const glb = objToGlb(sp.name);
+  const glb = objToGlb(sp.name, OUT_ROOT);
   if (glb.triangles !== check.nf) throw new Error(`${sp.name}: GLB triangle count mismatch`);
+
+  const tWritten = performance.now();
 
   const files = [`${sp.name}.obj`, `${sp.name}.mtl`, barkFile, leafFile].map((f) => {
     const buf = readFileSync(join(dir, f));
@@ -447,6 +520,21 @@ for (const sp of SPECIES) {
       `  bounds [${stats.min.toArray().map((x) => x.toFixed(2))}]..[${stats.max.toArray().map((x) => x.toFixed(2))}]`,
   );
   for (const f of files) console.log(`         ${f.name.padEnd(24)} ${kib(f.size).padStart(10)}  ${f.sha256.slice(0, 16)}`);
+  if (ARGS.heavy) {
+    console.log(
+      `         ${`${sp.name}/${sp.name}.glb`.padEnd(24)} ${kib(glb.bytes).padStart(10)}` +
+        `\n         preset overrides ${JSON.stringify(sp.overrides)}` +
+        `\n         ez-tree vertices: bark ${tree.branches.verts.length / 3}, leaves ${tree.leaves.verts.length / 3};` +
+        ` re-indexed with 32 bits: ${widened.join(', ') || 'none'}` +
+        `\n         time: generate ${((tGenerated - t0) / 1000).toFixed(2)} s,` +
+        ` textures + OBJ/MTL + check + GLB ${((tWritten - tGenerated) / 1000).toFixed(2)} s`,
+    );
+  }
+}
+
+if (ARGS.heavy) {
+  console.log(`wrote ${join(OUT_ROOT, HEAVY.name)}/ (not a bundled model; LICENSE.md untouched)`);
+  process.exit(0);
 }
 
 // ---------------------------------------------------------------------------
@@ -491,6 +579,13 @@ npm ci            # exact versions from package-lock.json (ez-tree ${PKG.version
 node export.mjs   # rewrites assets/trees/<species>/ and this LICENSE.md
 node glb.mjs      # only re-converts the OBJ folders to GLB (no dependencies)
 \`\`\`
+
+\`node export.mjs --out DIR\` writes the same files under DIR instead, e.g. to check a
+re-run against the committed ones. \`node export.mjs --heavy --out DIR\` writes only
+\`DIR/${HEAVY.name}/\`, one "production-size" tree of about 280k triangles for profiling the
+bake ("${HEAVY.preset}" with more twigs, rounder branches and many more, smaller leaves; the
+overrides are in the script and in the OBJ header). It is not a bundled model, is not
+listed below, and --heavy refuses to write into this folder.
 
 The output is deterministic (ez-tree uses its own seeded RNG).
 

@@ -79,8 +79,9 @@ function parseObj(text) {
 
 const pad4 = (n) => (n + 3) & ~3;
 
-export function objToGlb(species) {
-  const dir = join(TREES, species);
+/** Converts root/<species>/ (default root: assets/trees; export.mjs --out passes its own). */
+export function objToGlb(species, root = TREES) {
+  const dir = join(root, species);
   const obj = parseObj(readFileSync(join(dir, `${species}.obj`), 'utf8'));
   const mats = parseMtl(readFileSync(join(dir, obj.mtllib), 'utf8'));
 
