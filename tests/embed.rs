@@ -47,6 +47,8 @@ fn the_example_matches_forest_render() {
         "160x120",
         "--epsilon",
         "2",
+        "--haze",
+        "off",
         "-o",
         &p("cli.png"),
     ]));

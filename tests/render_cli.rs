@@ -214,6 +214,28 @@ fn bake_scene_render_end_to_end() {
     ]));
     assert!(e.contains("size"), "{e}");
     assert!(!d.join("x.png").exists());
+    for (flag, value) in [
+        ("--haze", "0"),
+        ("--haze", "-3"),
+        ("--haze", "fog"),
+        ("--haze-height", "inf"),
+    ] {
+        let e = err(&forest(&[
+            "render",
+            &p("f.forest"),
+            "-o",
+            &p("x.png"),
+            "--view",
+            "inside",
+            flag,
+            value,
+        ]));
+        assert!(
+            e.contains(flag) && e.contains("expected off or a distance in metres"),
+            "{e}"
+        );
+        assert!(!d.join("x.png").exists());
+    }
     std::fs::write(d.join("broken.forest"), b"FRST\x01\x00\x00\x00").unwrap();
     let e = err(&forest(&[
         "render",

@@ -1,5 +1,6 @@
 // Drawing of the geometry-based methods (see geometry.wgsl). Appended after common.wgsl and
-// geometry_types.wgsl; ground.wgsl follows.
+// geometry_types.wgsl; environment.wgsl follows (the sky, the ground
+// and the haze every fragment goes through).
 //
 // Meshes are shaded with the project's one shading model (forest_format::shading) in the
 // tree's object space — the bake's lighting rotates with the tree, so every method must too —
@@ -16,6 +17,7 @@
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 @group(0) @binding(6) var tex_sampler: sampler;
 @group(0) @binding(7) var<uniform> light: Light;
+// binding 8: the environment (environment.wgsl).
 @group(0) @binding(9) var<storage, read> geo_species: array<GeoSpecies>;
 @group(0) @binding(10) var<uniform> method: Method;
 @group(0) @binding(11) var<storage, read> leaf_centre: array<vec4<f32>>;
@@ -33,6 +35,8 @@ struct GeoOut {
     // The instance and its quad share (see quad_share): in the hybrid's transition band the
     // geometry keeps the pixels the quads leave.
     @location(6) @interpolate(flat) form: vec2<u32>,
+    // The surface point (world, metres), for the haze.
+    @location(7) world: vec3<f32>,
 }
 
 // The instance and its quad share (0 outside the hybrid's transition band).
@@ -70,6 +74,7 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     let w = to_world(inst, p);
     var out: GeoOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
+    out.world = w;
     out.uv = v.uv;
     out.normal = v.normal;
     out.to_eye = to_object_dir(inst, camera.eye.xyz - w);
@@ -99,7 +104,7 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
     let ambient = light.sky.rgb * hemi + light.ground.rgb * (1.0 - hemi);
     var c = albedo * (ambient + light.sun.rgb * (in.sun_visibility * direct));
     if (in.contrast.a < 1.0) { c = in.contrast.rgb + in.contrast.a * (c - in.contrast.rgb); }
-    return vec4<f32>(c, 1.0);
+    return hazed(vec4<f32>(c, 1.0), in.world);
 }
 
 struct BillboardOut {
@@ -107,6 +112,7 @@ struct BillboardOut {
     @location(0) uv: vec2<f32>,
     @location(1) @interpolate(flat) layer: u32,
     @location(2) @interpolate(flat) form: vec2<u32>,
+    @location(3) world: vec3<f32>,
 }
 
 // A camera-facing quad over the tree's bounding sphere showing the billboard image whose
@@ -132,7 +138,8 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     let elevation = degrees(asin(clamp(-f.y, -1.0, 1.0)));
     let e = u32(clamp(round(elevation / 30.0), 0.0, 3.0));
     var out: BillboardOut;
-    out.clip = camera.view_proj * vec4<f32>(c + (right * x + up * y) * r, 1.0);
+    out.world = c + (right * x + up * y) * r;
+    out.clip = camera.view_proj * vec4<f32>(out.world, 1.0);
     out.uv = vec2<f32>(0.5 + 0.5 * x, 0.5 - 0.5 * y);
     out.layer = sp.lod_first.w + e;
     out.form = geo_form(id, inst);
@@ -144,5 +151,5 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     if (quads_own(in.clip.xy, in.form)) { discard; }
     let t = textureSample(billboards, tex_sampler, in.uv, in.layer);
     if (t.a < 0.5) { discard; }
-    return vec4<f32>(t.rgb, 1.0);
+    return hazed(vec4<f32>(t.rgb, 1.0), in.world);
 }

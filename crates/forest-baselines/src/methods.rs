@@ -134,6 +134,14 @@ impl ForestRenderer {
             Method::Hybrid(h) => {
                 h.validate()?;
                 let g = self.geometry.as_mut().ok_or(missing)?;
+                // Both forms draw into one image: one haze for both.
+                if g.atmosphere() != self.stream.atmosphere() {
+                    return Err(RenderError::Parameter(
+                        "the hybrid needs the same atmosphere for the quad stream and the \
+                         geometry renderer (build both from one RendererOptions)"
+                            .into(),
+                    ));
+                }
                 g.set_method(ctx, h.near_form)?;
                 self.stream.set_refine(true);
             }

@@ -1,7 +1,7 @@
 //! The geometry renderer's WGSL modules: the runtime's common module (camera, helpers) first,
 //! then this crate's types and stages.
 
-use forest_render::passes::{COMMON_WGSL, GROUND_WGSL};
+use forest_render::passes::{COMMON_WGSL, ENVIRONMENT_WGSL};
 
 /// Structs shared by the geometry renderer's modules.
 pub const GEOMETRY_TYPES_WGSL: &str = include_str!("../shaders/geometry_types.wgsl");
@@ -11,7 +11,7 @@ pub const GEOMETRY_DRAW_WGSL: [&str; 4] = [
     COMMON_WGSL,
     GEOMETRY_TYPES_WGSL,
     include_str!("../shaders/geometry_draw.wgsl"),
-    GROUND_WGSL,
+    ENVIRONMENT_WGSL,
 ];
 
 /// WGSL of the full-geometry culling.

@@ -10,7 +10,7 @@ use forest_baselines::geometry::{
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
-use forest_render::options::{AspectBlend, RendererOptions, StreamOptions};
+use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
@@ -48,6 +48,15 @@ pub struct RenderArgs {
     /// Draw over a transparent background without ground (alpha = tree coverage, for metrics).
     #[arg(long)]
     pub transparent: bool,
+    /// Distance haze, the same for every method: the visibility along the ground in metres
+    /// (where 2 % of a surface's contrast is left), or `off`. Default: 2000 over the sky, off
+    /// with --transparent.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_haze)]
+    pub haze: Option<f32>,
+    /// Height in metres over which the haze thins by a factor e, or `off` for haze as thick
+    /// at every height.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_haze, default_value_t = Atmosphere::DEMO_HAZE_HEIGHT)]
+    pub haze_height: f32,
     #[command(flatten)]
     pub m: MethodArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
@@ -233,6 +242,19 @@ pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
     match v.as_slice() {
         [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
         _ => Err(format!("{s:?}: expected x,y,z")),
+    }
+}
+
+/// `off` (infinite) or a distance in metres, positive and finite.
+pub(crate) fn parse_haze(s: &str) -> Result<f32, String> {
+    if s == "off" {
+        return Ok(f32::INFINITY);
+    }
+    match s.parse::<f32>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!(
+            "{s:?}: expected off or a distance in metres above 0"
+        )),
     }
 }
 
@@ -434,6 +456,7 @@ fn stream_for(
         min_epsilon: args.epsilon.min(8.0),
         viewport: stream_viewport(args),
         background: background(args),
+        atmosphere: atmosphere(args),
         refine: args.m.method != "impostor",
         ..Default::default()
     };
@@ -452,7 +475,7 @@ fn render_hybrid(
     cameras: &[(String, Camera)],
 ) -> Result<()> {
     let prepared = prepare_models(&args.m.models, species)?;
-    let geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
+    let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &geometry_options(args))?;
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
     r.set_pipeline_statistics(args.json);
@@ -496,6 +519,30 @@ fn render_hybrid(
         }
     }
     Ok(())
+}
+
+/// The geometry renderer's options: the stream's background and atmosphere, the crate's own
+/// targets.
+fn geometry_options(args: &RenderArgs) -> RendererOptions {
+    RendererOptions {
+        format: TARGET_FORMAT,
+        background: background(args),
+        atmosphere: atmosphere(args),
+        ..Default::default()
+    }
+}
+
+/// The haze asked for, or by default the demo's over the sky and none over transparent.
+fn atmosphere(args: &RenderArgs) -> Atmosphere {
+    let default = if args.transparent {
+        f32::INFINITY
+    } else {
+        Atmosphere::DEMO_VISIBILITY
+    };
+    Atmosphere {
+        haze_height: args.haze_height,
+        ..Atmosphere::hazy(args.haze.unwrap_or(default))
+    }
 }
 
 fn background(args: &RenderArgs) -> forest_render::options::Background {
@@ -564,7 +611,7 @@ fn render_geometry(
     cameras: &[(String, Camera)],
 ) -> Result<()> {
     let prepared = prepare_models(&args.m.models, species)?;
-    let mut geo = GeometryRenderer::new(ctx, &prepared, forest, TARGET_FORMAT, background(args))?;
+    let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &geometry_options(args))?;
     geo.set_method(ctx, method)?;
     let (sw, sh) = (
         args.size.0 * args.supersample,

@@ -11,7 +11,7 @@ use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::ForestRenderer;
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
-use forest_render::options::{Background, DebugView, RendererOptions};
+use forest_render::options::{Atmosphere, Background, DebugView, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
@@ -61,7 +61,7 @@ fn parse_debug_view(s: &str) -> Result<DebugView, String> {
 }
 
 /// The quad stream of `forest` for a colour format, sized for `viewport` and ε `min_epsilon`
-/// (pixels), over the sky and ground.
+/// (pixels), over the sky and ground, in the demo's haze.
 fn quad_stream(
     ctx: &GpuContext,
     species: &[SpeciesData],
@@ -75,6 +75,7 @@ fn quad_stream(
         viewport,
         min_epsilon,
         background: Background::Sky,
+        atmosphere: Atmosphere::hazy(Atmosphere::DEMO_VISIBILITY),
         ..Default::default()
     };
     Ok(QuadStream::new(
@@ -84,19 +85,22 @@ fn quad_stream(
     )?)
 }
 
-/// The geometry renderer of `forest` for a colour format, over the sky and ground.
+/// The geometry renderer of `forest` for a colour format, over the sky and ground, in the
+/// demo's haze.
 fn geometry(
     ctx: &GpuContext,
     prepared: &PreparedGeometry,
     forest: &Forest,
     format: wgpu::TextureFormat,
 ) -> Result<GeometryRenderer> {
-    Ok(GeometryRenderer::new(
-        ctx,
-        prepared,
-        forest,
+    let opts = RendererOptions {
         format,
-        Background::Sky,
+        background: Background::Sky,
+        atmosphere: Atmosphere::hazy(Atmosphere::DEMO_VISIBILITY),
+        ..Default::default()
+    };
+    Ok(GeometryRenderer::with_targets(
+        ctx, prepared, forest, &opts,
     )?)
 }
 

@@ -1,4 +1,4 @@
-// Pass 3, draw: every quad of the final stream becomes 4 vertices (a triangle strip, one
+// Pass 3, draw: the environment (environment.wgsl), then every quad of the final stream becomes 4 vertices (a triangle strip, one
 // instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
 // the sampling frame of its direction and slab (object space), then the instance transform.
 // Textured from the colour array (premultiplied, sRGB-decoded by the format) and blended
@@ -54,6 +54,8 @@ struct VsOut {
     // and in `w` the mip level a composited quad samples (one for the whole quad: the tree is
     // under ε pixels).
     @location(8) @interpolate(flat) depths: vec4<f32>,
+    // The quad's point (world, metres), for the haze.
+    @location(9) world: vec3<f32>,
 }
 
 // 1 inside a slab image, 0 outside (a shifted sample must not repeat the edge texels).
@@ -219,6 +221,7 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
     let flags = stream_flags(camera);
     var out: VsOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
+    out.world = w;
     out.uv = vec2<f32>(u, v);
     out.layer = sp.layer_base + dir * sp.slabs + slab;
     out.slabs = select(1u, sp.slabs, composite);
@@ -277,7 +280,7 @@ fn fs_composite(in: VsOut) -> @location(0) vec4<f32> {
 }
 
 // A quad's fragment of colour `c` (premultiplied): the hybrid's and the dither's masks, the
-// debug views, the aspect's alpha.
+// debug views, the haze, the aspect's alpha.
 fn shade(in: VsOut, c: vec4<f32>) -> vec4<f32> {
     // Position inside the quad in quad widths and its screen derivative (before any branch).
     let g = in.uv * f32(1u << in.level);
@@ -303,5 +306,5 @@ fn shade(in: VsOut, c: vec4<f32>) -> vec4<f32> {
             return vec4<f32>(1.0, 0.95, 0.2, 1.0) * in.alpha;
         }
     }
-    return c * in.alpha;
+    return hazed(c, in.world) * in.alpha;
 }

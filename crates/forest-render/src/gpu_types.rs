@@ -215,10 +215,22 @@ pub struct SceneConsts {
     pub species: u32,
 }
 
-/// Ground colour and size (16 bytes), written once.
+/// The environment (80 bytes), written once: what `shaders/environment.wgsl` draws behind the
+/// trees and the haze every method applies (see [`crate::options::Atmosphere`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuGround {
-    /// Lit colour (linear) and the half side of the ground square (metres).
-    pub colour: [f32; 4],
+pub struct GpuEnvironment {
+    /// Lit ground colour (linear RGB); `w` unused.
+    pub ground: [f32; 4],
+    /// Sky colour at the horizon and haze colour (linear RGB); `w`: haze extinction per metre
+    /// (0: no haze).
+    pub horizon: [f32; 4],
+    /// Sky colour at the zenith (linear RGB); `w`: the haze's falloff per metre of height
+    /// (0: homogeneous).
+    pub zenith: [f32; 4],
+    /// Unit direction towards the sun (world); `w`: cosine of the disc's angular radius (above
+    /// 1: no disc).
+    pub sun: [f32; 4],
+    /// The sun's colour (linear RGB); `w` unused.
+    pub sun_colour: [f32; 4],
 }

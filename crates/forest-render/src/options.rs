@@ -4,12 +4,12 @@
 
 use forest_format::shading::Lighting;
 
-use crate::gpu_types::GpuGround;
+use crate::gpu_types::GpuEnvironment;
 
 /// What the trees are drawn over.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Background {
-    /// Sky colour and a ground plane (the demo).
+    /// The sky and an endless ground plane at y = 0 ([`Atmosphere`]; the demo).
     #[default]
     Sky,
     /// Transparent black, no ground: the alpha channel is the trees' coverage (for metrics).
@@ -54,6 +54,8 @@ pub struct RendererOptions {
     pub lighting: Lighting,
     /// Sky and ground, or transparent.
     pub background: Background,
+    /// Sky colours, sun disc and distance haze (no haze by default).
+    pub atmosphere: Atmosphere,
     /// Refine the stream (the method). `false` draws the level-0 quads only: the static
     /// impostor baseline (each tree as its 1–3 blended slab images, never subdivided).
     pub refine: bool,
@@ -72,6 +74,7 @@ impl Default for RendererOptions {
             max_quads: None,
             lighting: Lighting::with_sun(30.0, 55.0),
             background: Background::Sky,
+            atmosphere: Atmosphere::CLEAR,
             refine: true,
         }
     }
@@ -254,7 +257,8 @@ pub fn direction_colour(dir: u32) -> [f32; 3] {
     })
 }
 
-/// Background colour (sky) the demo clears to, linear RGB.
+/// Colour a frame over [`Background::Sky`] is cleared to (linear RGB), before the environment
+/// pass draws the sky and ground over every pixel; hosts drawing their own sky may use it.
 pub const SKY: wgpu::Color = wgpu::Color {
     r: 0.45,
     g: 0.62,
@@ -262,19 +266,166 @@ pub const SKY: wgpu::Color = wgpu::Color {
     a: 1.0,
 };
 
-/// The ground's uniform: the ground albedo lit by the shared shading model (facing up, in sun),
-/// and a square reaching 5 km beyond the farthest tree.
-pub fn ground_uniform(
-    lighting: &Lighting,
-    instances: &[crate::gpu_types::GpuInstance],
-) -> GpuGround {
-    let extent = instances
-        .iter()
-        .map(|i| glam::Vec3::from_array(i.position).length())
-        .fold(0.0f32, f32::max);
-    let lit = lighting.shade(glam::Vec3::new(0.16, 0.14, 0.09), glam::Vec3::Y, 1.0, 0.0);
-    GpuGround {
-        colour: [lit.x, lit.y, lit.z, extent + 5000.0],
+/// Koschmieder's constant: haze of extinction `σ` per metre leaves `exp(−σ·V) = 2 %` of a
+/// surface's contrast at the visibility `V = 3.912 / σ`.
+pub const KOSCHMIEDER: f32 = 3.912;
+
+/// The sky, the sun's disc and distance haze (aerial perspective), drawn and applied the same
+/// way by every method, so images of different methods stay comparable.
+///
+/// Haze thins out with height (exponential height fog): its extinction at height `y` is
+/// `σ(y) = σ₀·exp(−y / haze_height)`, `σ₀ = KOSCHMIEDER / visibility`, so a surface keeps
+/// `T = exp(−τ)` of its colour and takes `1 − T` of the horizon colour (times its coverage, for
+/// premultiplied colour), `τ` being `σ` integrated along the segment from the eye
+/// ([`Self::optical_depth`]). Looking down from high above crosses less haze than looking
+/// along the ground. The sky is drawn only over [`Background::Sky`]; haze applies over either
+/// background.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Atmosphere {
+    /// Meteorological visibility in metres (> 0) along the ground (y = 0): where haze leaves
+    /// 2 % of a surface's contrast. `f32::INFINITY`: no haze.
+    pub visibility: f32,
+    /// Height in metres (> 0) over which the haze thins by a factor e. `f32::INFINITY`:
+    /// homogeneous haze.
+    pub haze_height: f32,
+    /// Sky colour at the horizon, which is also the haze's colour (linear RGB, ≥ 0).
+    pub horizon: [f32; 3],
+    /// Sky colour at the zenith (linear RGB, ≥ 0).
+    pub zenith: [f32; 3],
+    /// Draw the sun's disc in the sky, in the lighting's sun direction.
+    pub sun_disc: bool,
+}
+
+impl Atmosphere {
+    /// Clear air: the sky gradient and the sun's disc, no haze (what metrics use).
+    pub const CLEAR: Atmosphere = Atmosphere {
+        visibility: f32::INFINITY,
+        haze_height: Self::DEMO_HAZE_HEIGHT,
+        horizon: [0.62, 0.72, 0.84],
+        zenith: [0.20, 0.38, 0.72],
+        sun_disc: true,
+    };
+
+    /// Visibility along the ground of the demo and viewer's haze, metres: a 2–3 km forest
+    /// fades into the horizon.
+    pub const DEMO_VISIBILITY: f32 = 2000.0;
+
+    /// Scale height of the demo and viewer's haze, metres: a view from a few hundred metres
+    /// up still shows the forest below.
+    pub const DEMO_HAZE_HEIGHT: f32 = 200.0;
+
+    /// [`Self::CLEAR`] with haze of the given visibility along the ground (metres).
+    pub fn hazy(visibility: f32) -> Self {
+        Self {
+            visibility,
+            ..Self::CLEAR
+        }
+    }
+
+    /// Haze extinction σ₀ per metre at y = 0 (0 without haze).
+    pub fn haze_density(&self) -> f32 {
+        if self.visibility.is_finite() {
+            KOSCHMIEDER / self.visibility
+        } else {
+            0.0
+        }
+    }
+
+    /// `1 / haze_height` (0: homogeneous).
+    pub fn haze_falloff(&self) -> f32 {
+        if self.haze_height.is_finite() {
+            1.0 / self.haze_height
+        } else {
+            0.0
+        }
+    }
+
+    /// The haze's optical depth between `eye` and `point` (world, metres): σ integrated along
+    /// the segment, `σ₀·|p − e|·exp(−k·e.y)·(1 − exp(−k·Δy)) / (k·Δy)` with `k` the falloff
+    /// (the limit `σ₀·|p − e|·exp(−k·e.y)` as `k·Δy → 0`). Mirrors `optical_depth` in
+    /// `shaders/environment.wgsl`.
+    pub fn optical_depth(&self, eye: glam::Vec3, point: glam::Vec3) -> f32 {
+        optical_depth(self.haze_density(), self.haze_falloff(), eye, point)
+    }
+
+    /// The fraction of the colour of a surface at `point` left at `eye`, `exp(−τ)`.
+    pub fn transmittance(&self, eye: glam::Vec3, point: glam::Vec3) -> f32 {
+        (-self.optical_depth(eye, point)).exp()
+    }
+
+    /// Check the parameters: one message naming the first bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.visibility.is_nan() || self.visibility <= 0.0 {
+            return Err(format!(
+                "haze visibility {} m must be positive (infinite for no haze)",
+                self.visibility
+            ));
+        }
+        if self.haze_height.is_nan() || self.haze_height <= 0.0 {
+            return Err(format!(
+                "haze height {} m must be positive (infinite for homogeneous haze)",
+                self.haze_height
+            ));
+        }
+        for (name, c) in [("horizon", self.horizon), ("zenith", self.zenith)] {
+            if c.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(format!(
+                    "the {name} colour {c:?} must be finite and non-negative"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for Atmosphere {
+    fn default() -> Self {
+        Self::CLEAR
+    }
+}
+
+/// See [`Atmosphere::optical_depth`]: extinction `sigma` per metre at y = 0, falloff `k` per
+/// metre of height.
+fn optical_depth(sigma: f32, k: f32, eye: glam::Vec3, point: glam::Vec3) -> f32 {
+    let x = k * (point.y - eye.y);
+    // exp(−k·e.y)·(1 − e^−x) / x, written so that neither exponential overflows for eyes and
+    // points above the ground; by its series where x is small.
+    let f = if x.abs() < 1e-3 {
+        (-k * eye.y).exp() * (1.0 - 0.5 * x)
+    } else {
+        ((-k * eye.y).exp() - (-k * point.y).exp()) / x
+    };
+    sigma * eye.distance(point) * f
+}
+
+/// Angular radius of the sun's disc in degrees (the real sun's is 0.27°; drawn larger so that
+/// it shows at a few hundred pixels across).
+pub const SUN_DISC_DEGREES: f32 = 0.6;
+
+/// The ground's albedo lit by the shared shading model (facing up, in sun), linear RGB.
+pub fn ground_colour(lighting: &Lighting) -> glam::Vec3 {
+    lighting.shade(glam::Vec3::new(0.16, 0.14, 0.09), glam::Vec3::Y, 1.0, 0.0)
+}
+
+/// The environment uniform: ground colour, sky, sun disc and haze (see
+/// `shaders/environment.wgsl`).
+pub fn environment_uniform(lighting: &Lighting, atmosphere: &Atmosphere) -> GpuEnvironment {
+    let g = ground_colour(lighting);
+    let [hr, hg, hb] = atmosphere.horizon;
+    let [zr, zg, zb] = atmosphere.zenith;
+    let s = lighting.sun_dir.normalize_or_zero();
+    // A cosine above 1 draws no disc.
+    let disc = if atmosphere.sun_disc {
+        SUN_DISC_DEGREES.to_radians().cos()
+    } else {
+        2.0
+    };
+    GpuEnvironment {
+        ground: [g.x, g.y, g.z, 0.0],
+        horizon: [hr, hg, hb, atmosphere.haze_density()],
+        zenith: [zr, zg, zb, atmosphere.haze_falloff()],
+        sun: [s.x, s.y, s.z, disc],
+        sun_colour: lighting.sun.extend(0.0).to_array(),
     }
 }
 

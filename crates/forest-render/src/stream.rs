@@ -19,7 +19,9 @@ use crate::capacity::{Capacity, CapacityInput};
 use crate::context::{GpuContext, RenderError};
 use crate::frame::{FrameParams, Targets};
 use crate::gpu_types::{GpuArgs, GpuCamera, GpuState, Quad, SceneConsts};
-use crate::options::{Background, DebugView, RendererOptions, StreamOptions, ground_uniform};
+use crate::options::{
+    Atmosphere, Background, DebugView, RendererOptions, StreamOptions, environment_uniform,
+};
 use crate::passes::ComputeShared;
 use crate::passes::cull::CullPass;
 use crate::passes::draw::DrawPass;
@@ -82,7 +84,7 @@ pub struct QuadStream {
     opts: RendererOptions,
     passes: Passes,
     camera: wgpu::Buffer,
-    ground: wgpu::Buffer,
+    environment: wgpu::Buffer,
     sized: Sized,
     levels: u32,
     iterations: u32,
@@ -150,6 +152,7 @@ impl QuadStream {
                 opts.depth_format
             )));
         }
+        opts.atmosphere.validate().map_err(RenderError::Parameter)?;
         let capacity = capacity(&scene, opts, 0);
         let shared = ComputeShared::new(device);
         let passes = Passes {
@@ -164,9 +167,9 @@ impl QuadStream {
             contents: bytemuck::bytes_of(&crate::frame::nothing_visible()),
             usage: U::UNIFORM | U::COPY_DST,
         });
-        let ground = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("ground"),
-            contents: bytemuck::bytes_of(&ground_uniform(&opts.lighting, &scene.tables.instances)),
+        let environment = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("environment"),
+            contents: bytemuck::bytes_of(&environment_uniform(&opts.lighting, &opts.atmosphere)),
             usage: U::UNIFORM,
         });
         let queries = device
@@ -192,7 +195,7 @@ impl QuadStream {
             &scene,
             &passes,
             &camera,
-            &ground,
+            &environment,
             &capacity,
             &readback(queries.as_ref(), statistics.as_ref()),
         )?;
@@ -210,7 +213,7 @@ impl QuadStream {
             opts: opts.clone(),
             passes,
             camera,
-            ground,
+            environment,
             sized,
             queries,
             statistics,
@@ -231,7 +234,7 @@ impl QuadStream {
         scene: &GpuScene,
         passes: &Passes,
         camera: &wgpu::Buffer,
-        ground: &wgpu::Buffer,
+        environment: &wgpu::Buffer,
         capacity: &Capacity,
         readback: &[(&wgpu::Buffer, u64)],
     ) -> Result<Sized, RenderError> {
@@ -366,7 +369,7 @@ impl QuadStream {
                     wgpu::BindingResource::TextureView(&nodes_view),
                     wgpu::BindingResource::TextureView(&colour_view),
                     wgpu::BindingResource::Sampler(&sampler),
-                    ground.as_entire_binding(),
+                    environment.as_entire_binding(),
                     scene.roots.as_entire_binding(),
                     state.as_entire_binding(),
                 ]),
@@ -376,7 +379,16 @@ impl QuadStream {
         sources.extend(readback.iter().map(|(b, n)| ((*b).clone(), *n)));
         let ring = StatsRing::new(device, sources);
         let view_bytes = [
-            camera, &consts, ground, &state, &args, &data[0], &data[1], &sums, &quads[0], &quads[1],
+            camera,
+            &consts,
+            environment,
+            &state,
+            &args,
+            &data[0],
+            &data[1],
+            &sums,
+            &quads[0],
+            &quads[1],
         ]
         .iter()
         .map(|b| b.size())
@@ -384,7 +396,7 @@ impl QuadStream {
         let owned: Vec<(&'static str, wgpu::Buffer)> = [
             ("camera", camera),
             ("scene constants", &consts),
-            ("ground", ground),
+            ("environment", environment),
             ("state", &state),
             ("args", &args),
             ("scan data A", &data[0]),
@@ -455,7 +467,7 @@ impl QuadStream {
             &self.scene,
             &self.passes,
             &self.camera,
-            &self.ground,
+            &self.environment,
             &capacity,
             &readback(self.queries.as_ref(), self.statistics.as_ref()),
         )?;
@@ -529,6 +541,11 @@ impl QuadStream {
     /// whether it draws the ground; the pipelines do not depend on it).
     pub fn set_background(&mut self, background: Background) {
         self.opts.background = background;
+    }
+
+    /// The sky and haze, fixed when the stream was built.
+    pub fn atmosphere(&self) -> Atmosphere {
+        self.opts.atmosphere
     }
 
     /// The debug view in use.

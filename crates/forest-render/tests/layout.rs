@@ -29,9 +29,15 @@ fn compute_structs_match_the_host() {
 fn draw_structs_match_the_host() {
     let mut e = shared();
     e.push((
-        "Ground",
-        size_of::<GpuGround>(),
-        vec![("colour", offset_of!(GpuGround, colour))],
+        "Environment",
+        size_of::<GpuEnvironment>(),
+        vec![
+            ("ground", offset_of!(GpuEnvironment, ground)),
+            ("horizon", offset_of!(GpuEnvironment, horizon)),
+            ("zenith", offset_of!(GpuEnvironment, zenith)),
+            ("sun", offset_of!(GpuEnvironment, sun)),
+            ("sun_colour", offset_of!(GpuEnvironment, sun_colour)),
+        ],
     ));
     check(&draw_source(), &e);
 }

@@ -62,6 +62,7 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             count: None,
         },
         buffer(7, S::FRAGMENT, uniform),
+        buffer(8, S::FRAGMENT, uniform),
         buffer(9, S::VERTEX, read),
         buffer(10, S::VERTEX, uniform),
         buffer(11, S::VERTEX, read),

@@ -8,8 +8,8 @@ use forest_render::Targets;
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::gpu_types::GpuCamera;
-use forest_render::options::Background;
 use forest_render::options::RendererOptions;
+use forest_render::options::{Atmosphere, Background};
 use forest_render::stats::PassTimes;
 use forest_render::target::Target;
 use forest_render::work::{self, FrameWork, StatisticsQueries};
@@ -40,8 +40,8 @@ pub struct GeometryRenderer {
     scatter: wgpu::ComputePipeline,
     draw: wgpu::RenderPipeline,
     billboard: wgpu::RenderPipeline,
-    ground_pipeline: wgpu::RenderPipeline,
-    ground_bg: wgpu::BindGroup,
+    environment: wgpu::RenderPipeline,
+    atmosphere: Atmosphere,
     compute_bg: wgpu::BindGroup,
     draw_bg: wgpu::BindGroup,
     args: wgpu::Buffer,
@@ -102,6 +102,7 @@ impl GeometryRenderer {
             lighting: l,
         } = prepared;
         let l = *l;
+        opts.atmosphere.validate().map_err(RenderError::Parameter)?;
         if geo_species.len() != forest.species.len() {
             return Err(RenderError::SpeciesCount {
                 forest: forest.species.len(),
@@ -310,26 +311,20 @@ impl GeometryRenderer {
             T::TriangleList,
             Some(&draw_pl),
         );
-        let ground_pipeline = render_pipeline("vs_ground", "fs_ground", T::TriangleStrip, None);
-        let ground_buf = init(
-            "geometry ground",
-            bytemuck::bytes_of(&forest_render::options::ground_uniform(&l, &instances)),
+        let environment = render_pipeline(
+            "vs_environment",
+            "fs_environment",
+            T::TriangleList,
+            Some(&draw_pl),
+        );
+        let environment_buf = init(
+            "geometry environment",
+            bytemuck::bytes_of(&forest_render::options::environment_uniform(
+                &l,
+                &opts.atmosphere,
+            )),
             U::UNIFORM,
         );
-        let ground_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("geometry ground"),
-            layout: &ground_pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: ground_buf.as_entire_binding(),
-                },
-            ],
-        });
         let resources = vec![
             (0, camera.as_entire_binding()),
             (1, inst_buf.as_entire_binding()),
@@ -339,6 +334,7 @@ impl GeometryRenderer {
             (5, wgpu::BindingResource::TextureView(&material_view)),
             (6, wgpu::BindingResource::Sampler(&sampler)),
             (7, light_buf.as_entire_binding()),
+            (8, environment_buf.as_entire_binding()),
             (9, species_buf.as_entire_binding()),
             (10, method_buf.as_entire_binding()),
             (11, leaf_centre_buf.as_entire_binding()),
@@ -386,8 +382,8 @@ impl GeometryRenderer {
             scatter: cpl("geo_scatter"),
             draw,
             billboard,
-            ground_pipeline,
-            ground_bg,
+            environment,
+            atmosphere: opts.atmosphere,
             compute_bg,
             draw_bg,
             args,
@@ -429,7 +425,12 @@ impl GeometryRenderer {
         self.statistics.as_ref().filter(|_| self.count_work)
     }
 
-    /// Draw over `background` from the next frame on (the clear colour and the ground).
+    /// The sky and haze, fixed when the renderer was built.
+    pub fn atmosphere(&self) -> Atmosphere {
+        self.atmosphere
+    }
+
+    /// Draw over `background` from the next frame on (the clear colour, the sky and ground).
     pub fn set_background(&mut self, background: Background) {
         self.background = background;
     }
@@ -549,20 +550,19 @@ impl GeometryRenderer {
         }
     }
 
-    /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
-    /// `ground` and the background is the sky), then the bands nearest first.
+    /// Record the draw into a render pass after [`Self::encode_compute`]: the environment (sky
+    /// and ground, when `ground` and the background is the sky), then the bands nearest first.
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
         let ground = ground && self.background == Background::Sky;
+        pass.set_bind_group(0, &self.draw_bg, &[]);
         if ground {
-            pass.set_pipeline(&self.ground_pipeline);
-            pass.set_bind_group(0, &self.ground_bg, &[]);
-            pass.draw(0..4, 0..1);
+            pass.set_pipeline(&self.environment);
+            pass.draw(0..3, 0..1);
         }
-        // The statistics are the trees' alone (the ground is outside the query).
+        // The statistics are the trees' alone (the environment is outside the query).
         if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
         }
-        pass.set_bind_group(0, &self.draw_bg, &[]);
         let first_billboard = self.method.first_billboard_band();
         for band in 0..BANDS {
             if band == 0 {

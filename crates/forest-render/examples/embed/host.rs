@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use forest_render::options::{RendererOptions, SKY, ground_uniform};
+use forest_render::options::{RendererOptions, SKY, ground_colour};
 use forest_render::{FrameParams, GpuScene, QuadStream, RenderError};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
@@ -106,7 +106,8 @@ impl Host {
             ..Default::default()
         };
         // The ground colour `forest render` uses, so that the two frames can be compared.
-        let ground_colour = ground_uniform(&opts.lighting, &scene.tables.instances).colour;
+        // A 10 km square around the eye.
+        let ground_colour = ground_colour(&opts.lighting).extend(5000.0).to_array();
         let forest = QuadStream::new(device, scene, &opts)?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("host ground"),

@@ -1,4 +1,4 @@
-//! Pass 3, draw (`shaders/draw.wgsl`): the ground, then the final stream as an indirect,
+//! Pass 3, draw (`shaders/draw.wgsl`): the environment (sky and ground), then the final stream as an indirect,
 //! instanced triangle strip per quad, blended back to front.
 
 use super::{args, draw_source};
@@ -9,7 +9,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
-/// ground, layer roots, the frame's state (where the plain quads start).
+/// environment, layer roots, the frame's state (where the plain quads start).
 pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let storage = |binding| wgpu::BindGroupLayoutEntry {
@@ -72,9 +72,9 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
 
 /// The draw pass's pipelines.
 pub struct DrawPass {
-    /// Bind-group layout (camera, scene tables, final stream, textures, ground).
+    /// Bind-group layout (camera, scene tables, final stream, textures, environment).
     pub bind_layout: wgpu::BindGroupLayout,
-    ground: wgpu::RenderPipeline,
+    environment: wgpu::RenderPipeline,
     /// Far trees' composited quads (drawn first).
     composite: wgpu::RenderPipeline,
     quads: wgpu::RenderPipeline,
@@ -130,7 +130,7 @@ impl DrawPass {
             })
         };
         Self {
-            ground: pipeline("vs_ground", "fs_ground", None, true),
+            environment: pipeline("vs_environment", "fs_environment", None, true),
             composite: pipeline(
                 "vs_composite",
                 "fs_composite",
@@ -147,7 +147,7 @@ impl DrawPass {
         }
     }
 
-    /// Record the ground (when `ground`) and the indirect quad draws, the latter inside the
+    /// Record the environment (sky and ground, when `ground`) and the indirect quad draws, the latter inside the
     /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone):
     /// the composited far trees' draw when `composite` (the stream's options can make such
     /// quads), then the others'. Returns the draws recorded.
@@ -162,8 +162,8 @@ impl DrawPass {
     ) -> u32 {
         pass.set_bind_group(0, bind_group, &[]);
         if ground {
-            pass.set_pipeline(&self.ground);
-            pass.draw(0..4, 0..1);
+            pass.set_pipeline(&self.environment);
+            pass.draw(0..3, 0..1);
         }
         if let Some(set) = statistics {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);

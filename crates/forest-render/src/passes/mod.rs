@@ -13,8 +13,9 @@ pub mod refine;
 /// The WGSL every module starts with: the camera, the scene's structs, the shared helpers
 /// (other crates' shaders that read the camera, such as the baselines', start with it too).
 pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
-/// The ground plane's vertex and fragment stages (after [`COMMON_WGSL`]).
-pub const GROUND_WGSL: &str = include_str!("../../shaders/ground.wgsl");
+/// The environment (sky and ground) and the haze every method's fragments go through (after
+/// a module declaring `camera`).
+pub const ENVIRONMENT_WGSL: &str = include_str!("../../shaders/environment.wgsl");
 
 /// WGSL of the compute passes.
 pub const COMPUTE_WGSL: [&str; 6] = [
@@ -30,7 +31,7 @@ pub const COMPUTE_WGSL: [&str; 6] = [
 pub const DRAW_WGSL: [&str; 3] = [
     COMMON_WGSL,
     include_str!("../../shaders/draw.wgsl"),
-    GROUND_WGSL,
+    ENVIRONMENT_WGSL,
 ];
 
 /// The compute module's source.

@@ -1,0 +1,425 @@
+//! The environment and the haze: the sky, the endless ground and the sun's disc have analytic
+//! colours; haze mixes every method's trees towards the horizon colour by exp(−σ·distance);
+//! full geometry and the quad stream draw the same sky and ground and the same hazed tree.
+
+mod common;
+
+use forest_baselines::geometry::{GeometryRenderer, MeshMethod};
+use forest_format::forest::Forest;
+use forest_format::shading::srgb_decode_table;
+use forest_render::options::{
+    Atmosphere, Background, KOSCHMIEDER, RendererOptions, SUN_DISC_DEGREES, ground_colour,
+};
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+use glam::{Vec3, Vec4};
+
+const SIZE: (u32, u32) = (160, 120);
+
+fn options(background: Background, atmosphere: Atmosphere) -> RendererOptions {
+    RendererOptions {
+        format: TARGET_FORMAT,
+        viewport: SIZE,
+        min_epsilon: 1.0,
+        background,
+        atmosphere,
+        ..Default::default()
+    }
+}
+
+fn quads(ctx: &GpuContext, forest: &Forest, opts: &RendererOptions, cam: &Camera) -> Image {
+    let scene = GpuScene::new(ctx, &common::species(), forest).unwrap();
+    let mut stream = QuadStream::new(&ctx.device, scene, opts).unwrap();
+    let target = Target::new(ctx, SIZE.0, SIZE.1);
+    stream.render_frame(ctx, cam, &target).unwrap();
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    Image(target.read(ctx))
+}
+
+fn geometry(ctx: &GpuContext, forest: &Forest, opts: &RendererOptions, cam: &Camera) -> Image {
+    let mut geo = GeometryRenderer::with_targets(ctx, common::prepared(), forest, opts).unwrap();
+    geo.set_method(ctx, MeshMethod::default()).unwrap();
+    let target = Target::new(ctx, SIZE.0, SIZE.1);
+    geo.render_frame(ctx, cam, &target).unwrap();
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    Image(target.read(ctx))
+}
+
+/// A read-back frame, with its pixels decoded to linear premultiplied RGBA.
+struct Image(image::RgbaImage);
+
+impl Image {
+    fn linear(&self, x: u32, y: u32) -> Vec4 {
+        let t = srgb_decode_table();
+        let p = self.0.get_pixel(x, y);
+        Vec4::new(
+            t[p[0] as usize],
+            t[p[1] as usize],
+            t[p[2] as usize],
+            f32::from(p[3]) / 255.0,
+        )
+    }
+
+    fn save(&self, name: &str) {
+        let out = common::root().join("target/test-output");
+        std::fs::create_dir_all(&out).unwrap();
+        self.0
+            .save(out.join(format!("atmosphere-{name}.png")))
+            .unwrap();
+    }
+}
+
+/// The unit direction through the centre of pixel (x, y), by inverting the view-projection
+/// (the shader finds it another way).
+fn pixel_ray(cam: &Camera, x: u32, y: u32) -> Vec3 {
+    let ndc_x = 2.0 * (x as f32 + 0.5) / SIZE.0 as f32 - 1.0;
+    let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / SIZE.1 as f32;
+    let p = cam
+        .view_proj()
+        .inverse()
+        .project_point3(Vec3::new(ndc_x, ndc_y, 0.5));
+    (p - cam.eye).normalize()
+}
+
+fn camera(eye: Vec3, target: Vec3) -> Camera {
+    Camera {
+        viewport: SIZE,
+        far: 5000.0,
+        ..common::camera(eye, target, 1.0)
+    }
+}
+
+/// σ₀·exp(−y / haze_height) integrated from `a` to `b` by the midpoint rule.
+fn numeric_optical_depth(atmosphere: &Atmosphere, a: Vec3, b: Vec3) -> f32 {
+    let n = 4000;
+    let step = a.distance(b) / n as f32;
+    let sigma = KOSCHMIEDER / atmosphere.visibility;
+    (0..n)
+        .map(|i| {
+            let p = a.lerp(b, (i as f32 + 0.5) / n as f32);
+            sigma * (-p.y / atmosphere.haze_height).exp() * step
+        })
+        .sum()
+}
+
+#[test]
+fn the_optical_depth_integrates_the_height_fog() {
+    let a = Atmosphere {
+        haze_height: 50.0,
+        ..Atmosphere::hazy(800.0)
+    };
+    for (eye, p) in [
+        (Vec3::new(0.0, 2.0, 0.0), Vec3::new(300.0, 0.0, 40.0)),
+        (Vec3::new(0.0, 400.0, 0.0), Vec3::new(900.0, 3.0, -200.0)),
+        (Vec3::new(5.0, 30.0, 0.0), Vec3::new(-60.0, 30.0, 10.0)),
+        (Vec3::new(5.0, 30.0, 0.0), Vec3::new(-60.0, 30.02, 10.0)),
+        (Vec3::new(0.0, 1.7, 0.0), Vec3::new(10.0, 25.0, 10.0)),
+    ] {
+        let (got, want) = (a.optical_depth(eye, p), numeric_optical_depth(&a, eye, p));
+        assert!(
+            (got - want).abs() <= 1e-3 * want.max(1.0),
+            "{eye} → {p}: {got} vs {want}"
+        );
+        assert!((a.optical_depth(p, eye) - want).abs() <= 1e-3 * want.max(1.0));
+    }
+    // Homogeneous haze: σ₀·distance; no overflow from a very high eye.
+    let h = Atmosphere {
+        haze_height: f32::INFINITY,
+        ..a
+    };
+    let (e, p) = (Vec3::new(0.0, 3.0, 0.0), Vec3::new(30.0, 3.0, 40.0));
+    assert!((h.optical_depth(e, p) - KOSCHMIEDER / 800.0 * 50.0).abs() < 1e-5);
+    let high = a.optical_depth(Vec3::new(0.0, 30_000.0, 0.0), Vec3::ZERO);
+    assert!(high.is_finite() && high > 0.0, "{high}");
+}
+
+/// Within one step of 8-bit sRGB around `want` (linear RGB).
+fn close(got: Vec4, want: Vec3, what: &str) {
+    let d = (got.truncate() - want).abs().max_element();
+    assert!(
+        d <= 0.01 + 0.02 * want.max_element(),
+        "{what}: got {got}, want {want}"
+    );
+}
+
+#[test]
+fn sky_ground_and_sun_have_their_analytic_colours() {
+    let ctx = common::ctx();
+    let empty = Forest::new(vec!["bush".into(), "pine".into()], Vec::new(), 15);
+    // Haze thinning with height, with a low eye in it.
+    let atmosphere = Atmosphere {
+        haze_height: 3.0,
+        ..Atmosphere::hazy(400.0)
+    };
+    let opts = options(Background::Sky, atmosphere);
+    let horizon = Vec3::from_array(atmosphere.horizon);
+    let zenith = Vec3::from_array(atmosphere.zenith);
+    let ground = ground_colour(&opts.lighting);
+    // Looking north, a little up: the ground in the lower rows, the sky above.
+    let cam = camera(Vec3::new(3.0, 2.0, -4.0), Vec3::new(3.0, 2.5, 20.0));
+    for img in [
+        quads(&ctx, &empty, &opts, &cam),
+        geometry(&ctx, &empty, &opts, &cam),
+    ] {
+        let mut checked = [0; 2];
+        for y in (0..SIZE.1).step_by(7) {
+            for x in (0..SIZE.0).step_by(13) {
+                let d = pixel_ray(&cam, x, y);
+                // Skip the rows that straddle the horizon.
+                if d.y.abs() < 0.02 {
+                    continue;
+                }
+                let want = if d.y < 0.0 {
+                    let hit = cam.eye + d * (cam.eye.y / -d.y);
+                    let t = (-numeric_optical_depth(&atmosphere, cam.eye, hit)).exp();
+                    checked[0] += 1;
+                    ground * t + horizon * (1.0 - t)
+                } else {
+                    checked[1] += 1;
+                    let glow = opts.lighting.sun
+                        * (0.25 * d.dot(opts.lighting.sun_dir).max(0.0).powf(256.0));
+                    horizon.lerp(zenith, d.y.sqrt()) + glow
+                };
+                let got = img.linear(x, y);
+                if (got.truncate() - want).abs().max_element() > 0.01 + 0.02 * want.max_element() {
+                    img.save("analytic");
+                }
+                close(got, want, &format!("pixel ({x}, {y}), ray {d}"));
+            }
+        }
+        assert!(checked[0] > 20 && checked[1] > 20, "{checked:?}");
+    }
+    // Looking at the sun: its disc, in the sun's colour.
+    let sun = opts.lighting.sun_dir;
+    let cam = camera(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.0) + sun * 100.0,
+    );
+    let img = quads(&ctx, &empty, &opts, &cam);
+    let (cx, cy) = (SIZE.0 / 2, SIZE.1 / 2);
+    assert!(pixel_ray(&cam, cx, cy).dot(sun) > SUN_DISC_DEGREES.to_radians().cos());
+    close(
+        img.linear(cx, cy),
+        (opts.lighting.sun * 1.5).min(Vec3::ONE),
+        "the sun's disc",
+    );
+    // Without the disc (and its glow), the sky there is the gradient alone.
+    let no_disc = Atmosphere {
+        sun_disc: false,
+        ..atmosphere
+    };
+    let img = quads(&ctx, &empty, &options(Background::Sky, no_disc), &cam);
+    let d = pixel_ray(&cam, cx, cy);
+    close(
+        img.linear(cx, cy),
+        horizon.lerp(zenith, d.y.sqrt()),
+        "the sky without the disc",
+    );
+}
+
+#[test]
+fn haze_mixes_every_methods_tree_towards_the_horizon_by_its_distance() {
+    let ctx = common::ctx();
+    let forest = common::one_tree(1, 0.4);
+    let sphere = common::atlases()[1].manifest.bounding_sphere;
+    let centre = sphere.center;
+    let r = sphere.radius;
+    // About 25 crown radii away, where the stream at ε = 1 is close to the geometry.
+    let distance = 25.0 * r;
+    // A narrow field of view, so that the far tree still covers some 50 pixels across.
+    let cam = Camera {
+        fov_y_deg: 12.0,
+        ..camera(
+            centre + Vec3::new(0.3, 0.1, -1.0).normalize() * distance,
+            centre,
+        )
+    };
+    // Half the colour left at the tree's centre.
+    let visibility = KOSCHMIEDER * distance / std::f32::consts::LN_2;
+    // Homogeneous, so that a fragment's transmittance is bounded by the tree's nearest and
+    // farthest points'.
+    let hazy = Atmosphere {
+        haze_height: f32::INFINITY,
+        ..Atmosphere::hazy(visibility)
+    };
+    let clear = Atmosphere::CLEAR;
+    let horizon = Vec3::from_array(hazy.horizon);
+    let sigma = hazy.haze_density();
+    let (t_near, t_far) = (
+        (-sigma * (distance - r)).exp(),
+        (-sigma * (distance + r)).exp(),
+    );
+    let render = [quads, geometry];
+    let mut hazed_images = Vec::new();
+    for (name, draw) in ["quads", "geometry"].into_iter().zip(render) {
+        let plain = draw(
+            &ctx,
+            &forest,
+            &options(Background::Transparent, clear),
+            &cam,
+        );
+        let hazed = draw(&ctx, &forest, &options(Background::Transparent, hazy), &cam);
+        let (mut n, mut err_sum, mut moved) = (0u32, 0.0f32, 0.0f32);
+        let mut worst = 0.0f32;
+        for y in 0..SIZE.1 {
+            for x in 0..SIZE.0 {
+                let (u, h) = (plain.linear(x, y), hazed.linear(x, y));
+                // The haze never changes coverage.
+                assert!(
+                    (u.w - h.w).abs() <= 1.0 / 255.0,
+                    "{name}: alpha at ({x}, {y})"
+                );
+                if u.w < 0.5 {
+                    continue;
+                }
+                // Each fragment keeps T of its colour, T between the tree's nearest and
+                // farthest points' transmittance, and takes 1 − T of the horizon colour.
+                let at = |t: f32| u.truncate() * t + horizon * (u.w * (1.0 - t));
+                let (a, b) = (at(t_near), at(t_far));
+                let lo = a.min(b) - Vec3::splat(0.01);
+                let hi = a.max(b) + Vec3::splat(0.01);
+                let c = h.truncate();
+                let out = (lo - c).max(c - hi).max(Vec3::ZERO).max_element();
+                worst = worst.max(out);
+                err_sum += (c - at(0.5)).abs().max_element();
+                moved += (c - u.truncate()).abs().max_element();
+                n += 1;
+            }
+        }
+        assert!(n > 50, "{name}: {n} covered pixels");
+        if worst > 0.01 || err_sum / n as f32 > 0.01 {
+            plain.save(&format!("{name}-clear"));
+            hazed.save(&format!("{name}-hazed"));
+        }
+        eprintln!(
+            "{name}: {n} pixels, worst {worst:.4} outside the bounds, mean error {:.4}, moved {:.3}",
+            err_sum / n as f32,
+            moved / n as f32
+        );
+        assert!(
+            worst <= 0.01,
+            "{name}: a pixel {worst} outside its haze bounds"
+        );
+        assert!(
+            err_sum / n as f32 <= 0.01,
+            "{name}: mean error {} against T = 0.5 at the centre",
+            err_sum / n as f32
+        );
+        // The haze did something a missing haze would fail.
+        assert!(
+            moved / n as f32 > 0.05,
+            "{name}: haze moved colours by {moved}"
+        );
+        hazed_images.push(draw(&ctx, &forest, &options(Background::Sky, hazy), &cam));
+    }
+    // Over the sky, both methods draw the same environment: wherever neither draws the tree,
+    // their pixels are identical, and the hazed trees agree as closely as the methods do.
+    let (q, g) = (&hazed_images[0], &hazed_images[1]);
+    let plain_q = quads(
+        &ctx,
+        &forest,
+        &options(Background::Transparent, clear),
+        &cam,
+    );
+    let plain_g = geometry(
+        &ctx,
+        &forest,
+        &options(Background::Transparent, clear),
+        &cam,
+    );
+    let mut background = 0;
+    for (x, y, p) in q.0.enumerate_pixels() {
+        if plain_q.0.get_pixel(x, y)[3] == 0 && plain_g.0.get_pixel(x, y)[3] == 0 {
+            assert_eq!(p, g.0.get_pixel(x, y), "environment at ({x}, {y})");
+            background += 1;
+        }
+    }
+    assert!(background > 1000, "{background} background pixels");
+    let (hazed_flip, _) = forest_metrics::flip(&g.0, &q.0).unwrap();
+    let (clear_flip, _) = forest_metrics::flip(
+        &geometry(&ctx, &forest, &options(Background::Sky, clear), &cam).0,
+        &quads(&ctx, &forest, &options(Background::Sky, clear), &cam).0,
+    )
+    .unwrap();
+    eprintln!("FLIP between the methods: {hazed_flip:.4} hazed, {clear_flip:.4} clear");
+    if hazed_flip > clear_flip + 0.002 {
+        q.save("quads-sky");
+        g.save("geometry-sky");
+    }
+    assert!(
+        hazed_flip <= clear_flip + 0.002,
+        "FLIP between the methods: {hazed_flip} hazed, {clear_flip} clear"
+    );
+}
+
+#[test]
+fn bad_atmospheres_are_refused_with_their_cause() {
+    let ctx = common::ctx();
+    let forest = common::one_tree(0, 0.0);
+    let scene = std::sync::Arc::new(GpuScene::new(&ctx, &common::species(), &forest).unwrap());
+    for (atmosphere, cause) in [
+        (Atmosphere::hazy(0.0), "visibility"),
+        (Atmosphere::hazy(-5.0), "visibility"),
+        (Atmosphere::hazy(f32::NAN), "visibility"),
+        (
+            Atmosphere {
+                zenith: [0.2, f32::INFINITY, 0.1],
+                ..Atmosphere::CLEAR
+            },
+            "zenith",
+        ),
+        (
+            Atmosphere {
+                horizon: [-0.1, 0.5, 0.5],
+                ..Atmosphere::CLEAR
+            },
+            "horizon",
+        ),
+    ] {
+        let opts = options(Background::Sky, atmosphere);
+        let Err(e) = QuadStream::new(&ctx.device, scene.clone(), &opts) else {
+            panic!("{atmosphere:?} accepted");
+        };
+        assert!(e.to_string().contains(cause), "{e}");
+        let Err(e) = GeometryRenderer::with_targets(&ctx, common::prepared(), &forest, &opts)
+        else {
+            panic!("{atmosphere:?} accepted by the geometry renderer");
+        };
+        assert!(e.to_string().contains(cause), "{e}");
+    }
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
+#[test]
+fn the_hybrid_refuses_forms_in_different_atmospheres() {
+    use forest_baselines::hybrid::Hybrid;
+    use forest_baselines::methods::{ForestRenderer, Method};
+    let ctx = common::ctx();
+    let forest = common::one_tree(0, 0.0);
+    let build = |stream_haze: Atmosphere| {
+        let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+        let stream =
+            QuadStream::new(&ctx.device, scene, &options(Background::Sky, stream_haze)).unwrap();
+        let geo = GeometryRenderer::with_targets(
+            &ctx,
+            common::prepared(),
+            &forest,
+            &options(Background::Sky, Atmosphere::hazy(900.0)),
+        )
+        .unwrap();
+        ForestRenderer::new(stream, Some(geo))
+    };
+    let mut same = build(Atmosphere::hazy(900.0));
+    same.set_method(&ctx, Method::Hybrid(Hybrid::default()))
+        .unwrap();
+    let mut different = build(Atmosphere::CLEAR);
+    let e = different
+        .set_method(&ctx, Method::Hybrid(Hybrid::default()))
+        .unwrap_err();
+    assert!(e.to_string().contains("atmosphere"), "{e}");
+    // The single-form methods draw alone and take either.
+    different
+        .set_method(&ctx, Method::Mesh(MeshMethod::default()))
+        .unwrap();
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
