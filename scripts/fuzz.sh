@@ -15,7 +15,7 @@ execs=${1:-1000000}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(forest_binary forest_json camera_path nodes atlas obj image)
+  targets=(forest_binary forest_json camera_path nodes atlas obj gltf image)
 fi
 
 if ! command -v cargo-afl >/dev/null; then

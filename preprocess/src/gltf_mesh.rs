@@ -13,12 +13,16 @@
 //!   BLEND is drawn alpha-tested at 0.5 like MASK at its default cutoff (the bake and every
 //!   renderer composite opaque, alpha-tested leaves). Every triangle is drawn double-sided,
 //!   as the OBJ's are, whatever `doubleSided` says;
-//! - buffers and images from the GLB's binary chunk or from files next to the model (read
-//!   with the same size limits as the OBJ's files), images as PNG or JPEG.
+//! - buffers and images from the GLB's binary chunk or from files next to the model (their
+//!   URIs percent-decoded; read with the same size limits as the OBJ's files), images as PNG
+//!   or JPEG.
 //!
 //! Refused, with a message naming it: `extensionsRequired`, `KHR_texture_transform` (it moves
 //! texture coordinates), `data:` URIs, skins, non-triangle primitives, textures on a
-//! coordinate set other than 0, and a file with no mesh.
+//! coordinate set other than 0, sparse accessors, and a file with no mesh; and, before the
+//! gltf crates (1.4.1) would panic on them, attributes naming missing accessors, accessors of
+//! types glTF does not allow for their attribute, images without a source or MIME type, and
+//! node hierarchies that are not trees.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -50,7 +54,8 @@ fn parse_err(path: &Path, reason: impl Into<String>) -> BakeError {
     }
 }
 
-/// An external file a URI names, relative to the model's folder (`data:` URIs refused).
+/// An external file a URI names, relative to the model's folder, its `%XX` escapes decoded
+/// (a URI reference, as glTF requires; `data:` URIs refused).
 fn external(path: &Path, uri: &str, what: &str) -> Result<PathBuf, BakeError> {
     if uri.starts_with("data:") {
         return Err(parse_err(
@@ -58,8 +63,16 @@ fn external(path: &Path, uri: &str, what: &str) -> Result<PathBuf, BakeError> {
             format!("{what} is a data: URI, which is not supported (use a .glb or a file)"),
         ));
     }
+    let name = percent_encoding::percent_decode_str(uri)
+        .decode_utf8()
+        .map_err(|_| {
+            parse_err(
+                path,
+                format!("{what} URI {uri:?} does not decode to a UTF-8 file name"),
+            )
+        })?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    Ok(dir.join(uri.replace("%20", " ")))
+    Ok(dir.join(name.as_ref()))
 }
 
 /// The files a glTF model is read from: itself, and the buffers and images its URIs name.
@@ -67,18 +80,13 @@ pub fn source_files(path: &Path) -> Result<Vec<PathBuf>, BakeError> {
     let bytes = bounded::read(path, bounded::limit::DATA)?;
     let doc = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| parse_err(path, e.to_string()))?;
+    // From the JSON itself: the document is not validated, and the crate's accessors unwrap.
+    let json = doc.document.as_json();
     let mut files = vec![path.to_path_buf()];
-    for b in doc.buffers() {
-        if let gltf::buffer::Source::Uri(uri) = b.source()
-            && let Ok(f) = external(path, uri, "a buffer")
-        {
-            files.push(f);
-        }
-    }
-    for i in doc.images() {
-        if let gltf::image::Source::Uri { uri, .. } = i.source()
-            && let Ok(f) = external(path, uri, "an image")
-        {
+    let uris = (json.buffers.iter().map(|b| b.uri.as_deref()))
+        .chain(json.images.iter().map(|i| i.uri.as_deref()));
+    for uri in uris.flatten() {
+        if let Ok(f) = external(path, uri, "a file") {
             files.push(f);
         }
     }
@@ -130,22 +138,97 @@ fn refuse_extensions(path: &Path, doc: &gltf::Document) -> Result<(), BakeError>
     Ok(())
 }
 
+/// What the gltf crates (1.4.1) would panic on: a primitive attribute naming an accessor the
+/// file lacks (validation indexes the accessors with POSITION's before checking it), an image
+/// with neither a URI nor a buffer view, or a buffer view without a MIME type
+/// (`Image::source` unwraps both).
+fn check_json(path: &Path, json: &gltf::json::Root) -> Result<(), BakeError> {
+    for (i, image) in json.images.iter().enumerate() {
+        let reason = match (&image.buffer_view, &image.uri, &image.mime_type) {
+            (Some(_), _, None) => "has a buffer view but no mimeType",
+            (None, None, _) => "has neither a uri nor a buffer view",
+            _ => continue,
+        };
+        return Err(parse_err(path, format!("image {i} {reason}")));
+    }
+    let count = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= count {
+                    let name = match semantic {
+                        gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                        gltf::json::validation::Checked::Invalid => "an unknown attribute".into(),
+                    };
+                    return Err(parse_err(
+                        path,
+                        format!(
+                            "mesh {m}, primitive {p}: {name} names accessor {}, but the file \
+                             has {count}",
+                            index.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The accessors a primitive is read through have the types glTF requires of them (the gltf
+/// crate's readers assume them and panic otherwise), and none is sparse.
+fn check_accessors(path: &Path, at: &str, prim: &gltf::Primitive) -> Result<(), BakeError> {
+    use gltf::accessor::{DataType as D, Dimensions as N};
+    use gltf::mesh::Semantic as S;
+    let check = |name: &str, a: gltf::Accessor, types: &[D], dims: N| {
+        if a.sparse().is_some() {
+            return Err(parse_err(
+                path,
+                format!("{at}: {name} is a sparse accessor, which is not supported"),
+            ));
+        }
+        if !types.contains(&a.data_type()) || a.dimensions() != dims {
+            return Err(parse_err(
+                path,
+                format!(
+                    "{at}: {name} is {:?} {:?}; glTF requires {dims:?} of {types:?}",
+                    a.dimensions(),
+                    a.data_type()
+                ),
+            ));
+        }
+        Ok(())
+    };
+    for (semantic, a) in prim.attributes() {
+        match semantic {
+            S::Positions => check("POSITION", a, &[D::F32], N::Vec3)?,
+            S::Normals => check("NORMAL", a, &[D::F32], N::Vec3)?,
+            S::TexCoords(0) => check("TEXCOORD_0", a, &[D::F32, D::U8, D::U16], N::Vec2)?,
+            _ => {}
+        }
+    }
+    if let Some(a) = prim.indices() {
+        check("the indices", a, &[D::U8, D::U16, D::U32], N::Scalar)?;
+    }
+    Ok(())
+}
+
 /// Load a glTF 2.0 model (see the module docs for what is read and what is refused).
 pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     let bytes = bounded::read(path, bounded::limit::DATA)?;
     let mut hash = fnv1a(FNV_OFFSET, &bytes);
-    // Validation calls an unsupported required extension invalid: on failure, the file is
-    // parsed again without it so that the message can name the extension.
-    let doc = match gltf::Gltf::from_slice(&bytes) {
-        Ok(doc) => doc,
-        Err(e) => {
-            if let Ok(doc) = gltf::Gltf::from_slice_without_validation(&bytes) {
-                refuse_extensions(path, &doc)?;
-            }
-            return Err(parse_err(path, e.to_string()));
-        }
+    // Parsed, then checked for what validation would call invalid without naming (an
+    // unsupported required extension) or lets through to a panic in the gltf crates, then
+    // validated.
+    let parsed = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| parse_err(path, e.to_string()))?;
+    refuse_extensions(path, &parsed)?;
+    check_json(path, parsed.document.as_json())?;
+    let doc = gltf::Gltf {
+        document: gltf::Document::from_json(parsed.document.into_json())
+            .map_err(|e| parse_err(path, e.to_string()))?,
+        blob: parsed.blob,
     };
-    refuse_extensions(path, &doc)?;
 
     // Buffers: the GLB's binary chunk, or files; each at least as long as it says.
     let mut buffers: Vec<Vec<u8>> = Vec::new();
@@ -309,7 +392,16 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     let mut raw: Vec<RawTri> = Vec::new();
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     let mut meshes = 0usize;
+    // Nodes form trees: a scene visits each at most once (a cycle would never end).
+    let mut visits = 0usize;
     while let Some((node, parent)) = stack.pop() {
+        visits += 1;
+        if visits > doc.nodes().len() {
+            return Err(parse_err(
+                path,
+                "the node hierarchy is not a tree (a cycle, or a node with two parents)",
+            ));
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if node.skin().is_some() {
             return Err(parse_err(
@@ -340,6 +432,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                     None => continue,
                 },
             };
+            check_accessors(path, &at(), &prim)?;
             let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let pos: Vec<Vec3> = reader
                 .read_positions()

@@ -166,12 +166,63 @@ fn unsupported_gltf_features_are_named() {
     let e = Mesh::load(&path).unwrap_err().to_string();
     assert!(e.contains("data: URI"), "{e}");
     // A missing buffer file names the file.
+    let tri_bytes = std::fs::read(dir.path().join("tri.bin")).unwrap();
     std::fs::remove_file(dir.path().join("tri.bin")).unwrap();
     std::fs::write(&path, &text).unwrap();
     let e = Mesh::load(&path).unwrap_err().to_string();
     assert!(e.contains("tri.bin"), "{e}");
+    // Escapes in a URI are decoded: "tri%20%2B%C3%A9.bin" names "tri +é.bin".
+    std::fs::write(dir.path().join("tri +é.bin"), &tri_bytes).unwrap();
+    std::fs::write(&path, text.replace("tri.bin", "tri%20%2B%C3%A9.bin")).unwrap();
+    assert_eq!(Mesh::load(&path).unwrap().tris.len(), 1);
+    assert!(
+        forest_bake::mesh::source_files(&path)
+            .unwrap()
+            .contains(&dir.path().join("tri +é.bin"))
+    );
+    // An escape that is not UTF-8 is named.
+    std::fs::write(&path, text.replace("tri.bin", "tri%FF.bin")).unwrap();
+    let e = Mesh::load(&path).unwrap_err().to_string();
+    assert!(e.contains("UTF-8") && e.contains("tri%FF.bin"), "{e}");
     // Not glTF at all.
     std::fs::write(&path, "solid cube").unwrap();
     let e = Mesh::load(&path).unwrap_err().to_string();
     assert!(e.contains("glTF"), "{e}");
+}
+
+#[test]
+fn malformed_gltf_is_refused_without_a_panic() {
+    // Each once panicked the gltf crates (found by the fuzz target): refused with the cause.
+    let dir = tempfile::tempdir().unwrap();
+    let path = write_gltf(dir.path(), "", r#"{"mesh":0}"#, "{}");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let refused = |from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        std::fs::write(&path, text.replace(from, to)).unwrap();
+        let e = Mesh::load(&path).unwrap_err().to_string();
+        // The file list the bake checks its output against must not panic either.
+        let _ = forest_bake::mesh::source_files(&path);
+        e
+    };
+    let e = refused(r#""POSITION":0"#, r#""POSITION":7"#);
+    assert!(e.contains("POSITION names accessor 7"), "{e}");
+    let e = refused(r#""material":0}"#, r#""material":0,"indices":0}"#);
+    assert!(e.contains("the indices") && e.contains("Scalar"), "{e}");
+    let e = refused(
+        r#""materials":[{}]"#,
+        r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+        "textures":[{"source":0}],"images":[{"name":"nowhere"}]"#,
+    );
+    assert!(
+        e.contains("image 0 has neither a uri nor a buffer view"),
+        "{e}"
+    );
+    let e = refused(
+        r#""materials":[{}]"#,
+        r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+        "textures":[{"source":0}],"images":[{"bufferView":0}]"#,
+    );
+    assert!(e.contains("no mimeType"), "{e}");
+    let e = refused(r#"{"mesh":0}"#, r#"{"mesh":0,"children":[0]}"#);
+    assert!(e.contains("not a tree"), "{e}");
 }

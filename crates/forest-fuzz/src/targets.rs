@@ -71,6 +71,12 @@ pub const TARGETS: &[Target] = &[
         covers: "OBJ + MTL + texture through the bake's loader (`Mesh::load`, `source_files`)",
     },
     Target {
+        name: "gltf",
+        run: gltf,
+        bound: IMAGE_BOUND,
+        covers: "glTF 2.0 (`.gltf` with its buffer and image files, or one `.glb`) through the bake's loader (`Mesh::load`, `source_files`)",
+    },
+    Target {
         name: "image",
         run: image,
         bound: IMAGE_BOUND,
@@ -115,21 +121,42 @@ fn atlas(data: &[u8]) -> bool {
 }
 
 thread_local! {
-    /// A folder per thread for the OBJ target's files (the loader reads paths).
-    static OBJ_DIR: tempfile::TempDir = tempfile::Builder::new()
-        .prefix("forest-fuzz-obj")
+    /// A folder per thread for the model targets' files (the loaders read paths; each run
+    /// writes every file it names).
+    static MODEL_DIR: tempfile::TempDir = tempfile::Builder::new()
+        .prefix("forest-fuzz-model")
         .tempdir()
-        .expect("a temporary folder for the OBJ target");
+        .expect("a temporary folder for the model targets");
 }
 
 /// Files: `model.obj`, `model.mtl`, `leaf.png` (the names the seeds refer to).
 fn obj(data: &[u8]) -> bool {
     let files = crate::split_files(data, 3);
-    OBJ_DIR.with(|dir| {
+    MODEL_DIR.with(|dir| {
         let path = dir.path().join("model.obj");
         for (name, bytes) in ["model.obj", "model.mtl", "leaf.png"].iter().zip(&files) {
             std::fs::write(dir.path().join(name), bytes).expect("writing a fuzz input file");
         }
+        let _ = forest_bake::mesh::source_files(&path);
+        forest_bake::Mesh::load(&path).is_ok()
+    })
+}
+
+/// A binary glTF alone when the input starts with its magic (`model.glb`); else files
+/// `model.gltf`, `model.bin`, `leaf.png` (the names the seeds refer to).
+fn gltf(data: &[u8]) -> bool {
+    MODEL_DIR.with(|dir| {
+        let path = if data.starts_with(b"glTF") {
+            let path = dir.path().join("model.glb");
+            std::fs::write(&path, data).expect("writing a fuzz input file");
+            path
+        } else {
+            let files = crate::split_files(data, 3);
+            for (name, bytes) in ["model.gltf", "model.bin", "leaf.png"].iter().zip(&files) {
+                std::fs::write(dir.path().join(name), bytes).expect("writing a fuzz input file");
+            }
+            dir.path().join("model.gltf")
+        };
         let _ = forest_bake::mesh::source_files(&path);
         forest_bake::Mesh::load(&path).is_ok()
     })

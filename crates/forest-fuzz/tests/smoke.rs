@@ -115,3 +115,8 @@ fn obj() {
 fn image() {
     smoke("image", 7);
 }
+
+#[test]
+fn gltf() {
+    smoke("gltf", 8);
+}

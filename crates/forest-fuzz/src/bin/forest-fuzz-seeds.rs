@@ -75,6 +75,73 @@ fn leaf_png() -> Vec<u8> {
     )))
 }
 
+/// A leaf card (MASK, textured, double-sided) under a node that moves it up, and a bark
+/// triangle at the root: the buffer (positions, texture coordinates, 16-bit indices, then the
+/// image when `embedded`) and the JSON naming it `model.bin` (or buffer 0 of a GLB).
+fn gltf_parts(leaf: &[u8], embedded: bool) -> (String, Vec<u8>) {
+    let positions: [f32; 15] = [
+        -0.5, 0.0, 0.0, 0.5, 0.0, 0.0, 0.5, 1.0, 0.0, -0.5, 1.0, 0.0, 0.0, -1.0, 0.1,
+    ];
+    let uvs: [f32; 8] = [0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+    let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bin: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
+    bin.extend(uvs.iter().flat_map(|x| x.to_le_bytes()));
+    bin.extend(indices.iter().flat_map(|x| x.to_le_bytes()));
+    let image_offset = bin.len();
+    let (buffer, image) = if embedded {
+        bin.extend_from_slice(leaf);
+        (
+            format!(r#"{{"byteLength":{}}}"#, bin.len()),
+            r#"{"bufferView":3,"mimeType":"image/png"}"#.to_string(),
+        )
+    } else {
+        (
+            format!(r#"{{"uri":"model.bin","byteLength":{}}}"#, bin.len()),
+            r#"{"uri":"leaf.png"}"#.to_string(),
+        )
+    };
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
+"nodes":[{{"mesh":0,"translation":[0,1,0]}},{{"mesh":1}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"indices":2,"material":0}}]}},
+{{"primitives":[{{"attributes":{{"POSITION":3}},"material":1}}]}}],
+"materials":[{{"name":"leaf","alphaMode":"MASK","alphaCutoff":0.4,"doubleSided":true,
+"pbrMetallicRoughness":{{"baseColorFactor":[0.3,0.6,0.2,1],"baseColorTexture":{{"index":0}}}}}},
+{{"name":"bark","pbrMetallicRoughness":{{"baseColorFactor":[0.4,0.3,0.2,1]}}}}],
+"textures":[{{"source":0}}],"images":[{image}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-0.5,0,0],"max":[0.5,1,0]}},
+{{"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"}},
+{{"bufferView":2,"componentType":5123,"count":6,"type":"SCALAR"}},
+{{"bufferView":0,"byteOffset":24,"componentType":5126,"count":3,"type":"VEC3","min":[-0.5,-1,0],"max":[0.5,1,0.1]}}],
+"bufferViews":[{{"buffer":0,"byteLength":60}},{{"buffer":0,"byteOffset":60,"byteLength":32}},
+{{"buffer":0,"byteOffset":92,"byteLength":12}},{{"buffer":0,"byteOffset":{image_offset},"byteLength":{}}}],
+"buffers":[{buffer}]}}"#,
+        leaf.len()
+    );
+    (json, bin)
+}
+
+/// A binary glTF: the 12-byte header, the JSON chunk padded with spaces, the BIN chunk padded
+/// with zeros.
+fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut j = json.as_bytes().to_vec();
+    j.resize(j.len().next_multiple_of(4), b' ');
+    let mut b = bin.to_vec();
+    b.resize(b.len().next_multiple_of(4), 0);
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&b);
+    out
+}
+
 fn write(target: &str, name: &str, bytes: &[u8]) {
     let dir = corpus_dir(target);
     std::fs::create_dir_all(&dir).expect("corpus folder");
@@ -137,6 +204,16 @@ fn main() {
         &join_files(&[OBJ.as_bytes(), MTL.as_bytes(), &leaf]),
     );
     write("obj", "seed-1", OBJ_PLAIN.as_bytes());
+
+    // glTF: JSON with its buffer and image as files, and the same model as one GLB.
+    let (json, bin) = gltf_parts(&leaf, false);
+    write(
+        "gltf",
+        "seed-0",
+        &join_files(&[json.as_bytes(), &bin, &leaf]),
+    );
+    let (json, bin) = gltf_parts(&leaf, true);
+    write("gltf", "seed-1.glb", &glb(&json, &bin));
 
     // Atlases baked from the OBJ seed, JPEG and PNG colour.
     for obj in
