@@ -316,22 +316,21 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                                     format!("image {ii}: its view lies outside its buffer"),
                                 )
                             })?;
-                            (data.to_vec(), path.join(format!("image {ii}")))
+                            (
+                                std::borrow::Cow::Borrowed(data),
+                                path.join(format!("image {ii}")),
+                            )
                         }
                         gltf::image::Source::Uri { uri, .. } => {
                             let f = external(path, uri, &format!("image {ii}"))?;
                             let data = bounded::read(&f, bounded::limit::TEXTURE)
                                 .map_err(|e| err(f.clone(), e.to_string()))?;
                             hash = fnv1a(hash, &data);
-                            (data, f)
+                            (std::borrow::Cow::Owned(data), f)
                         }
                     };
-                    let img = bounded::decode_image(&data, None, &file)
-                        .map_err(|e| err(file.clone(), e.to_string()))?
-                        .into_rgba8();
-                    if img.width() == 0 || img.height() == 0 {
-                        return Err(err(file, "empty image".into()));
-                    }
+                    let img = crate::texture::decode_rgba(&data, &file)
+                        .map_err(|reason| err(file.clone(), reason))?;
                     slot.insert(img);
                 }
                 Some(ii)

@@ -262,37 +262,28 @@ impl Mesh {
 
         let mut textures: Vec<Texture> = Vec::new();
         let mut by_path: HashMap<PathBuf, (usize, bool)> = HashMap::new();
-        let mut load_texture = |material: &str, spec: &str, hash: &mut u64| {
-            let file = texture_path(&obj_dir, spec);
-            if let Some(&i) = by_path.get(&file) {
-                return Ok(i);
-            }
-            let err = |reason: String| BakeError::Texture {
-                path: path.into(),
-                material: material.into(),
-                texture: file.clone(),
-                reason,
+        let mut load_texture =
+            |material: &str, spec: &str, hash: &mut u64| -> Result<(usize, bool), BakeError> {
+                let file = texture_path(&obj_dir, spec);
+                if let Some(&i) = by_path.get(&file) {
+                    return Ok(i);
+                }
+                let err = |reason: String| BakeError::Texture {
+                    path: path.into(),
+                    material: material.into(),
+                    texture: file.clone(),
+                    reason,
+                };
+                let bytes = bounded::read(&file, bounded::limit::TEXTURE)
+                    .map_err(|e| err(e.to_string()))?;
+                *hash = fnv1a(*hash, &bytes);
+                let img = crate::texture::decode_rgba(&bytes, &file).map_err(err)?;
+                let t = Texture::new(img.width(), img.height(), img.into_raw());
+                let i = (textures.len(), t.has_alpha);
+                textures.push(t);
+                by_path.insert(file, i);
+                Ok(i)
             };
-            let bytes =
-                bounded::read(&file, bounded::limit::TEXTURE).map_err(|e| err(e.to_string()))?;
-            *hash = fnv1a(*hash, &bytes);
-            let img = bounded::decode_image(&bytes, None, &file)
-                .map_err(|e| {
-                    err(match e {
-                        forest_format::FormatError::Image { what, .. } => what,
-                        other => other.to_string(),
-                    })
-                })?
-                .into_rgba8();
-            if img.width() == 0 || img.height() == 0 {
-                return Err(err("empty image".into()));
-            }
-            let t = Texture::new(img.width(), img.height(), img.into_raw());
-            let i = (textures.len(), t.has_alpha);
-            textures.push(t);
-            by_path.insert(file, i);
-            Ok(i)
-        };
 
         let mut mats = Vec::with_capacity(materials.len().max(1));
         for m in &materials {

@@ -64,6 +64,21 @@ impl Texture {
     }
 }
 
+/// Decode a texture file's bytes (PNG or JPEG, within the decoder's limits) to RGBA8: the
+/// reason it cannot be, in the words both model loaders' texture errors use.
+pub fn decode_rgba(bytes: &[u8], file: &std::path::Path) -> Result<image::RgbaImage, String> {
+    let img = forest_format::bounded::decode_image(bytes, None, file)
+        .map_err(|e| match e {
+            forest_format::FormatError::Image { what, .. } => what,
+            other => other.to_string(),
+        })?
+        .into_rgba8();
+    if img.width() == 0 || img.height() == 0 {
+        return Err("empty image".into());
+    }
+    Ok(img)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

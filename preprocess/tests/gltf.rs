@@ -226,3 +226,57 @@ fn malformed_gltf_is_refused_without_a_panic() {
     let e = refused(r#"{"mesh":0}"#, r#"{"mesh":0,"children":[0]}"#);
     assert!(e.contains("not a tree"), "{e}");
 }
+
+#[test]
+fn a_mask_cutoff_keeps_exactly_the_texels_at_or_above_it() {
+    // A textured quad whose texture's alpha runs 0, 1, …, 255 along x; the material's
+    // alphaCutoff (divided by its factor's alpha) must pass exactly the texels at or above it.
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbaImage::from_fn(256, 2, |x, _| image::Rgba([90, 160, 60, x as u8]));
+    img.save(dir.path().join("ramp.png")).unwrap();
+    let floats: [f32; 20] = [
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, // positions
+        0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, // texture coordinates
+    ];
+    let mut bin: Vec<u8> = floats.iter().flat_map(|x| x.to_le_bytes()).collect();
+    bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.path().join("quad.bin"), &bin).unwrap();
+    for (cutoff, factor_alpha) in [(0.3f32, 1.0f32), (0.5, 1.0), (0.77, 1.0), (0.35, 0.7)] {
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"indices":2,"material":0}}]}}],
+            "materials":[{{"alphaMode":"MASK","alphaCutoff":{cutoff},
+              "pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,{factor_alpha}],"baseColorTexture":{{"index":0}}}}}}],
+            "textures":[{{"source":0}}],"images":[{{"uri":"ramp.png"}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+              {{"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"}},
+              {{"bufferView":2,"componentType":5123,"count":6,"type":"SCALAR"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":32}},
+              {{"buffer":0,"byteOffset":80,"byteLength":12}}],
+            "buffers":[{{"uri":"quad.bin","byteLength":92}}]}}"#
+        );
+        let path = dir.path().join("quad.gltf");
+        std::fs::write(&path, json).unwrap();
+        let mesh = Mesh::load(&path).unwrap();
+        assert_eq!(mesh.tris.len(), 2);
+        let m = mesh.tris[0].material;
+        // Texture alpha times the factor's, against the cutoff (glTF's rule).
+        let want = |a: u32| (a as f32 / 255.0) * factor_alpha >= cutoff;
+        let mut passing = 0;
+        for a in 0..256u32 {
+            // The texel's centre, in the OBJ convention the loader turned v into.
+            let uv = glam::Vec2::new((a as f32 + 0.5) / 256.0, 0.5);
+            let solid = mesh.alpha(m, uv) >= forest_bake::mesh::ALPHA_CUTOFF;
+            assert_eq!(
+                solid,
+                want(a),
+                "alpha {a}, cutoff {cutoff}, factor {factor_alpha}"
+            );
+            passing += u32::from(solid);
+        }
+        assert!(
+            passing > 0 && passing < 256,
+            "cutoff {cutoff}: {passing} texels pass"
+        );
+    }
+}
