@@ -24,13 +24,18 @@
 //                      LICENSE.md, and is not for committing (the OBJ is
 //                      ~30 MB, the GLB ~20 MB). It is ez-tree's
 //                      "Oak Large" preset (its own seed) with more twigs, rounder
-//                      branches and many more, smaller leaves; see HEAVY below.
+//                      branches and many more, smaller leaves; see HEAVY_SMALL_LEAVES below.
 //                      Its vertex count is past the 16-bit indices ez-tree
 //                      builds its geometry with, so the script re-indexes the
 //                      meshes with 32-bit indices (and recomputes the leaf
 //                      normals as ez-tree does) before exporting them.
 //
 //   node export.mjs --heavy --out /tmp/heavy    ->  /tmp/heavy/oak-heavy/
+//
+//   --dense            With --heavy: write DIR/oak-dense/ instead, the same tree
+//                      with the preset's leaf size (4.5 units): the same
+//                      triangles, each leaf card about five times the area, the
+//                      bake's worst case (rays cross many transparent cards).
 //
 // The output is deterministic: ez-tree uses its own seeded RNG, all numbers are
 // rounded to a fixed number of decimals, and the textures are re-encoded with
@@ -84,7 +89,7 @@ const SPECIES = [
 // the tree's shape or its random sequence), and 150 leaves per twig instead of
 // 10, at 2 units (20 cm) instead of 4.5: 253,680 leaf triangles (63,420 leaves
 // of two crossed quads) and ~26k bark triangles.
-const HEAVY = {
+const HEAVY_SMALL_LEAVES = {
   name: 'oak-heavy',
   preset: 'Oak Large',
   seed: 23399,
@@ -93,6 +98,12 @@ const HEAVY = {
     leaves: { count: 150, size: 2 },
   },
 };
+// --dense: the preset's leaf size.
+const HEAVY_DENSE = {
+  ...HEAVY_SMALL_LEAVES,
+  name: 'oak-dense',
+  overrides: { ...HEAVY_SMALL_LEAVES.overrides, leaves: { count: 150 } },
+};
 
 const SCALE = 0.1; // ez-tree units -> metres (trees are ~50-100 units tall)
 const POS_DECIMALS = 4; // 0.1 mm
@@ -100,7 +111,7 @@ const NRM_DECIMALS = 4;
 const UV_DECIMALS = 4;
 
 function parseArgs(argv) {
-  const args = { textureSize: 512, out: null, heavy: false };
+  const args = { textureSize: 512, out: null, heavy: false, dense: false };
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === '--texture-size') {
       args.textureSize = Number(argv[++i]);
@@ -112,10 +123,13 @@ function parseArgs(argv) {
       if (!args.out) throw new Error('--out expects a directory');
     } else if (argv[i] === '--heavy') {
       args.heavy = true;
+    } else if (argv[i] === '--dense') {
+      args.dense = true;
     } else {
       throw new Error(`unknown argument ${argv[i]}`);
     }
   }
+  if (args.dense && !args.heavy) throw new Error('--dense goes with --heavy');
   return args;
 }
 const ARGS = parseArgs(process.argv.slice(2));
@@ -126,6 +140,7 @@ const OUT_ROOT = ARGS.out === null ? TREES : resolve(ARGS.out);
 if (ARGS.heavy && (ARGS.out === null || OUT_ROOT === TREES)) {
   throw new Error('--heavy needs --out DIR, not assets/trees itself (the heavy tree is not a bundled model)');
 }
+const HEAVY = ARGS.dense ? HEAVY_DENSE : HEAVY_SMALL_LEAVES;
 const LIST = ARGS.heavy ? [HEAVY] : SPECIES;
 const PKG_DIR = join(HERE, 'node_modules', '@dgreenheck', 'ez-tree');
 const PKG = JSON.parse(readFileSync(join(PKG_DIR, 'package.json'), 'utf8'));
@@ -585,7 +600,9 @@ re-run against the committed ones. \`node export.mjs --heavy --out DIR\` writes 
 \`DIR/${HEAVY.name}/\`, one "production-size" tree of about 280k triangles for profiling the
 bake ("${HEAVY.preset}" with more twigs, rounder branches and many more, smaller leaves; the
 overrides are in the script and in the OBJ header). It is not a bundled model, is not
-listed below, and --heavy refuses to write into this folder.
+listed below, and --heavy refuses to write into this folder. Adding \`--dense\` writes
+\`DIR/oak-dense/\` instead: the same tree with the preset's leaf size (4.5 units), each leaf
+card about five times the area, the bake's worst case.
 
 The output is deterministic (ez-tree uses its own seeded RNG).
 
