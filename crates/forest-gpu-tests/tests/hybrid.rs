@@ -11,7 +11,7 @@ use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
 use forest_render::forms as hybrid;
-use forest_render::options::{Background, RendererOptions};
+use forest_render::options::{Atmosphere, Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream, reference};
 use glam::Vec3;
@@ -24,14 +24,26 @@ fn renderer(
     viewport: (u32, u32),
     background: Background,
 ) -> ForestRenderer {
+    renderer_in(ctx, forest, viewport, background, Atmosphere::CLEAR)
+}
+
+/// Both forms over `background` in `atmosphere`.
+fn renderer_in(
+    ctx: &GpuContext,
+    forest: &Forest,
+    viewport: (u32, u32),
+    background: Background,
+    atmosphere: Atmosphere,
+) -> ForestRenderer {
     let scene = GpuScene::new(ctx, &common::species(), forest).unwrap();
     let opts = RendererOptions {
+        format: TARGET_FORMAT,
         viewport,
         background,
+        atmosphere,
         ..Default::default()
     };
-    let geometry =
-        GeometryRenderer::new(ctx, common::prepared(), forest, TARGET_FORMAT, background).unwrap();
+    let geometry = GeometryRenderer::with_targets(ctx, common::prepared(), forest, &opts).unwrap();
     ForestRenderer::new(
         QuadStream::new(&ctx.device, scene, &opts).unwrap(),
         Some(geometry),
@@ -69,8 +81,13 @@ fn save(name: &str, images: &[(&str, &image::RgbaImage)]) {
 fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     let ctx = common::ctx();
     let forest = common::forest(300);
-    for background in [Background::Transparent, Background::Sky] {
-        let mut r = renderer(&ctx, &forest, (160, 120), background);
+    // In haze too: both forms go through the same haze, so the ends still match exactly.
+    for (background, atmosphere) in [
+        (Background::Transparent, Atmosphere::CLEAR),
+        (Background::Sky, Atmosphere::CLEAR),
+        (Background::Sky, Atmosphere::hazy(300.0)),
+    ] {
+        let mut r = renderer_in(&ctx, &forest, (160, 120), background, atmosphere);
         for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
             let quads = frame(&ctx, &mut r, Method::Quads, &cam);
             let zero = frame(&ctx, &mut r, hybrid_at(0.0), &cam);
@@ -88,7 +105,7 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
             ] {
                 if got != want {
                     save(
-                        &format!("hybrid-{name}-{background:?}"),
+                        &format!("hybrid-{name}-{background:?}-{}", atmosphere.visibility),
                         &[("expected", want), ("hybrid", got)],
                     );
                     panic!("{name} {background:?}: the hybrid {what} differs");

@@ -292,7 +292,7 @@ pub struct Atmosphere {
     pub horizon: [f32; 3],
     /// Sky colour at the zenith (linear RGB, ≥ 0).
     pub zenith: [f32; 3],
-    /// Draw the sun's disc in the sky, in the lighting's sun direction.
+    /// Draw the sun's disc and the glow around it in the sky, in the lighting's sun direction.
     pub sun_disc: bool,
 }
 
