@@ -230,22 +230,25 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
         blob: parsed.blob,
     };
 
-    // Buffers: the GLB's binary chunk, or files; each at least as long as it says.
-    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    // Buffers: the GLB's binary chunk (borrowed, not copied), or files; each at least as long
+    // as it says.
+    let mut buffers: Vec<std::borrow::Cow<[u8]>> = Vec::new();
     for b in doc.buffers() {
         let data = match b.source() {
-            gltf::buffer::Source::Bin => doc.blob.clone().ok_or_else(|| {
-                parse_err(
-                    path,
-                    format!(
-                        "buffer {} is the binary chunk, which the file lacks",
-                        b.index()
-                    ),
-                )
-            })?,
+            gltf::buffer::Source::Bin => {
+                std::borrow::Cow::Borrowed(doc.blob.as_deref().ok_or_else(|| {
+                    parse_err(
+                        path,
+                        format!(
+                            "buffer {} is the binary chunk, which the file lacks",
+                            b.index()
+                        ),
+                    )
+                })?)
+            }
             gltf::buffer::Source::Uri(uri) => {
                 let f = external(path, uri, &format!("buffer {}", b.index()))?;
-                bounded::read(&f, bounded::limit::DATA)?
+                std::borrow::Cow::Owned(bounded::read(&f, bounded::limit::DATA)?)
             }
         };
         if data.len() < b.length() {
@@ -432,7 +435,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 },
             };
             check_accessors(path, &at(), &prim)?;
-            let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.as_ref()));
             let pos: Vec<Vec3> = reader
                 .read_positions()
                 .ok_or_else(|| parse_err(path, format!("{}: no POSITION", at())))?

@@ -452,13 +452,10 @@ fn stream_for(
 ) -> Result<QuadStream> {
     let scene = crate::progress::upload(ctx, species, forest)?;
     let opts = RendererOptions {
-        format: TARGET_FORMAT,
         min_epsilon: args.epsilon.min(8.0),
         viewport: stream_viewport(args),
-        background: background(args),
-        atmosphere: atmosphere(args),
         refine: args.m.method != "impostor",
-        ..Default::default()
+        ..target_options(args)
     };
     let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
     stream.set_options(args.m.stream_options());
@@ -475,7 +472,7 @@ fn render_hybrid(
     cameras: &[(String, Camera)],
 ) -> Result<()> {
     let prepared = prepare_models(&args.m.models, species)?;
-    let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &geometry_options(args))?;
+    let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
     r.set_pipeline_statistics(args.json);
@@ -521,9 +518,9 @@ fn render_hybrid(
     Ok(())
 }
 
-/// The geometry renderer's options: the stream's background and atmosphere, the crate's own
-/// targets.
-fn geometry_options(args: &RenderArgs) -> RendererOptions {
+/// What both forms draw into and over: the crate's own targets, the background and the
+/// atmosphere (one source, so that the hybrid's two forms always agree).
+fn target_options(args: &RenderArgs) -> RendererOptions {
     RendererOptions {
         format: TARGET_FORMAT,
         background: background(args),
@@ -611,7 +608,7 @@ fn render_geometry(
     cameras: &[(String, Camera)],
 ) -> Result<()> {
     let prepared = prepare_models(&args.m.models, species)?;
-    let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &geometry_options(args))?;
+    let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
     let (sw, sh) = (
         args.size.0 * args.supersample,

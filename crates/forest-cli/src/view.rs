@@ -71,12 +71,9 @@ fn quad_stream(
     min_epsilon: f32,
 ) -> Result<QuadStream> {
     let opts = RendererOptions {
-        format,
         viewport,
         min_epsilon,
-        background: Background::Sky,
-        atmosphere: Atmosphere::hazy(Atmosphere::DEMO_VISIBILITY),
-        ..Default::default()
+        ..viewer_options(format)
     };
     Ok(QuadStream::new(
         &ctx.device,
@@ -93,15 +90,23 @@ fn geometry(
     forest: &Forest,
     format: wgpu::TextureFormat,
 ) -> Result<GeometryRenderer> {
-    let opts = RendererOptions {
+    Ok(GeometryRenderer::with_targets(
+        ctx,
+        prepared,
+        forest,
+        &viewer_options(format),
+    )?)
+}
+
+/// What both forms draw into and over in the viewer: `format` targets, the sky and ground, the
+/// demo's haze (one source, so that the hybrid's two forms always agree).
+fn viewer_options(format: wgpu::TextureFormat) -> RendererOptions {
+    RendererOptions {
         format,
         background: Background::Sky,
         atmosphere: Atmosphere::hazy(Atmosphere::DEMO_VISIBILITY),
         ..Default::default()
-    };
-    Ok(GeometryRenderer::with_targets(
-        ctx, prepared, forest, &opts,
-    )?)
+    }
 }
 
 /// Far plane (metres): beyond the farthest tree from anywhere in the forest.
