@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job: bake the bundled tree models (cached), generate a 100k-tree forest, and render
-# a view inside the forest and a bird's-eye view to PNG, headless (lavapipe or a real GPU).
+# The main job: bake the bundled tree models (cached), generate a 100k-tree forest on seeded
+# hills, and render a view inside the forest, one from a hilltop over the valley and a bird's-eye
+# view to PNG, headless (lavapipe or a real GPU).
 # Outputs go to out/: atlases, contact sheets, the forest, the renders.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,8 +22,10 @@ for s in oak ash aspen pine bush; do
   fi
   species+=("$atlas")
 done
-$forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${species[*]}")" --seed 1 -o out/forest-100k.forest
-$forest render out/forest-100k.forest -o out/render/forest.png --view inside --view birds-eye --size 800x600
+$forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${species[*]}")" --seed 1 \
+  --terrain hills -o out/forest-100k.forest
+$forest render out/forest-100k.forest -o out/render/forest.png --view inside --view hill --view birds-eye \
+  --size 800x600
 echo
-echo "Renders: out/render/forest-inside.png, out/render/forest-birds-eye.png"
+echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png"
 echo "Atlases: out/atlases/, contact sheets: out/contact/"

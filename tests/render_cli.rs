@@ -590,3 +590,127 @@ fn scene_gives_trees_their_species_heights() {
         assert!(!d.join("bad.json").exists());
     }
 }
+
+#[test]
+fn a_forest_on_hills_or_a_height_field_stands_on_it_and_bad_height_fields_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    bake_small("bush", &d.join("bush.atlas"), 32, 3);
+    let atlas = p("bush.atlas");
+    let scene = |terrain: &str, out: &str, extra: &[&str]| {
+        let trees = if extra.contains(&"--trees") {
+            &[][..]
+        } else {
+            &["--trees", "300"][..]
+        };
+        let mut args = vec!["scene", "--model-sizes"];
+        args.extend_from_slice(trees);
+        args.extend_from_slice(&[
+            "--species",
+            &atlas,
+            "--area-per-tree",
+            "20",
+            "--terrain",
+            terrain,
+            "-o",
+        ]);
+        args.push(out);
+        args.extend_from_slice(extra);
+        forest(&args)
+    };
+    // Generated hills: every tree's base on the drawn surface; the named views render.
+    let hills = p("hills.forest");
+    let text = ok(&scene("hills", &hills, &["--relief", "40"]));
+    assert!(text.contains("terrain:"), "{text}");
+    let f = forest_format::forest::Forest::load(Path::new(&hills)).unwrap();
+    let t = f.terrain.as_ref().expect("a terrain");
+    let (lo, hi) = t.height_range();
+    assert!(hi - lo > 10.0, "{lo}..{hi}");
+    for i in &f.instances {
+        assert_eq!(
+            i.position[1],
+            t.height(i.position[0], i.position[2]),
+            "{i:?}"
+        );
+    }
+    let out = ok(&forest(&[
+        "render",
+        &hills,
+        "-o",
+        &p("h.png"),
+        "--view",
+        "inside",
+        "--view",
+        "hill",
+        "--view",
+        "birds-eye",
+        "--size",
+        "64x48",
+        "--json",
+    ]));
+    assert_eq!(out.lines().count(), 3, "{out}");
+    // A 16-bit height field: a ramp rising 0 to 30 m along x.
+    let png = d.join("ramp.png");
+    image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(64, 64, |x, _| {
+        image::Luma([(x * 1040) as u16])
+    })
+    .save(&png)
+    .unwrap();
+    let ramp = p("ramp.forest");
+    ok(&scene(
+        &png.display().to_string(),
+        &ramp,
+        &["--relief", "30", "--terrain-spacing", "3"],
+    ));
+    let f = forest_format::forest::Forest::load(Path::new(&ramp)).unwrap();
+    let t = f.terrain.as_ref().unwrap();
+    assert_eq!(t.size, [64, 64]);
+    for i in &f.instances {
+        let [x, y, z] = i.position;
+        let want = (x - t.origin[0]) / 3.0 * 1040.0 / 65535.0 * 30.0;
+        assert!((y - want).abs() < 1e-3, "{i:?}: {want}");
+        assert_eq!(y, t.height(x, z));
+    }
+    // Bad height fields and options: one line naming the cause, nothing written.
+    let eight = d.join("eight.png");
+    image::GrayImage::from_pixel(8, 8, image::Luma([3]))
+        .save(&eight)
+        .unwrap();
+    let junk = d.join("junk.exr");
+    std::fs::write(&junk, b"not an exr").unwrap();
+    let cases: Vec<(String, Vec<&str>, &str)> = vec![
+        (eight.display().to_string(), vec![], "16-bit greyscale"),
+        (junk.display().to_string(), vec![], "junk.exr"),
+        (p("missing.png"), vec![], "missing.png"),
+        (
+            "flat".into(),
+            vec!["--relief", "5"],
+            "--relief needs a --terrain",
+        ),
+        ("hills".into(), vec!["--terrain-spacing", "0"], "spacing"),
+        (
+            png.display().to_string(),
+            vec!["--trees", "3000", "--terrain-spacing", "3"],
+            "does not lie on the terrain",
+        ),
+        (
+            "mountains".into(),
+            vec![],
+            "give flat, hills, or a height field",
+        ),
+    ];
+    for (terrain, extra, why) in cases {
+        let out = p("bad.forest");
+        let e = err(&scene(&terrain, &out, &extra));
+        assert!(e.contains(why), "{terrain} {extra:?}: {e}");
+        assert!(!Path::new(&out).exists(), "{terrain}: wrote a forest");
+    }
+    // The height field is an input: never an output.
+    let e = err(&scene(
+        &png.display().to_string(),
+        &png.display().to_string(),
+        &[],
+    ));
+    assert!(e.contains("input"), "{e}");
+}

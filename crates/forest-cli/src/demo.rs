@@ -1,7 +1,8 @@
 //! The bundled demo forest that `forest view` opens when given no forest: the five bundled tree
 //! models (`assets/trees/`) baked into `out/atlases/` on first use, and again when a model's
-//! files change, and a forest of [`TREES`] trees over them in `out/forest-view.forest`. The
-//! same commands as `scripts/demo.sh`, so the two share their cache.
+//! files change, and a forest of [`TREES`] trees over them on seeded hills in
+//! `out/forest-view.forest`. The same commands as `scripts/demo.sh`, so the two share their
+//! cache.
 
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
@@ -111,7 +112,9 @@ fn prepare_in(root: &Path, bake_args: &[&str]) -> Result<Demo> {
         models.push(model);
     }
     let forest = out.join("forest-view.forest");
-    if modified(&forest).is_none_or(|t| t < newest_atlas) {
+    // A forest from before the demo stood on hills is made again.
+    let flat = || forest_format::forest::Forest::load(&forest).is_ok_and(|f| f.terrain.is_none());
+    if modified(&forest).is_none_or(|t| t < newest_atlas) || flat() {
         let trees = TREES.to_string();
         let (species, f) = (atlas_paths.join(","), forest.display().to_string());
         let args = [
@@ -123,6 +126,8 @@ fn prepare_in(root: &Path, bake_args: &[&str]) -> Result<Demo> {
             &species,
             "--seed",
             "1",
+            "--terrain",
+            "hills",
             "-o",
             &f,
         ];
@@ -166,6 +171,13 @@ mod tests {
         assert_eq!(demo.models.len(), SPECIES.len());
         let forest = forest_format::forest::Forest::load(&demo.forest).unwrap();
         assert_eq!(forest.instances.len(), TREES as usize);
+        let terrain = forest.terrain.as_ref().expect("the demo stands on hills");
+        assert!(
+            forest
+                .instances
+                .iter()
+                .all(|i| i.position[1] == terrain.height(i.position[0], i.position[2]))
+        );
         let manifest = |s: &str| {
             tmp.path()
                 .join(format!("out/atlases/{s}.atlas/manifest.json"))

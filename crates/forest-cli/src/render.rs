@@ -24,8 +24,9 @@ pub struct RenderArgs {
     /// Output PNG; with several views, `-VIEW` is inserted before the extension.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Named views: inside (eye height inside the forest), birds-eye (above it). Repeatable.
-    #[arg(long = "view", value_parser = ["inside", "birds-eye"])]
+    /// Named views: inside (eye height inside the forest), hill (on the highest ground among
+    /// the trees, looking down over the lowest), birds-eye (above it). Repeatable.
+    #[arg(long = "view", value_parser = ["inside", "hill", "birds-eye"])]
     pub views: Vec<String>,
     /// Eye position x,y,z in metres (with --target, instead of --view).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, requires = "target")]
@@ -293,26 +294,113 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
     Ok((forest, species))
 }
 
-/// The named views of a forest: eye height in a clump near the centre, and high above.
+/// The named views of a forest, standing on its ground: eye height in a clump near the centre
+/// ("inside"), on the highest ground among the trees looking over the lowest ("hill"), and
+/// high above ("birds-eye").
 pub fn named_view(name: &str, forest: &Forest) -> (Vec3, Vec3) {
-    let r = forest.extent().max(10.0);
-    // The tree nearest the centre: stand 6 m south of it, look north-west along the ground.
-    let centre = forest
+    // The trees' extent (the terrain may reach much farther).
+    let r = forest
         .instances
         .iter()
-        .map(|i| Vec3::from_array(i.position))
-        .min_by(|a, b| a.length().total_cmp(&b.length()))
-        .unwrap_or(Vec3::ZERO);
+        .map(|i| Vec3::from_array(i.position).with_y(0.0).length())
+        .fold(10.0, f32::max);
+    let (_, top) = forest
+        .terrain
+        .as_ref()
+        .map_or((0.0, 0.0), |t| t.height_range());
     match name {
-        "inside" => (
-            centre + Vec3::new(3.0, 1.7, 6.0),
-            centre + Vec3::new(-40.0, 3.0, -60.0),
-        ),
+        "inside" => inside_view(forest),
+        "hill" => hill_view(forest),
         _ => (
-            Vec3::new(0.0, r * 0.35, r * 0.55),
+            Vec3::new(0.0, top + r * 0.35, r * 0.55),
             Vec3::new(0.0, 0.0, -r * 0.1),
         ),
     }
+}
+
+/// Inside the forest: 6 m south of the tree with the most neighbours within 15 m among the
+/// 500 nearest the centre (a clump, not a clearing's edge), 1.7 m above the ground, looking
+/// along the heading (of eight) that sees the most trees within 80 m, at a point 3 m above
+/// the ground 60 m away.
+fn inside_view(forest: &Forest) -> (Vec3, Vec3) {
+    let ground = |x: f32, z: f32, up: f32| Vec3::new(x, forest.ground_height(x, z) + up, z);
+    let mut near: Vec<Vec3> = forest
+        .instances
+        .iter()
+        .map(|i| Vec3::from_array(i.position))
+        .collect();
+    near.sort_by(|a, b| a.with_y(0.0).length().total_cmp(&b.with_y(0.0).length()));
+    near.truncate(500);
+    let flat = |a: Vec3, b: Vec3| (a - b).with_y(0.0).length();
+    let Some(&c) = near
+        .iter()
+        .enumerate()
+        .max_by_key(|&(k, &p)| {
+            let n = near.iter().filter(|&&q| flat(p, q) < 15.0).count();
+            // The most neighbours; the nearest the centre among equals.
+            (n, std::cmp::Reverse(k))
+        })
+        .map(|(_, p)| p)
+    else {
+        return (Vec3::new(3.0, 1.7, 6.0), Vec3::new(-40.0, 3.0, -60.0));
+    };
+    let eye = ground(c.x + 3.0, c.z + 6.0, 1.7);
+    let seen = |h: f32| {
+        let d = Vec3::new(h.sin(), 0.0, -h.cos());
+        near.iter()
+            .filter(|&&q| {
+                let v = (q - eye).with_y(0.0);
+                let l = v.length();
+                l > 1.0 && l < 80.0 && v.dot(d) > l * 0.8
+            })
+            .count()
+    };
+    // Headings from north-west round through north; the first of the most trees wins.
+    let mut heading = -std::f32::consts::FRAC_PI_4;
+    let mut best = seen(heading);
+    for k in 1..8 {
+        let h = -std::f32::consts::FRAC_PI_4 + k as f32 * std::f32::consts::FRAC_PI_4;
+        if seen(h) > best {
+            (heading, best) = (h, seen(h));
+        }
+    }
+    let d = Vec3::new(heading.sin(), 0.0, -heading.cos()) * 60.0;
+    (eye, ground(eye.x + d.x, eye.z + d.z, 3.0))
+}
+
+/// On a lookout 30 m above the highest ground within the trees' square (above the canopy of
+/// the trees around), looking at the lowest ground 50 to 600 m away; on flat ground, 40 m up
+/// at the southern edge looking across.
+fn hill_view(forest: &Forest) -> (Vec3, Vec3) {
+    let half = forest
+        .instances
+        .iter()
+        .map(|i| i.position[0].abs().max(i.position[2].abs()))
+        .fold(10.0f32, f32::max);
+    let Some(t) = &forest.terrain else {
+        return (Vec3::new(0.0, 40.0, half), Vec3::new(0.0, 0.0, -half * 0.2));
+    };
+    let at = |k: usize| {
+        let (i, j) = (k % t.size[0] as usize, k / t.size[0] as usize);
+        Vec3::new(
+            t.origin[0] + i as f32 * t.spacing,
+            t.heights[k],
+            t.origin[1] + j as f32 * t.spacing,
+        )
+    };
+    let within = |p: Vec3, c: Vec3, r: f32| {
+        p.x.abs() <= half && p.z.abs() <= half && (p - c).with_y(0.0).length() <= r
+    };
+    let all = || (0..t.heights.len()).map(at);
+    let top = all()
+        .filter(|p| within(*p, Vec3::ZERO, f32::INFINITY))
+        .max_by(|a, b| a.y.total_cmp(&b.y))
+        .unwrap_or(Vec3::ZERO);
+    let low = all()
+        .filter(|p| within(*p, top, 600.0) && (*p - top).with_y(0.0).length() > 50.0)
+        .min_by(|a, b| a.y.total_cmp(&b.y))
+        .unwrap_or(Vec3::new(0.0, 0.0, -half));
+    (top + Vec3::Y * 30.0, low)
 }
 
 /// Run `forest render`.
@@ -327,7 +415,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         views.push(("camera".into(), e, t));
     }
     if views.is_empty() {
-        bail!("give a --view (inside, birds-eye) or --eye and --target");
+        bail!("give a --view (inside, hill, birds-eye) or --eye and --target");
     }
     let cameras: Vec<(String, Camera)> = views
         .into_iter()

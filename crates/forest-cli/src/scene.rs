@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::Args;
-use forest_format::generate::{GenerateParams, generate, species_height};
+use forest_format::generate::{GenerateParams, GroundRules, generate, species_height};
+use forest_format::terrain::{Terrain, TerrainParams};
 
 /// Arguments of `forest scene`.
 #[derive(Args, Debug)]
@@ -36,6 +37,27 @@ pub struct SceneArgs {
     /// Keep every model's own size, varied ×0.8-1.25, instead of the species' heights.
     #[arg(long, conflicts_with = "heights")]
     pub model_sizes: bool,
+    /// The ground: `flat` (y = 0), `hills` (seeded rolling hills reaching past the forest and
+    /// fading into the plain), or a height field: a 16-bit greyscale PNG (0-65535 map to 0 to
+    /// --relief metres) or an OpenEXR file of heights in metres, centred on the forest, row 0
+    /// at the smallest z. Trees stand on it, keep off slopes over --max-slope and off ground
+    /// above the treeline, and each species keeps to its altitude band.
+    #[arg(long, default_value = "flat")]
+    pub terrain: String,
+    /// Relief in metres: the highest hilltop of `hills`, or the height of a PNG's value 65535
+    /// [default: 100].
+    #[arg(long, allow_negative_numbers = true)]
+    pub relief: Option<f32>,
+    /// Metres between height samples (a height field's pixels, or the generated hills').
+    #[arg(long, allow_negative_numbers = true, default_value_t = 8.0)]
+    pub terrain_spacing: f32,
+    /// Steepest ground that carries trees, degrees.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 35.0)]
+    pub max_slope: f32,
+    /// Treeline: the fraction of the way from the lowest to the highest ground above which no
+    /// tree grows.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.92)]
+    pub treeline: f32,
     /// Output: binary forest, or JSON when the name ends in .json.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -128,9 +150,62 @@ fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
     Ok((scales, lines))
 }
 
+/// Relief of `--terrain hills` and of a PNG's full range when `--relief` is not given, metres.
+pub const DEFAULT_RELIEF: f32 = 100.0;
+
+/// The terrain `--terrain` asks for (`None`: flat), for a forest `side` metres across.
+fn terrain(args: &SceneArgs, side: f32) -> Result<Option<Terrain>> {
+    let relief = args.relief.unwrap_or(DEFAULT_RELIEF);
+    match args.terrain.as_str() {
+        "flat" => {
+            if args.relief.is_some() {
+                bail!("--relief needs a --terrain (hills, or a 16-bit PNG)");
+            }
+            Ok(None)
+        }
+        "hills" => {
+            // Hills reach half the forest's width past each edge, falling gently to the plain
+            // from the forest's edge on, so the forest's edge is not the world's; a hill is
+            // about a quarter of the forest across.
+            let half = side.max(200.0);
+            Terrain::generate(&TerrainParams {
+                half_extent: half,
+                spacing: args.terrain_spacing,
+                relief,
+                hill_size: (side / 4.0).max(150.0),
+                fade: 0.5,
+                seed: args.seed,
+            })
+            .map(Some)
+            .map_err(|e| anyhow::anyhow!("--terrain hills: {e}"))
+        }
+        file => {
+            let path = Path::new(file);
+            let exr = path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+            if exr && args.relief.is_some() {
+                bail!("--relief scales 16-bit PNG height fields; an EXR holds heights in metres");
+            }
+            if path.extension().is_none() {
+                bail!("--terrain '{file}': give flat, hills, or a height field (.png or .exr)");
+            }
+            Ok(Some(Terrain::from_image(
+                path,
+                args.terrain_spacing,
+                relief,
+            )?))
+        }
+    }
+}
+
 /// Run `forest scene`.
 pub fn run(args: &SceneArgs) -> Result<()> {
-    crate::guard::not_an_input(&args.output, "output", &args.species)?;
+    let mut inputs = args.species.clone();
+    if !matches!(args.terrain.as_str(), "flat" | "hills") {
+        inputs.push(PathBuf::from(&args.terrain));
+    }
+    crate::guard::not_an_input(&args.output, "output", &inputs)?;
     let mut species = Vec::new();
     for s in &args.species {
         if !s.join(forest_format::atlas::MANIFEST_FILE).is_file() {
@@ -153,7 +228,19 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     } else {
         spinner.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
+    let side = (f64::from(args.trees) * f64::from(args.area_per_tree)).sqrt() as f32;
+    let terrain = if side.is_finite() && side > 0.0 {
+        terrain(args, side)?
+    } else {
+        None
+    };
     let forest = generate(&GenerateParams {
+        terrain,
+        ground: GroundRules {
+            max_slope_deg: args.max_slope,
+            treeline: args.treeline,
+            ..GroundRules::default()
+        },
         trees: args.trees,
         species,
         area_per_tree: args.area_per_tree,
@@ -173,10 +260,21 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         "{} trees of {} species, {:.0} m across, {} presort directions -> {}",
         forest.instances.len(),
         forest.species.len(),
-        2.0 * forest.extent(),
+        side,
         forest.presort.directions.len(),
         args.output.display()
     );
+    if let Some(t) = &forest.terrain {
+        let (lo, hi) = t.height_range();
+        let ([x0, _], [x1, _]) = t.bounds();
+        println!(
+            "  terrain: {}×{} samples, {:.1} m apart, {:.0} m across, ground {lo:.1} to {hi:.1} m",
+            t.size[0],
+            t.size[1],
+            t.spacing,
+            x1 - x0
+        );
+    }
     for l in size_lines {
         println!("{l}");
     }

@@ -241,6 +241,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
     let (size, epsilon) = (args.size, args.epsilon);
     // Both builders hold the forest (the window calls them once, when it has a device).
     let extent = forest.extent();
+    let terrain = forest.terrain.clone();
     let forest = Rc::new(forest);
     let f = forest.clone();
     let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
@@ -258,6 +259,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
         size,
         epsilon,
         extent,
+        terrain,
         methods,
         method: start,
         debug_view: args.debug_view,

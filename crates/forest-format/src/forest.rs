@@ -4,8 +4,11 @@
 //! - **binary** (`.forest`): magic `FRST`, version, species names, instances as raw
 //!   little-endian [`Instance`] records, then the presort directions and orders. Compact enough
 //!   for 1M instances (24 bytes per instance plus 4 bytes per instance per presort direction).
+//!   Version 2 appends the terrain (see [`Terrain::write_to`]); a forest without terrain is
+//!   written as version 1, which both versions' readers read.
 //! - **JSON** (`.json`), for small hand-made scenes: `{"species": [...], "instances": [{"species":
-//!   0, "position": [x, y, z], "rotation_deg": 0, "scale": 1}]}`; presorts are computed on load.
+//!   0, "position": [x, y, z], "rotation_deg": 0, "scale": 1}]}`, optionally `"terrain": {"size":
+//!   [nx, nz], "origin": [x, z], "spacing": s, "heights": [...]}`; presorts are computed on load.
 //!
 //! Writers go through a temporary name and a rename; readers check every count and value.
 
@@ -17,9 +20,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::directions::hemisphere_directions;
 use crate::error::FormatError;
+use crate::terrain::Terrain;
 
-/// Binary forest format version.
-pub const FOREST_VERSION: u32 = 1;
+/// Binary forest format version (2: with a terrain; a forest without one is written as 1).
+pub const FOREST_VERSION: u32 = 2;
+const TERRAIN_MAGIC: &[u8; 4] = b"TERR";
 const MAGIC: &[u8; 4] = b"FRST";
 /// Default number of presort directions.
 pub const DEFAULT_PRESORT_DIRECTIONS: u32 = 15;
@@ -98,6 +103,8 @@ pub struct Forest {
     pub instances: Vec<Instance>,
     /// Presorted orders (one per presort direction).
     pub presort: Presort,
+    /// The ground the trees stand on (`None`: flat at y = 0).
+    pub terrain: Option<Terrain>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -121,6 +128,17 @@ struct JsonForest {
     instances: Vec<JsonInstance>,
     #[serde(default)]
     presort_directions: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    terrain: Option<JsonTerrain>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonTerrain {
+    size: [u32; 2],
+    origin: [f32; 2],
+    spacing: f32,
+    heights: Vec<f32>,
 }
 
 impl Forest {
@@ -131,7 +149,14 @@ impl Forest {
             species,
             instances,
             presort,
+            terrain: None,
         }
+    }
+
+    /// The forest standing on `terrain`.
+    pub fn with_terrain(mut self, terrain: Terrain) -> Self {
+        self.terrain = Some(terrain);
+        self
     }
 
     /// Check values: species indices in range, finite positions, positive finite scales,
@@ -171,6 +196,10 @@ impl Forest {
             if !(i.scale.is_finite() && i.scale > 0.0) {
                 return bad(format!("instance {k} has scale {}, not positive", i.scale));
             }
+        }
+        if let Some(t) = &self.terrain {
+            t.check()
+                .map_err(|e| FormatError::invalid(path, format!("terrain: {e}")))?;
         }
         let p = &self.presort;
         if p.directions.is_empty() || p.directions.len() != p.orders.len() {
@@ -242,7 +271,16 @@ impl Forest {
                     format!("presort_directions = {k}: must be 1 to 256"),
                 ));
             }
-            Self::new(j.species, instances, k)
+            let forest = Self::new(j.species, instances, k);
+            match j.terrain {
+                Some(t) => forest.with_terrain(Terrain {
+                    size: t.size,
+                    origin: t.origin,
+                    spacing: t.spacing,
+                    heights: t.heights,
+                }),
+                None => forest,
+            }
         } else {
             Self::from_bytes(bytes).map_err(|e| FormatError::invalid(path, e))?
         };
@@ -266,6 +304,12 @@ impl Forest {
                     })
                     .collect(),
                 presort_directions: Some(self.presort.directions.len() as u32),
+                terrain: self.terrain.as_ref().map(|t| JsonTerrain {
+                    size: t.size,
+                    origin: t.origin,
+                    spacing: t.spacing,
+                    heights: t.heights.clone(),
+                }),
             };
             serde_json::to_vec_pretty(&j).expect("a forest serialises")
         } else {
@@ -278,7 +322,8 @@ impl Forest {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::new();
         out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&FOREST_VERSION.to_le_bytes());
+        let version: u32 = if self.terrain.is_some() { 2 } else { 1 };
+        out.extend_from_slice(&version.to_le_bytes());
         out.extend_from_slice(&(self.species.len() as u32).to_le_bytes());
         for s in &self.species {
             out.extend_from_slice(&(s.len() as u32).to_le_bytes());
@@ -293,6 +338,10 @@ impl Forest {
         for o in &self.presort.orders {
             out.extend_from_slice(bytemuck::cast_slice(o));
         }
+        if let Some(t) = &self.terrain {
+            out.extend_from_slice(TERRAIN_MAGIC);
+            t.write_to(&mut out);
+        }
         out
     }
 
@@ -303,9 +352,9 @@ impl Forest {
             return Err("not a forest file (missing the FRST header)".into());
         }
         let version = r.u32()?;
-        if version != FOREST_VERSION {
+        if !(1..=FOREST_VERSION).contains(&version) {
             return Err(format!(
-                "forest version {version} but this program reads version {FOREST_VERSION}"
+                "forest version {version} but this program reads versions 1 to {FOREST_VERSION}"
             ));
         }
         let ns = r.u32()? as usize;
@@ -333,25 +382,55 @@ impl Forest {
         for _ in 0..k {
             orders.push(bytemuck::pod_collect_to_vec(r.take(n * 4)?));
         }
+        let terrain = if version >= 2 {
+            if r.take(4)? != TERRAIN_MAGIC {
+                return Err("a version 2 forest without its TERR section".into());
+            }
+            let t = Terrain::read_from(|n| r.take(n).map(<[u8]>::to_vec))
+                .map_err(|e| format!("terrain: {e}"))?;
+            Some(t)
+        } else {
+            None
+        };
         if r.at != bytes.len() {
             return Err(format!(
-                "{} bytes of trailing data after the presorts",
-                bytes.len() - r.at
+                "{} bytes of trailing data after the {}",
+                bytes.len() - r.at,
+                if terrain.is_some() {
+                    "terrain"
+                } else {
+                    "presorts"
+                }
             ));
         }
         Ok(Self {
             species,
             instances,
             presort: Presort { directions, orders },
+            terrain,
         })
     }
 
-    /// Largest distance of any instance position from the origin of the forest (metres).
+    /// Largest distance from the origin (metres) of any instance position, and of the
+    /// terrain's corners at its highest and lowest heights.
     pub fn extent(&self) -> f32 {
-        self.instances
+        let trees = self
+            .instances
             .iter()
             .map(|i| Vec3::from_array(i.position).length())
-            .fold(0.0, f32::max)
+            .fold(0.0, f32::max);
+        let ground = self.terrain.as_ref().map_or(0.0, |t| {
+            let ([x0, z0], [x1, z1]) = t.bounds();
+            let (lo, hi) = t.height_range();
+            let (x, z) = (x0.abs().max(x1.abs()), z0.abs().max(z1.abs()));
+            Vec3::new(x, lo.abs().max(hi.abs()), z).length()
+        });
+        trees.max(ground)
+    }
+
+    /// Height of the ground at world (x, z): the terrain's, or 0 without one (metres).
+    pub fn ground_height(&self, x: f32, z: f32) -> f32 {
+        self.terrain.as_ref().map_or(0.0, |t| t.height(x, z))
     }
 
     /// The far-plane distance (metres) every front end uses for a camera at `eye`: three
@@ -446,6 +525,43 @@ mod tests {
             assert!((a.rotation - b.rotation).abs() < 1e-5);
             assert_eq!(a.position, b.position);
         }
+    }
+
+    #[test]
+    fn a_terrain_round_trips_and_a_forest_without_one_stays_version_1() {
+        let plain = sample();
+        assert_eq!(plain.to_bytes()[4..8], 1u32.to_le_bytes());
+        let terrain = Terrain {
+            size: [3, 2],
+            origin: [-20.0, -15.0],
+            spacing: 20.0,
+            heights: vec![0.0, 1.5, 3.0, 2.0, 4.0, 8.0],
+        };
+        let f = plain.with_terrain(terrain.clone());
+        let bytes = f.to_bytes();
+        assert_eq!(bytes[4..8], 2u32.to_le_bytes());
+        assert_eq!(Forest::from_bytes(&bytes).unwrap(), f);
+        let dir = tempfile::tempdir().unwrap();
+        let json = dir.path().join("f.json");
+        f.save(&json).unwrap();
+        assert_eq!(Forest::load(&json).unwrap().terrain, Some(terrain));
+        assert_eq!(f.ground_height(20.0, 5.0), 8.0);
+        assert_eq!(f.ground_height(500.0, 5.0), 0.0);
+        assert!(f.extent() >= Vec3::new(20.0, 8.0, 15.0).length());
+        // Truncated, bad or trailing terrain data is named.
+        let err = |b: &[u8]| Forest::from_bytes(b).unwrap_err();
+        assert!(err(&bytes[..bytes.len() - 2]).contains("truncated"));
+        let mut extra = bytes.clone();
+        extra.push(0);
+        assert!(err(&extra).contains("after the terrain"), "{}", err(&extra));
+        let mut nan = bytes.clone();
+        let n = nan.len();
+        nan[n - 4..].copy_from_slice(&f32::NAN.to_le_bytes());
+        assert!(err(&nan).contains("terrain: height NaN"), "{}", err(&nan));
+        let mut huge = bytes;
+        let at = huge.len() - 6 * 4 - 5 * 4;
+        huge[at..at + 4].copy_from_slice(&100_000u32.to_le_bytes());
+        assert!(err(&huge).contains("100000×2"), "{}", err(&huge));
     }
 
     #[test]

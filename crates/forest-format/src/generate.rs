@@ -5,8 +5,14 @@
 //! 4 octaves, normalised to `[0,1]`), after `t` is raised to the power 3: low values leave gaps
 //! between clumps, high values fill them, with organic, vein-like edges. Species come from a
 //! second, coarser noise so that each species also grows in patches. Deterministic per seed.
+//!
+//! On a terrain ([`GenerateParams::terrain`]) every tree stands at the ground's height, and two
+//! more rules thin the candidates ([`GroundRules`]): steep slopes carry no trees, nothing grows
+//! above the treeline, and each species keeps to its altitude band
+//! ([`species_altitude`]: pines on the hilltops, oaks and ashes in the valleys).
 
 use crate::forest::{Forest, Instance};
+use crate::terrain::Terrain;
 
 /// Parameters of [`generate`].
 #[derive(Clone, Debug, PartialEq)]
@@ -29,6 +35,51 @@ pub struct GenerateParams {
     pub seed: u64,
     /// Presort directions.
     pub presort_directions: u32,
+    /// The ground: trees stand on it and follow [`Self::ground`]'s rules; the forest's square
+    /// must lie on it. `None`: flat ground at y = 0.
+    pub terrain: Option<Terrain>,
+    /// Where trees grow on a terrain.
+    pub ground: GroundRules,
+}
+
+/// Where trees grow on a terrain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GroundRules {
+    /// Steepest ground that carries trees, degrees; they thin out over the 10° below it.
+    pub max_slope_deg: f32,
+    /// Treeline, as a fraction of the way from the terrain's lowest to its highest sample;
+    /// trees thin out over the tenth below it.
+    pub treeline: f32,
+    /// Width of a species' altitude band (same fraction): a tree of a species preferring
+    /// altitude `a₀` is kept at altitude `a` with probability `exp(−((a − a₀)/width)²)`.
+    pub band: f32,
+}
+
+impl Default for GroundRules {
+    fn default() -> Self {
+        Self {
+            max_slope_deg: 35.0,
+            treeline: 0.92,
+            band: 0.45,
+        }
+    }
+}
+
+/// Preferred altitude of a species (fraction of the terrain's height range, 0 = valley floor)
+/// by name: ash 0.2, oak 0.3, bush 0.35, aspen 0.55, pine 0.8; 0.5 for any other name.
+pub fn species_altitude(name: &str) -> f32 {
+    let stem = std::path::Path::new(name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match stem.as_str() {
+        "ash" => 0.2,
+        "oak" => 0.3,
+        "bush" => 0.35,
+        "aspen" => 0.55,
+        "pine" => 0.8,
+        _ => 0.5,
+    }
 }
 
 impl Default for GenerateParams {
@@ -42,6 +93,8 @@ impl Default for GenerateParams {
             species_scale: Vec::new(),
             seed: 1,
             presort_directions: crate::forest::DEFAULT_PRESORT_DIRECTIONS,
+            terrain: None,
+            ground: GroundRules::default(),
         }
     }
 }
@@ -170,6 +223,38 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         ));
     }
     let side = (p.trees as f32 * p.area_per_tree).sqrt();
+    let ground = match &p.terrain {
+        Some(t) => {
+            t.check().map_err(|e| format!("terrain: {e}"))?;
+            let half = side / 2.0;
+            if !(t.contains(-half, -half) && t.contains(half, half)) {
+                let ([x0, z0], [x1, z1]) = t.bounds();
+                return Err(format!(
+                    "the forest's square, {side:.0} m across and centred on the origin, does \
+                     not lie on the terrain (x {x0:.0} to {x1:.0} m, z {z0:.0} to {z1:.0} m): \
+                     fewer trees, a smaller area per tree, or a larger terrain spacing"
+                ));
+            }
+            let g = p.ground;
+            if !(g.max_slope_deg > 0.0 && g.max_slope_deg <= 90.0) {
+                return Err(format!(
+                    "steepest slope {}°: must be above 0 and at most 90",
+                    g.max_slope_deg
+                ));
+            }
+            if !(g.treeline > 0.0 && g.treeline <= 1.0 && g.band > 0.0 && g.band.is_finite()) {
+                return Err(format!(
+                    "treeline {} and altitude band {}: the treeline must be above 0 and at \
+                     most 1, the band positive",
+                    g.treeline, g.band
+                ));
+            }
+            let (lo, hi) = t.height_range();
+            let prefs: Vec<f32> = p.species.iter().map(|s| species_altitude(s)).collect();
+            Some((t, g, lo, (hi - lo).max(1e-6), prefs))
+        }
+        None => None,
+    };
     let mut rng = SplitMix64(p.seed);
     let mut instances = Vec::with_capacity(p.trees as usize);
     let max_attempts = 1000u64 * u64::from(p.trees);
@@ -193,23 +278,35 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
             .floor()
             .clamp(0.0, (p.species.len() - 1) as f32) as u32;
+        let mut y = 0.0;
+        if let Some((t, g, low, range, prefs)) = &ground {
+            y = t.height(x, z);
+            let slope = t.slope(x, z).atan().to_degrees();
+            let alt = (y - low) / range;
+            let keep = ((g.max_slope_deg - slope) / 10.0).clamp(0.0, 1.0)
+                * ((g.treeline - alt) / 0.1).clamp(0.0, 1.0)
+                * (-((alt - prefs[pick as usize]) / g.band).powi(2)).exp();
+            if rng.next_f32() >= keep {
+                continue;
+            }
+        }
         let (lo, hi) = p
             .species_scale
             .get(pick as usize)
             .copied()
             .unwrap_or(p.scale);
         instances.push(Instance {
-            position: [x, 0.0, z],
+            position: [x, y, z],
             rotation: rng.next_f32() * std::f32::consts::TAU,
             scale: lo + (hi - lo) * rng.next_f32(),
             species: pick,
         });
     }
-    Ok(Forest::new(
-        p.species.clone(),
-        instances,
-        p.presort_directions,
-    ))
+    let forest = Forest::new(p.species.clone(), instances, p.presort_directions);
+    Ok(match &p.terrain {
+        Some(t) => forest.with_terrain(t.clone()),
+        None => forest,
+    })
 }
 
 #[cfg(test)]
@@ -281,6 +378,55 @@ mod tests {
         assert!(generate(&p).unwrap_err().contains("of species b"));
         assert_eq!(species_height("Pine"), Some((20.0, 35.0)));
         assert_eq!(species_height("baobab"), None);
+    }
+
+    #[test]
+    fn trees_stand_on_the_terrain_and_keep_off_steep_ground_and_hilltops() {
+        use crate::terrain::TerrainParams;
+        let terrain = Terrain::generate(&TerrainParams {
+            half_extent: 600.0,
+            spacing: 10.0,
+            relief: 150.0,
+            hill_size: 400.0,
+            fade: 0.125,
+            seed: 9,
+        })
+        .unwrap();
+        let mut p = params(3000, 4);
+        p.species = vec!["x/oak.atlas".into(), "x/pine.atlas".into()];
+        p.area_per_tree = 300.0;
+        p.terrain = Some(terrain.clone());
+        let f = generate(&p).unwrap();
+        assert_eq!(f.terrain.as_ref(), Some(&terrain));
+        let (lo, hi) = terrain.height_range();
+        let g = GroundRules::default();
+        let (mut oak, mut pine) = (Vec::new(), Vec::new());
+        for i in &f.instances {
+            let [x, y, z] = i.position;
+            // Every base exactly on the drawn surface.
+            assert_eq!(y, terrain.height(x, z), "{i:?}");
+            assert!(terrain.slope(x, z).atan().to_degrees() < g.max_slope_deg);
+            let alt = (y - lo) / (hi - lo);
+            assert!(alt < g.treeline, "above the treeline: {alt}");
+            [&mut oak, &mut pine][i.species as usize].push(alt);
+        }
+        let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
+        assert!(
+            mean(&pine) > mean(&oak) + 0.1,
+            "pines higher up: {} against {}",
+            mean(&pine),
+            mean(&oak)
+        );
+        // The same forest without a terrain is the flat one of before.
+        p.terrain = None;
+        let flat = generate(&p).unwrap();
+        assert!(flat.instances.iter().all(|i| i.position[1] == 0.0));
+        assert!(flat.terrain.is_none());
+        // A square larger than the terrain is refused.
+        p.terrain = Some(terrain);
+        p.area_per_tree = 1000.0;
+        let err = generate(&p).unwrap_err();
+        assert!(err.contains("does not lie on the terrain"), "{err}");
     }
 
     #[test]

@@ -8,7 +8,8 @@
 //! - [`slab`]: the image-space conventions that map a slab pixel back to object space;
 //! - [`shading`]: the one shading model every renderer of the project uses;
 //! - [`atlas`]: the baked atlas (manifest, colour, nodes), its atomic writer and checked loader;
-//! - [`forest`], [`generate`]: forest files and the clumped-forest generator;
+//! - [`forest`], [`generate`], [`terrain`]: forest files, the clumped-forest generator and the
+//!   height field the trees stand on;
 //! - [`camera_path`]: recorded camera paths for the viewer.
 
 pub mod atlas;
@@ -23,6 +24,7 @@ pub mod node;
 pub mod nodes_codec;
 pub mod shading;
 pub mod slab;
+pub mod terrain;
 pub mod trim;
 
 pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding, PlaneFit};

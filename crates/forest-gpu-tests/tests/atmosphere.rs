@@ -1,14 +1,19 @@
 //! The environment and the haze: the sky, the endless ground and the sun's disc have analytic
 //! colours; haze mixes every method's trees towards the horizon colour by exp(−σ·distance);
-//! full geometry and the quad stream draw the same sky and ground and the same hazed tree.
+//! full geometry and the quad stream draw the same sky and ground and the same hazed tree. The
+//! terrain: a planar height field is drawn where the analytic plane is, in the shading model's
+//! colour for its normal, the flat ground continuing around it; both methods draw the same
+//! hills pixel for pixel, in haze too.
 
 mod common;
 
 use forest_baselines::geometry::{GeometryRenderer, MeshMethod};
 use forest_format::forest::Forest;
 use forest_format::shading::srgb_decode_table;
+use forest_format::terrain::Terrain;
 use forest_render::options::{
-    Atmosphere, Background, KOSCHMIEDER, RendererOptions, SUN_DISC_DEGREES, ground_colour,
+    Atmosphere, Background, GROUND_ALBEDO, KOSCHMIEDER, RendererOptions, SUN_DISC_DEGREES,
+    ground_colour,
 };
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
@@ -422,4 +427,144 @@ fn the_hybrid_refuses_forms_in_different_atmospheres() {
         .set_method(&ctx, Method::Mesh(MeshMethod::default()))
         .unwrap();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
+/// Heights `a·x + b·z + c` on a 41 × 41 grid 5 m apart, centred on the origin.
+fn planar(a: f32, b: f32, c: f32) -> Terrain {
+    let (n, s) = (41u32, 5.0f32);
+    let o = -s * (n - 1) as f32 / 2.0;
+    let heights = (0..n)
+        .flat_map(|j| (0..n).map(move |i| a * (o + i as f32 * s) + b * (o + j as f32 * s) + c))
+        .collect();
+    Terrain {
+        size: [n, n],
+        origin: [o, o],
+        spacing: s,
+        heights,
+    }
+}
+
+#[test]
+fn a_planar_terrain_is_drawn_where_and_as_the_plane_is() {
+    let ctx = common::ctx();
+    // Rising to the east and the north: 50 m at the centre, 10 m to 90 m along x.
+    let (a, b, c) = (0.4, 0.1, 50.0);
+    let terrain = planar(a, b, c);
+    let forest = Forest::new(vec!["bush".into(), "pine".into()], Vec::new(), 15)
+        .with_terrain(terrain.clone());
+    let opts = options(Background::Sky, Atmosphere::CLEAR);
+    let normal = Vec3::new(-a, 1.0, -b).normalize();
+    let slope = opts.lighting.shade(GROUND_ALBEDO, normal, 1.0, 0.0);
+    let flat = ground_colour(&opts.lighting);
+    // From the south-west, above the slope, looking at its middle and past its east edge.
+    let cam = Camera {
+        viewport: SIZE,
+        far: 5000.0,
+        ..common::camera(
+            Vec3::new(-60.0, 140.0, -160.0),
+            Vec3::new(40.0, 50.0, 20.0),
+            1.0,
+        )
+    };
+    let q = quads(&ctx, &forest, &opts, &cam);
+    let g = geometry(&ctx, &forest, &opts, &cam);
+    if q.0 != g.0 {
+        q.save("terrain-quads");
+        g.save("terrain-geometry");
+    }
+    assert!(q.0 == g.0, "both methods draw the same terrain");
+    let ([x0, z0], [x1, z1]) = terrain.bounds();
+    let (mut on, mut off) = (0, 0);
+    for y in (0..SIZE.1).step_by(5) {
+        for x in (0..SIZE.0).step_by(7) {
+            let d = pixel_ray(&cam, x, y);
+            // The ray against the plane y = a·x + b·z + c, kept where it is on the grid.
+            let n = Vec3::new(-a, 1.0, -b);
+            let t = (c - n.dot(cam.eye)) / n.dot(d);
+            let p = cam.eye + d * t;
+            let margin = 2.0;
+            let inside =
+                |p: Vec3, m: f32| p.x > x0 + m && p.x < x1 - m && p.z > z0 + m && p.z < z1 - m;
+            let want = if t > 0.0 && inside(p, margin) {
+                on += 1;
+                slope
+            } else if t > 0.0 && inside(p, -margin) {
+                continue; // near the border or its skirt
+            } else if d.y < -0.05 {
+                // Past the grid the ray meets the flat ground, unless it passes over the
+                // grid below its highest point first (then a skirt or the slope is in front).
+                let hit = cam.eye + d * (cam.eye.y / -d.y);
+                let crosses = (0..=400).any(|k| {
+                    let p = cam.eye.lerp(hit, k as f32 / 400.0);
+                    p.y <= 95.0 && inside(p, -3.0 * margin)
+                });
+                if crosses {
+                    continue;
+                }
+                off += 1;
+                flat
+            } else {
+                continue;
+            };
+            let got = q.linear(x, y).truncate();
+            if (got - want).abs().max_element() > 0.01 + 0.02 * want.max_element() {
+                q.save("terrain-planar");
+                panic!("pixel ({x}, {y}), ray {d}: got {got}, want {want}");
+            }
+        }
+    }
+    assert!(on > 100 && off > 10, "{on} on the slope, {off} beyond");
+    assert!(
+        (slope - flat).abs().max_element() > 0.02,
+        "a slope is shaded"
+    );
+}
+
+#[test]
+fn hills_in_haze_are_the_same_for_every_method_and_hide_the_plane() {
+    let ctx = common::ctx();
+    let forest = common::hilly_forest(60);
+    let t = forest.terrain.as_ref().unwrap();
+    let (lo, hi) = t.height_range();
+    let opts = options(Background::Sky, Atmosphere::hazy(600.0));
+    let empty = Forest::new(forest.species.clone(), Vec::new(), 15).with_terrain(t.clone());
+    // Standing on the ground, looking across the hills; and from high above.
+    let low = Vec3::new(-10.0, forest.ground_height(-10.0, 5.0) + 1.7, 5.0);
+    for (name, eye, target) in [
+        ("ground", low, Vec3::new(30.0, (lo + hi) / 2.0, -30.0)),
+        (
+            "above",
+            Vec3::new(0.0, hi + 150.0, 120.0),
+            Vec3::new(0.0, lo, 0.0),
+        ),
+    ] {
+        let cam = Camera {
+            viewport: SIZE,
+            far: 5000.0,
+            ..common::camera(eye, target, 1.0)
+        };
+        let q = quads(&ctx, &empty, &opts, &cam);
+        let g = geometry(&ctx, &empty, &opts, &cam);
+        if q.0 != g.0 {
+            q.save(&format!("terrain-{name}-quads"));
+            g.save(&format!("terrain-{name}-geometry"));
+        }
+        assert!(q.0 == g.0, "{name}: both methods draw the same hills");
+        // No sky shows through the hills: every pixel whose ray points down hits ground.
+        let sky = |p: &image::Rgba<u8>| p[2] > p[0] + 30;
+        let holes = (0..SIZE.1)
+            .flat_map(|y| (0..SIZE.0).map(move |x| (x, y)))
+            .filter(|&(x, y)| pixel_ray(&cam, x, y).y < -0.02 && sky(q.0.get_pixel(x, y)))
+            .count();
+        if holes > 0 {
+            q.save(&format!("terrain-{name}-holes"));
+        }
+        assert_eq!(holes, 0, "{name}: sky through the ground");
+        // The trees standing on the hills are drawn over them.
+        let trees = quads(&ctx, &forest, &opts, &cam);
+        let differ = (trees.0.pixels().zip(q.0.pixels()))
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(differ > 20, "{name}: {differ} pixels of trees");
+    }
 }

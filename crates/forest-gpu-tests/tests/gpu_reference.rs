@@ -147,6 +147,59 @@ fn gpu_stream_equals_the_cpu_reference() {
     assert!(coarse.composites > 0 && coarse.refined > 0, "{coarse:?}");
 }
 
+/// Trees standing on hills: the cull's bounding spheres, the presorts and the refinement
+/// still give the reference's stream, from eyes standing on the ground in a valley and on a
+/// hilltop, looking up and down the slopes, and from above.
+#[test]
+fn on_hilly_ground_the_gpu_stream_equals_the_cpu_reference() {
+    use glam::Vec3;
+    let ctx = common::ctx();
+    let forest = common::hilly_forest(300);
+    let terrain = forest.terrain.as_ref().unwrap();
+    let (lo, hi) = terrain.height_range();
+    assert!(hi - lo > 8.0, "hills: {lo}..{hi}");
+    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let (mut stream, target) = common::small_stream(&ctx, scene, None);
+    let on_ground = |x: f32, z: f32, up: f32| Vec3::new(x, forest.ground_height(x, z) + up, z);
+    // The lowest and highest trees' places.
+    let by_height = |f: fn(f32, f32) -> bool| {
+        forest
+            .instances
+            .iter()
+            .map(|i| Vec3::from_array(i.position))
+            .reduce(|a, b| if f(a.y, b.y) { a } else { b })
+            .unwrap()
+    };
+    let (low, high) = (by_height(|a, b| a < b), by_height(|a, b| a > b));
+    let side = forest.extent();
+    let views = [
+        (
+            "valley, up the slope",
+            common::camera(on_ground(low.x + 2.0, low.z, 1.7), high, 2.0),
+        ),
+        (
+            "hilltop, down the slope",
+            common::camera(on_ground(high.x + 2.0, high.z, 1.7), low, 2.0),
+        ),
+        (
+            "above",
+            common::camera(
+                Vec3::new(0.0, hi + side * 0.8, side * 0.6),
+                Vec3::new(0.0, lo, 0.0),
+                2.0,
+            ),
+        ),
+    ];
+    for (name, cam) in &views {
+        let s = compare(&ctx, &mut stream, &target, name, cam);
+        assert!(s.visible > 0 && s.quads > 0, "{s:?}");
+    }
+    // Every tree stands on the drawn surface.
+    for i in &forest.instances {
+        assert_eq!(i.position[1], terrain.height(i.position[0], i.position[2]));
+    }
+}
+
 /// Refinement alternates the stream buffers, so the final stream lies in the second buffer
 /// after an odd number of steps: the composited quads, which no step writes, must be there
 /// too (the test atlases' 5 levels give an even 4 steps; 64 px with 8-px finest quads give 4

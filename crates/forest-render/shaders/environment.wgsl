@@ -1,7 +1,8 @@
 // The environment: an endless ground plane at y = 0 and the sky behind it, drawn first as one
-// full-screen triangle, and the distance haze every method's fragments go through (`hazed`).
-// Appended to draw.wgsl and geometry_draw.wgsl, which declare `camera` at binding 0. Mirrors
-// options::Atmosphere and gpu_types::GpuEnvironment.
+// full-screen triangle; the terrain's height field, drawn as a triangle mesh over the plane; and
+// the distance haze every method's fragments go through (`hazed`). Appended to draw.wgsl and
+// geometry_draw.wgsl, which declare `camera` at binding 0. Mirrors options::Atmosphere,
+// gpu_types::GpuEnvironment and forest_format::terrain::Terrain.
 
 struct Environment {
     // xyz: lit ground colour (linear); w unused.
@@ -15,9 +16,21 @@ struct Environment {
     sun: vec4<f32>,
     // xyz: the sun's colour; w unused.
     sun_colour: vec4<f32>,
+    // xyz: the ground's albedo; w unused.
+    albedo: vec4<f32>,
+    // xyz: sky irradiance on a surface facing up; w unused.
+    sky_light: vec4<f32>,
+    // xyz: ground-bounce irradiance on a surface facing down; w unused.
+    ground_light: vec4<f32>,
+    // x, y: world x and z of sample (0, 0); z: metres between samples; w: 1 with a terrain.
+    terrain: vec4<f32>,
+    // x, y: samples along x and z.
+    terrain_size: vec4<u32>,
 }
 
 @group(0) @binding(8) var<uniform> env: Environment;
+// The terrain's heights in metres, row after row (sample (i, j) at j·size.x + i).
+@group(0) @binding(13) var<storage, read> terrain_heights: array<f32>;
 
 // The haze's optical depth from the eye to `p`: extinction σ₀·exp(−k·y) integrated along the
 // segment (mirrors options::Atmosphere::optical_depth).
@@ -87,7 +100,7 @@ fn fs_environment(@builtin(position) frag: vec4<f32>) -> EnvironmentOut {
     let eye = camera.eye.xyz;
     var out: EnvironmentOut;
     let t = -eye.y / d.y;
-    if (d.y != 0.0 && t > 0.0) {
+    if (d.y != 0.0 && t > 0.0 && !under_terrain(eye + d * t)) {
         let p = eye + d * t;
         let clip = camera.view_proj * vec4<f32>(p, 1.0);
         out.colour = hazed(vec4<f32>(env.ground.rgb, 1.0), p);
@@ -98,4 +111,92 @@ fn fs_environment(@builtin(position) frag: vec4<f32>) -> EnvironmentOut {
         out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
     }
     return out;
+}
+
+// Whether the plane's point `p` lies under the terrain's mesh, which draws the ground there:
+// inside the grid by more than half a cell (the mesh's skirts close the rest).
+fn under_terrain(p: vec3<f32>) -> bool {
+    if (env.terrain.w == 0.0) { return false; }
+    let s = env.terrain.z;
+    let lo = env.terrain.xy + vec2<f32>(0.5 * s);
+    let hi = env.terrain.xy + (vec2<f32>(env.terrain_size.xy) - vec2<f32>(1.5)) * s;
+    return all(p.xz > lo) && all(p.xz < hi);
+}
+
+fn terrain_sample(i: i32, j: i32) -> f32 {
+    let n = vec2<i32>(env.terrain_size.xy);
+    let c = clamp(vec2<i32>(i, j), vec2<i32>(0), n - vec2<i32>(1));
+    return terrain_heights[c.y * n.x + c.x];
+}
+
+// Sample (i, j)'s position on the perimeter walk of the grid: along j = 0, up i = n.x − 1,
+// back along j = n.y − 1, down i = 0 (2·(n.x − 1) + 2·(n.y − 1) steps, then round again).
+fn perimeter(step: u32) -> vec2<u32> {
+    let n = env.terrain_size.xy - vec2<u32>(1u);
+    let s = step % (2u * (n.x + n.y));
+    if (s < n.x) { return vec2<u32>(s, 0u); }
+    if (s < n.x + n.y) { return vec2<u32>(n.x, s - n.x); }
+    if (s < 2u * n.x + n.y) { return vec2<u32>(n.x - (s - n.x - n.y), n.y); }
+    return vec2<u32>(0u, n.y - (s - 2u * n.x - n.y));
+}
+
+struct TerrainOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+}
+
+// The terrain's mesh: 6 vertices per cell, split along the diagonal from sample (i, j) to
+// (i+1, j+1) as forest_format::terrain::Terrain::height interpolates, then 6 per segment of a
+// vertical skirt from the border down to the plane at y = 0. Normals by central differences of
+// the heights (one-sided at the border).
+@vertex
+fn vs_terrain(@builtin(vertex_index) vi: u32) -> TerrainOut {
+    let n = env.terrain_size.xy;
+    let cells = (n.x - 1u) * (n.y - 1u);
+    let cell = vi / 6u;
+    let k = vi % 6u;
+    var ij: vec2<u32>;
+    var skirt_bottom = false;
+    if (cell < cells) {
+        var corner = array<vec2<u32>, 6>(
+            vec2<u32>(0u, 0u), vec2<u32>(1u, 0u), vec2<u32>(1u, 1u),
+            vec2<u32>(0u, 0u), vec2<u32>(1u, 1u), vec2<u32>(0u, 1u));
+        ij = vec2<u32>(cell % (n.x - 1u), cell / (n.x - 1u)) + corner[k];
+    } else {
+        // Segment from perimeter step s to s + 1: top a, top b, bottom b; top a, bottom b,
+        // bottom a.
+        let s = cell - cells;
+        var next = array<u32, 6>(0u, 1u, 1u, 0u, 1u, 0u);
+        ij = perimeter(s + next[k]);
+        skirt_bottom = k == 2u || k == 4u || k == 5u;
+    }
+    let i = i32(ij.x);
+    let j = i32(ij.y);
+    let sp = env.terrain.z;
+    let h = select(terrain_sample(i, j), 0.0, skirt_bottom);
+    let world = vec3<f32>(env.terrain.x + f32(ij.x) * sp, h, env.terrain.y + f32(ij.y) * sp);
+    let i0 = max(i - 1, 0);
+    let i1 = min(i + 1, i32(n.x) - 1);
+    let j0 = max(j - 1, 0);
+    let j1 = min(j + 1, i32(n.y) - 1);
+    let dx = (terrain_sample(i1, j) - terrain_sample(i0, j)) / (f32(i1 - i0) * sp);
+    let dz = (terrain_sample(i, j1) - terrain_sample(i, j0)) / (f32(j1 - j0) * sp);
+    var out: TerrainOut;
+    out.clip = camera.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.normal = vec3<f32>(-dx, 1.0, -dz);
+    return out;
+}
+
+// The ground's albedo under the shared shading model (forest_format::shading, in sun, no
+// translucency) at the interpolated normal, then hazed: on level ground the plane's colour.
+@fragment
+fn fs_terrain(in: TerrainOut) -> @location(0) vec4<f32> {
+    let n = normalize(in.normal);
+    let ndl = dot(n, env.sun.xyz);
+    let hemi = 0.5 + 0.5 * n.y;
+    let ambient = env.sky_light.rgb * hemi + env.ground_light.rgb * (1.0 - hemi);
+    let c = env.albedo.rgb * (ambient + env.sun_colour.rgb * max(ndl, 0.0));
+    return hazed(vec4<f32>(c, 1.0), in.world);
 }

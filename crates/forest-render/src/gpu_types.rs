@@ -215,8 +215,9 @@ pub struct SceneConsts {
     pub species: u32,
 }
 
-/// The environment (80 bytes), written once: what `shaders/environment.wgsl` draws behind the
-/// trees and the haze every method applies (see [`crate::options::Atmosphere`]).
+/// The environment (160 bytes), written once: what `shaders/environment.wgsl` draws behind the
+/// trees (sky, ground, terrain) and the haze every method applies (see
+/// [`crate::options::Atmosphere`] and [`crate::terrain`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuEnvironment {
@@ -233,4 +234,15 @@ pub struct GpuEnvironment {
     pub sun: [f32; 4],
     /// The sun's colour (linear RGB); `w` unused.
     pub sun_colour: [f32; 4],
+    /// The ground's albedo (linear RGB), which the terrain shades by its normal; `w` unused.
+    pub albedo: [f32; 4],
+    /// Sky irradiance on a surface facing up (linear RGB); `w` unused.
+    pub sky_light: [f32; 4],
+    /// Ground-bounce irradiance on a surface facing down (linear RGB); `w` unused.
+    pub ground_light: [f32; 4],
+    /// The terrain's grid: world x and z of sample (0, 0), metres between samples, and 1 when
+    /// there is a terrain (0: flat ground only).
+    pub terrain: [f32; 4],
+    /// Samples along x and z of the terrain's grid; `zw` unused.
+    pub terrain_size: [u32; 4],
 }

@@ -23,6 +23,7 @@ pub mod scene;
 pub mod stats;
 pub mod stream;
 pub mod target;
+pub mod terrain;
 pub mod work;
 
 pub use camera::Camera;

@@ -402,14 +402,21 @@ fn optical_depth(sigma: f32, k: f32, eye: glam::Vec3, point: glam::Vec3) -> f32 
 /// it shows at a few hundred pixels across).
 pub const SUN_DISC_DEGREES: f32 = 0.6;
 
+/// The ground's albedo (linear RGB): dry soil and leaf litter.
+pub const GROUND_ALBEDO: glam::Vec3 = glam::Vec3::new(0.16, 0.14, 0.09);
+
 /// The ground's albedo lit by the shared shading model (facing up, in sun), linear RGB.
 pub fn ground_colour(lighting: &Lighting) -> glam::Vec3 {
-    lighting.shade(glam::Vec3::new(0.16, 0.14, 0.09), glam::Vec3::Y, 1.0, 0.0)
+    lighting.shade(GROUND_ALBEDO, glam::Vec3::Y, 1.0, 0.0)
 }
 
-/// The environment uniform: ground colour, sky, sun disc and haze (see
+/// The environment uniform: ground colour, sky, sun disc, haze and the terrain's grid (see
 /// `shaders/environment.wgsl`).
-pub fn environment_uniform(lighting: &Lighting, atmosphere: &Atmosphere) -> GpuEnvironment {
+pub fn environment_uniform(
+    lighting: &Lighting,
+    atmosphere: &Atmosphere,
+    terrain: &crate::terrain::TerrainGrid,
+) -> GpuEnvironment {
     let g = ground_colour(lighting);
     let [hr, hg, hb] = atmosphere.horizon;
     let [zr, zg, zb] = atmosphere.zenith;
@@ -426,6 +433,16 @@ pub fn environment_uniform(lighting: &Lighting, atmosphere: &Atmosphere) -> GpuE
         zenith: [zr, zg, zb, atmosphere.haze_falloff()],
         sun: [s.x, s.y, s.z, disc],
         sun_colour: lighting.sun.extend(0.0).to_array(),
+        albedo: GROUND_ALBEDO.extend(0.0).to_array(),
+        sky_light: lighting.sky.extend(0.0).to_array(),
+        ground_light: lighting.ground.extend(0.0).to_array(),
+        terrain: [
+            terrain.origin[0],
+            terrain.origin[1],
+            terrain.spacing,
+            if terrain.present() { 1.0 } else { 0.0 },
+        ],
+        terrain_size: [terrain.size[0], terrain.size[1], 0, 0],
     }
 }
 

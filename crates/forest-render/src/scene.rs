@@ -259,6 +259,8 @@ pub struct GpuScene {
     pub roots: wgpu::Buffer,
     /// Presort directions.
     pub presort_dirs: wgpu::Buffer,
+    /// The forest's terrain (its heights; a single zero without one).
+    pub terrain: crate::terrain::GpuTerrain,
     /// Bytes of all the above on the GPU.
     pub bytes: u64,
     /// Whether colour is BC7 (else RGBA8).
@@ -349,6 +351,7 @@ impl GpuScene {
         progress: &(dyn Fn(u64, u64) + Sync),
     ) -> Result<Self, RenderError> {
         let tables = SceneTables::new(species, forest)?;
+        let terrain = crate::terrain::GpuTerrain::new(&ctx.device, forest.terrain.as_ref())?;
         let limits = ctx.device.limits();
         if tables.layers > limits.max_texture_array_layers {
             return Err(RenderError::DeviceLimit {
@@ -435,7 +438,8 @@ impl GpuScene {
                 + std::mem::size_of_val(tables.frames.as_slice())
                 + std::mem::size_of_val(tables.tris.as_slice())
                 + std::mem::size_of_val(tables.roots.as_slice())
-                + std::mem::size_of_val(tables.presort_dirs.as_slice())) as u64;
+                + std::mem::size_of_val(tables.presort_dirs.as_slice())) as u64
+            + terrain.bytes();
         Ok(Self {
             instances: storage(ctx, "instances", &tables.instances),
             species: storage(ctx, "species", &tables.species),
@@ -443,6 +447,7 @@ impl GpuScene {
             tris: storage(ctx, "direction triangles", &tables.tris),
             roots: storage(ctx, "roots", &tables.roots),
             presort_dirs: storage(ctx, "presort directions", &tables.presort_dirs),
+            terrain,
             tables,
             colour,
             nodes,

@@ -169,7 +169,11 @@ impl QuadStream {
         });
         let environment = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("environment"),
-            contents: bytemuck::bytes_of(&environment_uniform(&opts.lighting, &opts.atmosphere)),
+            contents: bytemuck::bytes_of(&environment_uniform(
+                &opts.lighting,
+                &opts.atmosphere,
+                &scene.terrain.grid,
+            )),
             usage: U::UNIFORM,
         });
         let queries = device
@@ -360,19 +364,26 @@ impl QuadStream {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("draw"),
                 layout: &passes.draw.bind_layout,
-                entries: &crate::passes::numbered(vec![
-                    camera.as_entire_binding(),
-                    scene.instances.as_entire_binding(),
-                    scene.species.as_entire_binding(),
-                    scene.frames.as_entire_binding(),
-                    final_quads.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(&nodes_view),
-                    wgpu::BindingResource::TextureView(&colour_view),
-                    wgpu::BindingResource::Sampler(&sampler),
-                    environment.as_entire_binding(),
-                    scene.roots.as_entire_binding(),
-                    state.as_entire_binding(),
-                ]),
+                entries: &[
+                    crate::passes::numbered(vec![
+                        camera.as_entire_binding(),
+                        scene.instances.as_entire_binding(),
+                        scene.species.as_entire_binding(),
+                        scene.frames.as_entire_binding(),
+                        final_quads.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&nodes_view),
+                        wgpu::BindingResource::TextureView(&colour_view),
+                        wgpu::BindingResource::Sampler(&sampler),
+                        environment.as_entire_binding(),
+                        scene.roots.as_entire_binding(),
+                        state.as_entire_binding(),
+                    ]),
+                    vec![wgpu::BindGroupEntry {
+                        binding: crate::terrain::HEIGHTS_BINDING,
+                        resource: scene.terrain.heights.as_entire_binding(),
+                    }],
+                ]
+                .concat(),
             })
         });
         let mut sources = vec![(state.clone(), std::mem::size_of::<GpuState>() as u64)];
@@ -767,7 +778,7 @@ impl QuadStream {
             pass,
             &self.sized.bg_draw[(self.iterations % 2) as usize],
             &self.sized.args,
-            ground && self.opts.background == Background::Sky,
+            (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,
             self.counting().map(|q| &q.set),
         );

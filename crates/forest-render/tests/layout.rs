@@ -37,6 +37,11 @@ fn draw_structs_match_the_host() {
             ("zenith", offset_of!(GpuEnvironment, zenith)),
             ("sun", offset_of!(GpuEnvironment, sun)),
             ("sun_colour", offset_of!(GpuEnvironment, sun_colour)),
+            ("albedo", offset_of!(GpuEnvironment, albedo)),
+            ("sky_light", offset_of!(GpuEnvironment, sky_light)),
+            ("ground_light", offset_of!(GpuEnvironment, ground_light)),
+            ("terrain", offset_of!(GpuEnvironment, terrain)),
+            ("terrain_size", offset_of!(GpuEnvironment, terrain_size)),
         ],
     ));
     check(&draw_source(), &e);

@@ -62,10 +62,12 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             count: None,
         },
         buffer(7, S::FRAGMENT, uniform),
-        buffer(8, S::FRAGMENT, uniform),
+        // The environment: the terrain's grid is read by `vs_terrain`.
+        buffer(8, S::VERTEX_FRAGMENT, uniform),
         buffer(9, S::VERTEX, read),
         buffer(10, S::VERTEX, uniform),
         buffer(11, S::VERTEX, read),
         texture(12),
+        forest_render::terrain::heights_entry(),
     ]
 }

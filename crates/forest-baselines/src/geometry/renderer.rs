@@ -41,6 +41,8 @@ pub struct GeometryRenderer {
     draw: wgpu::RenderPipeline,
     billboard: wgpu::RenderPipeline,
     environment: wgpu::RenderPipeline,
+    terrain_pipeline: wgpu::RenderPipeline,
+    terrain: forest_render::terrain::GpuTerrain,
     atmosphere: Atmosphere,
     compute_bg: wgpu::BindGroup,
     draw_bg: wgpu::BindGroup,
@@ -317,11 +319,16 @@ impl GeometryRenderer {
             T::TriangleList,
             Some(&draw_pl),
         );
+        let terrain_pipeline =
+            render_pipeline("vs_terrain", "fs_terrain", T::TriangleList, Some(&draw_pl));
+        let terrain = forest_render::terrain::GpuTerrain::new(device, forest.terrain.as_ref())?;
+        gpu_bytes.set(gpu_bytes.get() + terrain.bytes());
         let environment_buf = init(
             "geometry environment",
             bytemuck::bytes_of(&forest_render::options::environment_uniform(
                 &l,
                 &opts.atmosphere,
+                &terrain.grid,
             )),
             U::UNIFORM,
         );
@@ -339,6 +346,10 @@ impl GeometryRenderer {
             (10, method_buf.as_entire_binding()),
             (11, leaf_centre_buf.as_entire_binding()),
             (12, wgpu::BindingResource::TextureView(&billboard_view)),
+            (
+                forest_render::terrain::HEIGHTS_BINDING,
+                terrain.heights.as_entire_binding(),
+            ),
         ];
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry draw"),
@@ -383,6 +394,8 @@ impl GeometryRenderer {
             draw,
             billboard,
             environment,
+            terrain_pipeline,
+            terrain,
             atmosphere: opts.atmosphere,
             compute_bg,
             draw_bg,
@@ -555,9 +568,11 @@ impl GeometryRenderer {
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
         let ground = ground && self.background == Background::Sky;
         pass.set_bind_group(0, &self.draw_bg, &[]);
+        let mut environment = 0;
         if ground {
             pass.set_pipeline(&self.environment);
             pass.draw(0..3, 0..1);
+            environment = 1 + self.terrain.record(pass, &self.terrain_pipeline);
         }
         // The statistics are the trees' alone (the environment is outside the query).
         if let Some(q) = self.counting() {
@@ -579,7 +594,7 @@ impl GeometryRenderer {
             pass.end_pipeline_statistics_query();
         }
         self.draws.store(
-            BANDS * self.species + u32::from(ground),
+            BANDS * self.species + environment,
             std::sync::atomic::Ordering::Relaxed,
         );
     }

@@ -111,9 +111,9 @@ fn columns() -> Vec<&'static str> {
 pub const WALK_SEED: u64 = 0x3a1f_2c77;
 
 /// `n` seeded random eye-height cameras inside the forest, as a walkthrough meets them: eyes
-/// 1.7 m up anywhere in the inner half of the forest (inside crowns too: none is rejected),
-/// any heading, pitched −10°…+30°.
-pub fn walkthrough(side: f32, viewport: (u32, u32), n: usize) -> Vec<Camera> {
+/// 1.7 m above the forest's ground anywhere in the inner half of the forest (inside crowns
+/// too: none is rejected), any heading, pitched −10°…+30°.
+pub fn walkthrough(forest: &Forest, side: f32, viewport: (u32, u32), n: usize) -> Vec<Camera> {
     let mut rng = SplitMix64(WALK_SEED);
     (0..n)
         .map(|_| {
@@ -121,7 +121,7 @@ pub fn walkthrough(side: f32, viewport: (u32, u32), n: usize) -> Vec<Camera> {
             let z = (rng.next_f32() - 0.5) * side * 0.5;
             let heading = rng.next_f32() * std::f32::consts::TAU;
             let pitch = (-10.0 + 40.0 * rng.next_f32()).to_radians();
-            let eye = Vec3::new(x, 1.7, z);
+            let eye = Vec3::new(x, forest.ground_height(x, z) + 1.7, z);
             let dir = Vec3::new(
                 heading.cos() * pitch.cos(),
                 pitch.sin(),
@@ -247,7 +247,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         .into_iter()
         .map(|(v, c)| (v, vec![c]))
         .collect();
-    groups.push(("walkthrough", walkthrough(side, viewport, walk)));
+    groups.push(("walkthrough", walkthrough(&forest, side, viewport, walk)));
     let chosen = |list: &[String], name: &str| list.is_empty() || list.iter().any(|v| v == name);
     groups.retain(|(view, _)| chosen(&b.views, view));
     let settings: Vec<_> = settings(b.quick)

@@ -13,14 +13,21 @@ use super::chart::{Chart, Series};
 use super::report::Section;
 use super::{Bench, Table, WORK_COLUMNS, ms, work_cells};
 
-/// View `i` of `n` along the walkthrough of a forest of side `side`: eye height 1.7 m, across
-/// the forest on a gentle S-curve, looking ahead and swinging left and right.
-pub fn view(i: u32, n: u32, side: f32, viewport: (u32, u32)) -> Camera {
+/// View `i` of `n` along the walkthrough of a forest of side `side`: eye height 1.7 m above
+/// the ground `ground(x, z)`, across the forest on a gentle S-curve, looking ahead (level)
+/// and swinging left and right.
+pub fn view(
+    i: u32,
+    n: u32,
+    side: f32,
+    viewport: (u32, u32),
+    ground: impl Fn(f32, f32) -> f32,
+) -> Camera {
     let t = i as f32 / (n.max(2) - 1) as f32;
     let x = (t - 0.5) * side * 0.7;
     let z = (t * std::f32::consts::TAU).sin() * side * 0.1;
     let yaw = (t * 3.0 * std::f32::consts::TAU).sin() * 0.6;
-    let eye = Vec3::new(x, 1.7, z);
+    let eye = Vec3::new(x, ground(x, z) + 1.7, z);
     Camera {
         eye,
         target: eye + Vec3::new(yaw.cos(), 0.05, yaw.sin()) * 50.0,
@@ -71,7 +78,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             ..Default::default()
         };
         for i in (0..views).step_by(stride) {
-            let cam = view(i, views, side, viewport);
+            let cam = view(i, views, side, viewport, |x, z| forest.ground_height(x, z));
             // One measured frame per view: the hundred views are the samples.
             let (st, t) = b.measure(&mut r, method, &cam, &target, 1)?;
             let work = b.work(&mut r, method, &cam, &target)?;

@@ -16,13 +16,16 @@ impl Viewer {
         // Slow frames move the walker at most 0.1 s's worth (no leaps after a stall).
         let dt = elapsed.min(0.1);
         self.last = now;
-        self.walker.step(&self.keys, dt);
+        let terrain = self.terrain.as_ref();
+        let ground = |x: f32, z: f32| terrain.map_or(0.0, |t| t.height(x, z));
+        self.walker.step(&self.keys, dt, ground);
         let cam = self.camera();
         if let (Some(p), Some(i)) = (&self.path, self.playing) {
             // One key per frame; at the end, control returns at the last key.
             if i + 1 >= p.keys.len() {
                 self.playing = None;
-                self.walker = Walker::looking_at(cam.eye, cam.target, self.walker.speed);
+                let floor = ground(cam.eye.x, cam.eye.z);
+                self.walker = Walker::looking_at(cam.eye, cam.target, self.walker.speed, floor);
             } else {
                 self.playing = Some(i + 1);
             }

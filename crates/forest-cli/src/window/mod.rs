@@ -84,6 +84,8 @@ pub struct Settings {
     pub epsilon: f32,
     /// The forest's extent (metres from the origin), for the far plane.
     pub extent: f32,
+    /// The forest's terrain, which walking follows (`None`: flat ground at y = 0).
+    pub terrain: Option<forest_format::terrain::Terrain>,
     /// The methods offered (see [`offered`]).
     pub methods: Vec<Method>,
     /// Index of the starting method in `methods`.
@@ -108,6 +110,7 @@ pub struct Viewer {
     grow_failed: Option<((u32, u32), f32)>,
     size: (u32, u32),
     walker: Walker,
+    terrain: Option<forest_format::terrain::Terrain>,
     epsilon: f32,
     extent: f32,
     fov_deg: f32,
@@ -138,14 +141,16 @@ pub struct Viewer {
 impl Viewer {
     /// A viewer with these settings, standing at the origin (or at the path's first key).
     pub fn new(st: Settings) -> Self {
+        let ground = |x: f32, z: f32| st.terrain.as_ref().map_or(0.0, |t| t.height(x, z));
         let walker = match &st.path {
             Some(p) => Walker::looking_at(
                 Vec3::from_array(p.keys[0].eye),
                 Vec3::from_array(p.keys[0].target),
                 5.0,
+                ground(p.keys[0].eye[0], p.keys[0].eye[2]),
             ),
             None => Walker {
-                eye: Vec3::new(0.0, EYE_HEIGHT, 0.0),
+                eye: Vec3::new(0.0, ground(0.0, 0.0) + EYE_HEIGHT, 0.0),
                 yaw: 0.0,
                 pitch: 0.0,
                 speed: 5.0,
@@ -159,6 +164,7 @@ impl Viewer {
             grow_failed: None,
             size: st.size,
             walker,
+            terrain: st.terrain,
             epsilon: st.epsilon,
             extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),

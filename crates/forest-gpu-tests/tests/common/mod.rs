@@ -59,15 +59,37 @@ pub fn species_with(params: &BakeParams) -> Vec<SpeciesData> {
 }
 
 pub fn forest(trees: u32) -> Forest {
+    forest_on(trees, None)
+}
+
+/// [`forest`]'s trees on `terrain` (flat ground without one).
+fn forest_on(trees: u32, terrain: Option<forest_format::terrain::Terrain>) -> Forest {
     generate(&GenerateParams {
         trees,
         species: vec!["bush".into(), "pine".into()],
         area_per_tree: 12.0,
         clump_size: 15.0,
         seed: 5,
+        terrain,
         ..GenerateParams::default()
     })
     .unwrap()
+}
+
+/// [`forest`]'s trees on seeded hills of 25 m relief, the hills reaching past the trees.
+pub fn hilly_forest(trees: u32) -> Forest {
+    let side = (trees as f32 * 12.0).sqrt();
+    let terrain =
+        forest_format::terrain::Terrain::generate(&forest_format::terrain::TerrainParams {
+            half_extent: side * 0.75,
+            spacing: 2.0,
+            relief: 25.0,
+            hill_size: side / 2.0,
+            fade: 0.125,
+            seed: 5,
+        })
+        .unwrap();
+    forest_on(trees, Some(terrain))
 }
 
 /// The bad-size forests every method must render without validation errors: empty and

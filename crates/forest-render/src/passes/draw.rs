@@ -9,7 +9,8 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
-/// environment, layer roots, the frame's state (where the plain quads start).
+/// environment, layer roots, the frame's state (where the plain quads start), and the
+/// terrain's heights at [`crate::terrain::HEIGHTS_BINDING`].
 pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let storage = |binding| wgpu::BindGroupLayoutEntry {
@@ -67,6 +68,7 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         uniform(8),
         storage(9),
         storage(10),
+        crate::terrain::heights_entry(),
     ]
 }
 
@@ -75,6 +77,7 @@ pub struct DrawPass {
     /// Bind-group layout (camera, scene tables, final stream, textures, environment).
     pub bind_layout: wgpu::BindGroupLayout,
     environment: wgpu::RenderPipeline,
+    terrain: wgpu::RenderPipeline,
     /// Far trees' composited quads (drawn first).
     composite: wgpu::RenderPipeline,
     quads: wgpu::RenderPipeline,
@@ -98,7 +101,11 @@ impl DrawPass {
             label: Some("draw"),
             source: wgpu::ShaderSource::Wgsl(draw_source().into()),
         });
-        let pipeline = |vs: &str, fs: &str, blend: Option<wgpu::BlendState>, depth_write: bool| {
+        let pipeline_of = |topology: wgpu::PrimitiveTopology,
+                           vs: &str,
+                           fs: &str,
+                           blend: Option<wgpu::BlendState>,
+                           depth_write: bool| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(vs),
                 layout: Some(&layout),
@@ -109,7 +116,7 @@ impl DrawPass {
                     buffers: &[],
                 },
                 primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleStrip,
+                    topology,
                     cull_mode: None,
                     ..Default::default()
                 },
@@ -129,8 +136,24 @@ impl DrawPass {
                 cache: None,
             })
         };
+        let pipeline = |vs: &str, fs: &str, blend: Option<wgpu::BlendState>, depth_write: bool| {
+            pipeline_of(
+                wgpu::PrimitiveTopology::TriangleStrip,
+                vs,
+                fs,
+                blend,
+                depth_write,
+            )
+        };
         Self {
             environment: pipeline("vs_environment", "fs_environment", None, true),
+            terrain: pipeline_of(
+                wgpu::PrimitiveTopology::TriangleList,
+                "vs_terrain",
+                "fs_terrain",
+                None,
+                true,
+            ),
             composite: pipeline(
                 "vs_composite",
                 "fs_composite",
@@ -147,7 +170,7 @@ impl DrawPass {
         }
     }
 
-    /// Record the environment (sky and ground, when `ground`) and the indirect quad draws, the latter inside the
+    /// Record the environment (sky, ground and the terrain `ground` holds, when given) and the indirect quad draws, the latter inside the
     /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone):
     /// the composited far trees' draw when `composite` (the stream's options can make such
     /// quads), then the others'. Returns the draws recorded.
@@ -156,14 +179,16 @@ impl DrawPass {
         pass: &mut wgpu::RenderPass,
         bind_group: &wgpu::BindGroup,
         args_buf: &wgpu::Buffer,
-        ground: bool,
+        ground: Option<&crate::terrain::GpuTerrain>,
         composite: bool,
         statistics: Option<&wgpu::QuerySet>,
     ) -> u32 {
         pass.set_bind_group(0, bind_group, &[]);
-        if ground {
+        let mut environment = 0;
+        if let Some(terrain) = ground {
             pass.set_pipeline(&self.environment);
             pass.draw(0..3, 0..1);
+            environment = 1 + terrain.record(pass, &self.terrain);
         }
         if let Some(set) = statistics {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
@@ -182,6 +207,6 @@ impl DrawPass {
         if statistics.is_some() {
             pass.end_pipeline_statistics_query();
         }
-        drawn.len() as u32 + u32::from(ground)
+        drawn.len() as u32 + environment
     }
 }

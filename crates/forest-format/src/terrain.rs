@@ -1,0 +1,591 @@
+//! Terrain: a regular height field the trees stand on, drawn by every method.
+//!
+//! Samples lie on a square grid in the x–z plane, `spacing` metres apart, sample `(i, j)` at
+//! `(origin.x + i·spacing, origin.z + j·spacing)`. Each cell is split into two triangles along
+//! its diagonal from `(i, j)` to `(i+1, j+1)`, and the surface is linear on each: this is the
+//! mesh the renderers draw, so [`Terrain::height`] is exactly the surface on screen and a tree
+//! placed at that height stands on it. Outside the grid the ground is flat at y = 0 (the
+//! environment pass's endless plane); the renderers close the gap at the border with vertical
+//! skirts down to y = 0.
+//!
+//! Sources: [`Terrain::generate`] (seeded hills fading into the plain at the border) and
+//! [`Terrain::from_image`] (a 16-bit greyscale PNG, or an OpenEXR file of heights in metres).
+
+use std::path::Path;
+
+use crate::error::FormatError;
+use crate::generate::value_noise;
+
+/// Most samples along either side of a height field (4097 × 4097 heights are 64 MiB).
+pub const MAX_SIDE: u32 = 4097;
+/// Largest height magnitude (metres): higher than any mountain, low enough that every
+/// coordinate stays within [`crate::forest::MAX_COORDINATE`].
+pub const MAX_HEIGHT: f32 = 20_000.0;
+
+/// A height field: see the module documentation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Terrain {
+    /// Samples along x and along z (each 2 to [`MAX_SIDE`]).
+    pub size: [u32; 2],
+    /// World (x, z) of sample (0, 0), metres.
+    pub origin: [f32; 2],
+    /// Metres between neighbouring samples (> 0).
+    pub spacing: f32,
+    /// Heights (metres, finite, |h| ≤ [`MAX_HEIGHT`]), row after row: sample `(i, j)` at
+    /// `heights[j·size[0] + i]`.
+    pub heights: Vec<f32>,
+}
+
+/// Parameters of [`Terrain::generate`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct TerrainParams {
+    /// The field covers `[−half_extent, half_extent]²` (metres, > 0).
+    pub half_extent: f32,
+    /// Metres between samples (> 0).
+    pub spacing: f32,
+    /// Height of the highest possible hilltop above the lowest valley floor, metres (≥ 0).
+    pub relief: f32,
+    /// Size of a hill, metres (> 0): the wavelength of the noise's first octave.
+    pub hill_size: f32,
+    /// Width of the border over which the hills fade to the plain, as a fraction of
+    /// `half_extent` (0 to 1).
+    pub fade: f32,
+    /// Random seed.
+    pub seed: u64,
+}
+
+impl Default for TerrainParams {
+    fn default() -> Self {
+        Self {
+            half_extent: 1000.0,
+            spacing: 8.0,
+            relief: 80.0,
+            hill_size: 900.0,
+            fade: 0.125,
+            seed: 1,
+        }
+    }
+}
+
+impl Terrain {
+    /// Check the grid and every height; the message names the first problem.
+    pub fn check(&self) -> Result<(), String> {
+        let [nx, nz] = self.size;
+        if !(2..=MAX_SIDE).contains(&nx) || !(2..=MAX_SIDE).contains(&nz) {
+            return Err(format!(
+                "a {nx}×{nz} height field: each side must hold 2 to {MAX_SIDE} samples"
+            ));
+        }
+        if self.heights.len() != nx as usize * nz as usize {
+            return Err(format!(
+                "{} heights for a {nx}×{nz} height field",
+                self.heights.len()
+            ));
+        }
+        if !(self.spacing.is_finite() && self.spacing > 0.0) {
+            return Err(format!(
+                "sample spacing {} m must be positive",
+                self.spacing
+            ));
+        }
+        let far = self
+            .origin
+            .iter()
+            .map(|o| o.abs() + self.spacing * (nx.max(nz) - 1) as f32)
+            .fold(0.0, f32::max);
+        if far.is_nan() || far > crate::forest::MAX_COORDINATE {
+            return Err(format!(
+                "the height field reaches {far} m from the origin, farther than {} m",
+                crate::forest::MAX_COORDINATE
+            ));
+        }
+        if let Some(k) = self
+            .heights
+            .iter()
+            .position(|h| !(h.is_finite() && h.abs() <= MAX_HEIGHT))
+        {
+            return Err(format!(
+                "height {} at sample ({}, {}) is not a finite height within ±{MAX_HEIGHT} m",
+                self.heights[k],
+                k % nx as usize,
+                k / nx as usize
+            ));
+        }
+        Ok(())
+    }
+
+    /// World (x, z) extent of the grid: `(min, max)` corners, metres.
+    pub fn bounds(&self) -> ([f32; 2], [f32; 2]) {
+        let [nx, nz] = self.size;
+        let [ox, oz] = self.origin;
+        (
+            [ox, oz],
+            [
+                ox + self.spacing * (nx - 1) as f32,
+                oz + self.spacing * (nz - 1) as f32,
+            ],
+        )
+    }
+
+    /// Whether world (x, z) lies on the grid (borders included).
+    pub fn contains(&self, x: f32, z: f32) -> bool {
+        let (lo, hi) = self.bounds();
+        x >= lo[0] && x <= hi[0] && z >= lo[1] && z <= hi[1]
+    }
+
+    fn sample(&self, i: usize, j: usize) -> f32 {
+        self.heights[j * self.size[0] as usize + i]
+    }
+
+    /// The drawn surface's height at world (x, z), metres: linear on each of a cell's two
+    /// triangles (see the module documentation); 0 outside the grid.
+    pub fn height(&self, x: f32, z: f32) -> f32 {
+        if !self.contains(x, z) {
+            return 0.0;
+        }
+        let [nx, nz] = self.size;
+        let u = (x - self.origin[0]) / self.spacing;
+        let v = (z - self.origin[1]) / self.spacing;
+        // The last row and column belong to the cell before them.
+        let i = (u.floor() as usize).min(nx as usize - 2);
+        let j = (v.floor() as usize).min(nz as usize - 2);
+        let (fx, fz) = (u - i as f32, v - j as f32);
+        let h00 = self.sample(i, j);
+        let h11 = self.sample(i + 1, j + 1);
+        if fx >= fz {
+            let h10 = self.sample(i + 1, j);
+            h00 + fx * (h10 - h00) + fz * (h11 - h10)
+        } else {
+            let h01 = self.sample(i, j + 1);
+            h00 + fz * (h01 - h00) + fx * (h11 - h01)
+        }
+    }
+
+    /// The slope of the drawn surface at world (x, z), as the tangent of its angle to the
+    /// horizontal (rise over run; 0 outside the grid).
+    pub fn slope(&self, x: f32, z: f32) -> f32 {
+        if !self.contains(x, z) {
+            return 0.0;
+        }
+        // Finite differences within the triangle holding (x, z): the surface is linear there.
+        let e = self.spacing * 1e-3;
+        let h = self.height(x, z);
+        let (lo, hi) = self.bounds();
+        let dx = if x + e <= hi[0] {
+            self.height(x + e, z) - h
+        } else {
+            h - self.height((x - e).max(lo[0]), z)
+        };
+        let dz = if z + e <= hi[1] {
+            self.height(x, z + e) - h
+        } else {
+            h - self.height(x, (z - e).max(lo[1]))
+        };
+        (dx * dx + dz * dz).sqrt() / e
+    }
+
+    /// Lowest and highest sample, metres.
+    pub fn height_range(&self) -> (f32, f32) {
+        self.heights
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &h| {
+                (lo.min(h), hi.max(h))
+            })
+    }
+
+    /// Seeded rolling hills: five octaves of value noise, shaped so valleys are broad and
+    /// hilltops rounder, from 0 m to at most `relief`, fading to 0 m over the outer `fade` of
+    /// the field so that it meets the flat ground around it without a step.
+    pub fn generate(p: &TerrainParams) -> Result<Self, String> {
+        if !(p.half_extent.is_finite() && p.half_extent > 0.0) {
+            return Err(format!(
+                "terrain half extent {} m must be positive",
+                p.half_extent
+            ));
+        }
+        if !(p.spacing.is_finite() && p.spacing > 0.0) {
+            return Err(format!("terrain spacing {} m must be positive", p.spacing));
+        }
+        if !(p.relief.is_finite() && (0.0..=MAX_HEIGHT).contains(&p.relief)) {
+            return Err(format!("relief {} m must be 0 to {MAX_HEIGHT} m", p.relief));
+        }
+        if !(p.fade > 0.0 && p.fade <= 1.0) {
+            return Err(format!(
+                "fade {}: must be above 0 and at most 1 (of the half extent)",
+                p.fade
+            ));
+        }
+        if !(p.hill_size.is_finite() && p.hill_size > 0.0) {
+            return Err(format!("hill size {} m must be positive", p.hill_size));
+        }
+        let cells = (2.0 * f64::from(p.half_extent) / f64::from(p.spacing)).ceil();
+        if cells + 1.0 > f64::from(MAX_SIDE) {
+            return Err(format!(
+                "a terrain {:.0} m across at {} m spacing needs {} samples a side, more than \
+                 {MAX_SIDE}: raise the spacing to at least {:.1} m",
+                2.0 * p.half_extent,
+                p.spacing,
+                cells + 1.0,
+                2.0 * p.half_extent / (MAX_SIDE - 1) as f32
+            ));
+        }
+        let n = cells as u32 + 1;
+        let spacing = 2.0 * p.half_extent / (n - 1) as f32;
+        let origin = [-p.half_extent, -p.half_extent];
+        let border = p.half_extent * p.fade;
+        let mut heights = Vec::with_capacity(n as usize * n as usize);
+        for j in 0..n {
+            for i in 0..n {
+                let x = origin[0] + i as f32 * spacing;
+                let z = origin[1] + j as f32 * spacing;
+                let mut sum = 0.0;
+                let mut norm = 0.0;
+                for o in 0..5 {
+                    let f = (1 << o) as f32;
+                    let a = 0.5f32.powi(o);
+                    sum += a * value_noise(
+                        x * f / p.hill_size,
+                        z * f / p.hill_size,
+                        p.seed.wrapping_add(0x7e44 + o as u64),
+                    );
+                    norm += a;
+                }
+                // Noise sums cluster near 0: stretch to [0, 1], then flatten the valleys.
+                let u = (0.5 + 0.9 * sum / norm).clamp(0.0, 1.0);
+                let shaped = u * u * (3.0 - 2.0 * u);
+                let edge = (p.half_extent - x.abs()).min(p.half_extent - z.abs());
+                let t = (edge / border).clamp(0.0, 1.0);
+                let fade = t * t * (3.0 - 2.0 * t);
+                heights.push(p.relief * shaped * fade);
+            }
+        }
+        let t = Terrain {
+            size: [n, n],
+            origin,
+            spacing,
+            heights,
+        };
+        t.check()?;
+        Ok(t)
+    }
+
+    /// Load a height field from an image, centred on the origin, `spacing` metres between
+    /// pixels, row 0 at the smallest z:
+    /// - a 16-bit greyscale PNG: 0 to 65535 map to 0 to `png_relief` metres;
+    /// - an OpenEXR file (`.exr`): its first channel holds heights in metres.
+    ///
+    /// 8-bit or colour PNGs are refused (256 levels would terrace every slope; a colour image
+    /// is rarely a height field), and so are images smaller than 2×2 or larger than
+    /// [`MAX_SIDE`], and non-finite heights. Errors name the file and the cause.
+    pub fn from_image(path: &Path, spacing: f32, png_relief: f32) -> Result<Self, FormatError> {
+        let bad = |what: String| FormatError::invalid(path, what);
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return Err(bad(format!("sample spacing {spacing} m must be positive")));
+        }
+        let exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !exr && !png {
+            return Err(bad(
+                "a height field must be a 16-bit greyscale .png or an .exr".into(),
+            ));
+        }
+        if png && !(png_relief.is_finite() && (0.0..=MAX_HEIGHT).contains(&png_relief)) {
+            return Err(bad(format!(
+                "relief {png_relief} m must be 0 to {MAX_HEIGHT} m"
+            )));
+        }
+        let bytes = crate::bounded::read(path, crate::bounded::limit::DATA)?;
+        let format = if exr {
+            image::ImageFormat::OpenExr
+        } else {
+            image::ImageFormat::Png
+        };
+        let (w, h) = crate::bounded::image_dimensions(&bytes, Some(format), path)?;
+        if !(2..=MAX_SIDE).contains(&w) || !(2..=MAX_SIDE).contains(&h) {
+            return Err(bad(format!(
+                "a {w}×{h} image: a height field needs 2 to {MAX_SIDE} pixels a side"
+            )));
+        }
+        let img = crate::bounded::decode_image(&bytes, Some(format), path)?;
+        let heights: Vec<f32> = if exr {
+            let first = img.to_rgba32f();
+            first.pixels().map(|p| p.0[0]).collect()
+        } else {
+            match img {
+                image::DynamicImage::ImageLuma16(g) => g
+                    .pixels()
+                    .map(|p| f32::from(p.0[0]) / 65535.0 * png_relief)
+                    .collect(),
+                image::DynamicImage::ImageLumaA16(g) => g
+                    .pixels()
+                    .map(|p| f32::from(p.0[0]) / 65535.0 * png_relief)
+                    .collect(),
+                other => {
+                    let c = other.color();
+                    return Err(bad(format!(
+                        "a PNG of {} bits per sample with {} channel(s): a height field must \
+                         be a 16-bit greyscale PNG (or an EXR of heights in metres)",
+                        c.bits_per_pixel() / u16::from(c.channel_count()),
+                        c.channel_count()
+                    )));
+                }
+            }
+        };
+        let t = Terrain {
+            size: [w, h],
+            origin: [
+                -spacing * (w - 1) as f32 / 2.0,
+                -spacing * (h - 1) as f32 / 2.0,
+            ],
+            spacing,
+            heights,
+        };
+        t.check().map_err(bad)?;
+        Ok(t)
+    }
+
+    /// Append the binary form (sizes, origin, spacing, heights; little-endian).
+    pub fn write_to(&self, out: &mut Vec<u8>) {
+        for v in self.size {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        for v in [self.origin[0], self.origin[1], self.spacing] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out.extend_from_slice(bytemuck::cast_slice(&self.heights));
+    }
+
+    /// Read the binary form from `take` (a reader of the next `n` bytes), checking the sizes
+    /// before allocating.
+    pub fn read_from(
+        mut take: impl FnMut(usize) -> Result<Vec<u8>, String>,
+    ) -> Result<Self, String> {
+        let mut u32s = |n: usize| -> Result<Vec<u32>, String> {
+            Ok(bytemuck::pod_collect_to_vec(&take(4 * n)?))
+        };
+        let head = u32s(5)?;
+        let size = [head[0], head[1]];
+        if !(2..=MAX_SIDE).contains(&size[0]) || !(2..=MAX_SIDE).contains(&size[1]) {
+            return Err(format!(
+                "a {}×{} height field: each side must hold 2 to {MAX_SIDE} samples",
+                size[0], size[1]
+            ));
+        }
+        let f = |k: usize| f32::from_bits(head[k]);
+        let n = size[0] as usize * size[1] as usize;
+        let heights = bytemuck::pod_collect_to_vec(&take(4 * n)?);
+        let t = Terrain {
+            size,
+            origin: [f(2), f(3)],
+            spacing: f(4),
+            heights,
+        };
+        t.check()?;
+        Ok(t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane(a: f32, b: f32, c: f32) -> Terrain {
+        let (nx, nz) = (5u32, 4u32);
+        let origin = [-10.0, 3.0];
+        let spacing = 2.5;
+        let heights = (0..nz)
+            .flat_map(|j| {
+                (0..nx).map(move |i| {
+                    a * (origin[0] + i as f32 * spacing) + b * (origin[1] + j as f32 * spacing) + c
+                })
+            })
+            .collect();
+        Terrain {
+            size: [nx, nz],
+            origin,
+            spacing,
+            heights,
+        }
+    }
+
+    #[test]
+    fn a_planar_field_is_that_plane_everywhere_on_it() {
+        let t = plane(0.3, -0.2, 4.0);
+        t.check().unwrap();
+        let ([x0, z0], [x1, z1]) = t.bounds();
+        assert_eq!((x0, z0, x1, z1), (-10.0, 3.0, 0.0, 10.5));
+        for k in 0..200 {
+            let x = x0 + (x1 - x0) * ((k * 37) % 101) as f32 / 100.0;
+            let z = z0 + (z1 - z0) * ((k * 61) % 103) as f32 / 102.0;
+            let want = 0.3 * x - 0.2 * z + 4.0;
+            assert!((t.height(x, z) - want).abs() < 1e-4, "({x}, {z})");
+            let s = t.slope(x, z);
+            assert!((s - (0.09f32 + 0.04).sqrt()).abs() < 2e-3, "slope {s}");
+        }
+        // Outside: the flat ground.
+        assert_eq!(t.height(-10.5, 5.0), 0.0);
+        assert_eq!(t.height(-5.0, 11.0), 0.0);
+        assert_eq!(t.slope(20.0, 5.0), 0.0);
+    }
+
+    #[test]
+    fn cells_split_along_the_diagonal_from_their_first_corner() {
+        // One cell, corner (1, 0) raised: the triangle (00, 10, 11) carries it, the other
+        // triangle (00, 11, 01) stays flat.
+        let t = Terrain {
+            size: [2, 2],
+            origin: [0.0, 0.0],
+            spacing: 1.0,
+            heights: vec![0.0, 4.0, 0.0, 0.0],
+        };
+        assert_eq!(t.height(1.0, 0.0), 4.0);
+        assert!((t.height(0.75, 0.25) - 2.0).abs() < 1e-6);
+        assert!((t.height(0.5, 0.5)).abs() < 1e-6);
+        assert_eq!(t.height(0.25, 0.75), 0.0);
+        // Samples are interpolated exactly at the grid's points.
+        let p = plane(1.0, 2.0, 0.0);
+        for j in 0..4 {
+            for i in 0..5 {
+                let (x, z) = (-10.0 + i as f32 * 2.5, 3.0 + j as f32 * 2.5);
+                assert_eq!(p.height(x, z), p.heights[j * 5 + i]);
+            }
+        }
+    }
+
+    #[test]
+    fn generated_hills_are_seeded_bounded_and_meet_the_plain() {
+        let p = TerrainParams {
+            half_extent: 400.0,
+            spacing: 10.0,
+            relief: 60.0,
+            hill_size: 300.0,
+            fade: 0.125,
+            seed: 3,
+        };
+        let a = Terrain::generate(&p).unwrap();
+        assert_eq!(a, Terrain::generate(&p).unwrap());
+        assert_ne!(
+            a,
+            Terrain::generate(&TerrainParams {
+                seed: 4,
+                ..p.clone()
+            })
+            .unwrap()
+        );
+        assert_eq!(a.size, [81, 81]);
+        let (lo, hi) = a.height_range();
+        assert!(lo >= 0.0 && hi <= 60.0, "{lo} {hi}");
+        assert!(hi - lo > 15.0, "hills, not a plain: {lo}..{hi}");
+        // The border is at the plain's height.
+        for k in 0..81 {
+            assert_eq!(a.heights[k], 0.0);
+            assert_eq!(a.heights[80 * 81 + k], 0.0);
+            assert_eq!(a.heights[k * 81], 0.0);
+        }
+        let err = Terrain::generate(&TerrainParams {
+            spacing: 0.1,
+            ..p.clone()
+        })
+        .unwrap_err();
+        assert!(err.contains("raise the spacing"), "{err}");
+        assert!(
+            Terrain::generate(&TerrainParams { relief: -1.0, ..p })
+                .unwrap_err()
+                .contains("relief")
+        );
+    }
+
+    #[test]
+    fn the_binary_form_round_trips_and_bad_grids_are_named() {
+        let t = plane(0.1, 0.2, 1.0);
+        let mut bytes = Vec::new();
+        t.write_to(&mut bytes);
+        let mut at = 0;
+        let back = Terrain::read_from(|n| {
+            let s = bytes.get(at..at + n).ok_or("truncated")?.to_vec();
+            at += n;
+            Ok(s)
+        })
+        .unwrap();
+        assert_eq!(back, t);
+        let mut bad = t.clone();
+        bad.heights[7] = f32::NAN;
+        assert!(bad.check().unwrap_err().contains("sample (2, 1)"));
+        let mut bad = t.clone();
+        bad.heights.pop();
+        assert!(bad.check().unwrap_err().contains("19 heights"));
+        let mut bad = t;
+        bad.size = [1, 20];
+        assert!(bad.check().unwrap_err().contains("1×20"));
+    }
+
+    fn write_png16(path: &Path, w: u32, h: u32, f: impl Fn(u32, u32) -> u16) {
+        let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(w, h, |x, y| {
+            image::Luma([f(x, y)])
+        });
+        img.save(path).unwrap();
+    }
+
+    #[test]
+    fn height_images_load_and_malformed_ones_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("h.png");
+        write_png16(&png, 3, 2, |x, y| (x * 1000 + y * 30000) as u16);
+        let t = Terrain::from_image(&png, 4.0, 65.535).unwrap();
+        assert_eq!(t.size, [3, 2]);
+        assert_eq!(t.origin, [-4.0, -2.0]);
+        assert!((t.heights[1] - 1.0).abs() < 1e-5);
+        assert!((t.heights[3] - 30.0).abs() < 1e-4);
+        assert!((t.height(0.0, 2.0) - 31.0).abs() < 1e-4);
+
+        let exr = dir.path().join("h.exr");
+        let img = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_fn(4, 3, |x, y| {
+            image::Rgb([x as f32 - 0.5 * y as f32, 0.0, 0.0])
+        });
+        image::DynamicImage::ImageRgb32F(img).save(&exr).unwrap();
+        let t = Terrain::from_image(&exr, 1.0, 0.0).unwrap();
+        assert_eq!(t.size, [4, 3]);
+        assert_eq!(t.heights[4 * 2 + 3], 2.0);
+
+        let err = |p: &Path| Terrain::from_image(p, 1.0, 10.0).unwrap_err().to_string();
+        let eight = dir.path().join("8bit.png");
+        image::GrayImage::from_pixel(4, 4, image::Luma([9]))
+            .save(&eight)
+            .unwrap();
+        assert!(err(&eight).contains("16-bit greyscale"), "{}", err(&eight));
+        let rgb = dir.path().join("rgb.png");
+        image::RgbImage::from_pixel(4, 4, image::Rgb([9, 9, 9]))
+            .save(&rgb)
+            .unwrap();
+        assert!(err(&rgb).contains("3 channel"), "{}", err(&rgb));
+        let tiny = dir.path().join("tiny.png");
+        write_png16(&tiny, 1, 5, |_, _| 0);
+        assert!(err(&tiny).contains("1×5"), "{}", err(&tiny));
+        let junk = dir.path().join("junk.png");
+        std::fs::write(&junk, b"not a png at all").unwrap();
+        assert!(err(&junk).contains("junk.png"), "{}", err(&junk));
+        let cut = dir.path().join("cut.png");
+        let full = std::fs::read(&png).unwrap();
+        std::fs::write(&cut, &full[..full.len() / 2]).unwrap();
+        assert!(err(&cut).contains("cut.png"), "{}", err(&cut));
+        let nan = dir.path().join("nan.exr");
+        let img = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_fn(2, 2, |x, _| {
+            image::Rgb([if x == 1 { f32::NAN } else { 0.0 }, 0.0, 0.0])
+        });
+        image::DynamicImage::ImageRgb32F(img).save(&nan).unwrap();
+        assert!(err(&nan).contains("sample (1, 0)"), "{}", err(&nan));
+        let tif = dir.path().join("h.tif");
+        std::fs::write(&tif, b"x").unwrap();
+        assert!(err(&tif).contains(".exr"), "{}", err(&tif));
+        assert!(
+            Terrain::from_image(&png, 0.0, 1.0)
+                .unwrap_err()
+                .to_string()
+                .contains("spacing")
+        );
+    }
+}
