@@ -11,6 +11,7 @@ cargo build --release --locked -p forest-cli
 forest=./target/release/forest
 mkdir -p out/atlases out/contact out/render
 species=()
+models=()
 for s in oak ash aspen pine bush; do
   atlas="out/atlases/$s.atlas"
   # Cached: re-bake only when the model, its materials or textures are newer than the atlas.
@@ -21,11 +22,13 @@ for s in oak ash aspen pine bush; do
     $forest bake "assets/trees/$s/$s.obj" -o "$atlas" --contact-sheet "out/contact/$s.png"
   fi
   species+=("$atlas")
+  models+=("assets/trees/$s/$s.obj")
 done
 $forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${species[*]}")" --seed 1 \
   --terrain hills -o out/forest-100k.forest
+# The hybrid: the trees within a few crown radii as full geometry, the rest as the quad stream.
 $forest render out/forest-100k.forest -o out/render/forest.png --view inside --view hill --view birds-eye \
-  --size 800x600
+  --size 800x600 --method hybrid --models "$(IFS=,; echo "${models[*]}")"
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png"
 echo "Atlases: out/atlases/, contact sheets: out/contact/"

@@ -1,16 +1,17 @@
 //! The geometry renderer's WGSL modules: the runtime's common module (camera, helpers) first,
 //! then this crate's types and stages.
 
-use forest_render::passes::{COMMON_WGSL, ENVIRONMENT_WGSL};
+use forest_render::passes::{COMMON_WGSL, ENVIRONMENT_WGSL, GROUND_WGSL};
 
 /// Structs shared by the geometry renderer's modules.
 pub const GEOMETRY_TYPES_WGSL: &str = include_str!("../shaders/geometry_types.wgsl");
 
 /// WGSL of the full-geometry draw.
-pub const GEOMETRY_DRAW_WGSL: [&str; 4] = [
+pub const GEOMETRY_DRAW_WGSL: [&str; 5] = [
     COMMON_WGSL,
     GEOMETRY_TYPES_WGSL,
     include_str!("../shaders/geometry_draw.wgsl"),
+    GROUND_WGSL,
     ENVIRONMENT_WGSL,
 ];
 

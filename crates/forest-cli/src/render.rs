@@ -14,7 +14,7 @@ use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOpt
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 /// Arguments of `forest render`.
 #[derive(Args, Debug)]
@@ -318,10 +318,11 @@ pub fn named_view(name: &str, forest: &Forest) -> (Vec3, Vec3) {
     }
 }
 
-/// Inside the forest: 6 m south of the tree with the most neighbours within 15 m among the
-/// 500 nearest the centre (a clump, not a clearing's edge), 1.7 m above the ground, looking
-/// along the heading (of eight) that sees the most trees within 80 m, at a point 3 m above
-/// the ground 60 m away.
+/// Inside the forest: near the tree with the most neighbours within 15 m among the 500
+/// nearest the centre (a clump, not a clearing's edge), at the first spot 6.7, 10, 14 or 20 m from
+/// it (south-south-east first, then round) with no tree's base within 6 m, 1.7 m above the
+/// ground, looking along the heading (of eight) that sees the most trees within 80 m, at a
+/// point 3 m above the ground 60 m away.
 fn inside_view(forest: &Forest) -> (Vec3, Vec3) {
     let ground = |x: f32, z: f32, up: f32| Vec3::new(x, forest.ground_height(x, z) + up, z);
     let mut near: Vec<Vec3> = forest
@@ -344,7 +345,23 @@ fn inside_view(forest: &Forest) -> (Vec3, Vec3) {
     else {
         return (Vec3::new(3.0, 1.7, 6.0), Vec3::new(-40.0, 3.0, -60.0));
     };
-    let eye = ground(c.x + 3.0, c.z + 6.0, 1.7);
+    let clear = |x: f32, z: f32| {
+        forest
+            .instances
+            .iter()
+            .all(|i| Vec3::new(i.position[0] - x, 0.0, i.position[2] - z).length() >= 6.0)
+    };
+    let first = Vec3::new(3.0, 0.0, 6.0);
+    let spot = [1.0f32, 1.5, 2.1, 3.0]
+        .iter()
+        .flat_map(|&r| {
+            (0..8).map(move |k| {
+                Quat::from_rotation_y(k as f32 * std::f32::consts::FRAC_PI_4) * first * r
+            })
+        })
+        .find(|o| clear(c.x + o.x, c.z + o.z))
+        .unwrap_or(first);
+    let eye = ground(c.x + spot.x, c.z + spot.z, 1.7);
     let seen = |h: f32| {
         let d = Vec3::new(h.sin(), 0.0, -h.cos());
         near.iter()
@@ -479,6 +496,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 "{}",
                 serde_json::json!({
                     "view": name, "output": out.display().to_string(),
+                    "eye": cam.eye.to_array(), "target": cam.target.to_array(),
                     "adapter": ctx.adapter_info.name,
                     "visible_trees": stats.visible_trees, "quads": stats.quads,
                     "composited_quads": stats.composites,
@@ -578,6 +596,7 @@ fn render_hybrid(
                 "{}",
                 serde_json::json!({
                     "view": name, "output": out.display().to_string(),
+                    "eye": cam.eye.to_array(), "target": cam.target.to_array(),
                     "adapter": ctx.adapter_info.name, "method": "hybrid",
                     "visible_trees": stats.visible_trees,
                     "geometry_trees": stats.geometry_trees, "quads": quads,
@@ -715,6 +734,7 @@ fn render_geometry(
                 "{}",
                 serde_json::json!({
                     "view": name, "output": out.display().to_string(),
+                    "eye": cam.eye.to_array(), "target": cam.target.to_array(),
                     "adapter": ctx.adapter_info.name, "method": args.m.method,
                     "visible_trees": stats.visible_trees, "triangles": stats.triangles,
                     "billboards": stats.billboards, "per_band": stats.per_band,

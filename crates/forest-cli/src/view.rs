@@ -242,6 +242,8 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
     // Both builders hold the forest (the window calls them once, when it has a device).
     let extent = forest.extent();
     let terrain = forest.terrain.clone();
+    // Start inside the forest, standing on its ground.
+    let start_view = Some(crate::render::named_view("inside", &forest));
     let forest = Rc::new(forest);
     let f = forest.clone();
     let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
@@ -260,6 +262,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
         epsilon,
         extent,
         terrain,
+        start: start_view,
         methods,
         method: start,
         debug_view: args.debug_view,

@@ -278,6 +278,18 @@ impl Terrain {
     /// is rarely a height field), and so are images smaller than 2×2 or larger than
     /// [`MAX_SIDE`], and non-finite heights. Errors name the file and the cause.
     pub fn from_image(path: &Path, spacing: f32, png_relief: f32) -> Result<Self, FormatError> {
+        let bytes = crate::bounded::read(path, crate::bounded::limit::DATA)?;
+        Self::parse_image(path, &bytes, spacing, png_relief)
+    }
+
+    /// [`Terrain::from_image`] of the file's bytes (`path` names the file and, by its
+    /// extension, the format).
+    pub fn parse_image(
+        path: &Path,
+        bytes: &[u8],
+        spacing: f32,
+        png_relief: f32,
+    ) -> Result<Self, FormatError> {
         let bad = |what: String| FormatError::invalid(path, what);
         if !(spacing.is_finite() && spacing > 0.0) {
             return Err(bad(format!("sample spacing {spacing} m must be positive")));
@@ -298,19 +310,18 @@ impl Terrain {
                 "relief {png_relief} m must be 0 to {MAX_HEIGHT} m"
             )));
         }
-        let bytes = crate::bounded::read(path, crate::bounded::limit::DATA)?;
         let format = if exr {
             image::ImageFormat::OpenExr
         } else {
             image::ImageFormat::Png
         };
-        let (w, h) = crate::bounded::image_dimensions(&bytes, Some(format), path)?;
+        let (w, h) = crate::bounded::image_dimensions(bytes, Some(format), path)?;
         if !(2..=MAX_SIDE).contains(&w) || !(2..=MAX_SIDE).contains(&h) {
             return Err(bad(format!(
                 "a {w}×{h} image: a height field needs 2 to {MAX_SIDE} pixels a side"
             )));
         }
-        let img = crate::bounded::decode_image(&bytes, Some(format), path)?;
+        let img = crate::bounded::decode_image(bytes, Some(format), path)?;
         let heights: Vec<f32> = if exr {
             let first = img.to_rgba32f();
             first.pixels().map(|p| p.0[0]).collect()

@@ -77,6 +77,12 @@ pub const TARGETS: &[Target] = &[
         covers: "glTF 2.0 (`.gltf` with its buffer and image files, or one `.glb`) through the bake's loader (`Mesh::load`, `source_files`)",
     },
     Target {
+        name: "terrain",
+        run: terrain,
+        bound: IMAGE_BOUND,
+        covers: "height field for `scene --terrain` (first byte: 0 a 16-bit PNG, else an EXR; then the file)",
+    },
+    Target {
         name: "image",
         run: image,
         bound: IMAGE_BOUND,
@@ -160,6 +166,16 @@ fn gltf(data: &[u8]) -> bool {
         let _ = forest_bake::mesh::source_files(&path);
         forest_bake::Mesh::load(&path).is_ok()
     })
+}
+
+/// A height field as `forest scene --terrain FILE` reads it: a PNG when the first byte is 0,
+/// else an EXR.
+fn terrain(data: &[u8]) -> bool {
+    let Some((&kind, file)) = data.split_first() else {
+        return false;
+    };
+    let name = if kind == 0 { "fuzz.png" } else { "fuzz.exr" };
+    forest_format::terrain::Terrain::parse_image(Path::new(name), file, 2.0, 50.0).is_ok()
 }
 
 /// An image as `compare` reads it, then compared with itself when small (the metrics check

@@ -120,3 +120,8 @@ fn image() {
 fn gltf() {
     smoke("gltf", 8);
 }
+
+#[test]
+fn terrain() {
+    smoke("terrain", 9);
+}

@@ -1,11 +1,12 @@
 // The environment: an endless ground plane at y = 0 and the sky behind it, drawn first as one
 // full-screen triangle; the terrain's height field, drawn as a triangle mesh over the plane; and
 // the distance haze every method's fragments go through (`hazed`). Appended to draw.wgsl and
-// geometry_draw.wgsl, which declare `camera` at binding 0. Mirrors options::Atmosphere,
+// geometry_draw.wgsl, which declare `camera` at binding 0, after ground.wgsl. Mirrors
+// options::Atmosphere,
 // gpu_types::GpuEnvironment and forest_format::terrain::Terrain.
 
 struct Environment {
-    // xyz: lit ground colour (linear); w unused.
+    // xyz: the ground's second albedo, moss (linear); w unused.
     ground: vec4<f32>,
     // xyz: sky colour at the horizon, also the haze's colour; w: haze extinction per metre at
     // y = 0.
@@ -16,7 +17,7 @@ struct Environment {
     sun: vec4<f32>,
     // xyz: the sun's colour; w unused.
     sun_colour: vec4<f32>,
-    // xyz: the ground's albedo; w unused.
+    // xyz: the ground's first albedo, soil; w unused.
     albedo: vec4<f32>,
     // xyz: sky irradiance on a surface facing up; w unused.
     sky_light: vec4<f32>,
@@ -103,7 +104,7 @@ fn fs_environment(@builtin(position) frag: vec4<f32>) -> EnvironmentOut {
     if (d.y != 0.0 && t > 0.0 && !under_terrain(eye + d * t)) {
         let p = eye + d * t;
         let clip = camera.view_proj * vec4<f32>(p, 1.0);
-        out.colour = hazed(vec4<f32>(env.ground.rgb, 1.0), p);
+        out.colour = hazed(vec4<f32>(ground_shade(p, vec3<f32>(0.0, 1.0, 0.0)), 1.0), p);
         out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
     } else {
         let clip = camera.view_proj * vec4<f32>(d, 0.0);
@@ -189,14 +190,22 @@ fn vs_terrain(@builtin(vertex_index) vi: u32) -> TerrainOut {
     return out;
 }
 
-// The ground's albedo under the shared shading model (forest_format::shading, in sun, no
-// translucency) at the interpolated normal, then hazed: on level ground the plane's colour.
-@fragment
-fn fs_terrain(in: TerrainOut) -> @location(0) vec4<f32> {
-    let n = normalize(in.normal);
+// Soil with patches of moss at world (x, z) (mirrors options::ground_albedo).
+fn ground_albedo(xz: vec2<f32>) -> vec3<f32> {
+    return mix(env.albedo.rgb, env.ground.rgb, ground_moss(xz));
+}
+
+// The ground at `world` with unit normal `n` under the shared shading model
+// (forest_format::shading: in sun, no translucency).
+fn ground_shade(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let ndl = dot(n, env.sun.xyz);
     let hemi = 0.5 + 0.5 * n.y;
     let ambient = env.sky_light.rgb * hemi + env.ground_light.rgb * (1.0 - hemi);
-    let c = env.albedo.rgb * (ambient + env.sun_colour.rgb * max(ndl, 0.0));
-    return hazed(vec4<f32>(c, 1.0), in.world);
+    return ground_albedo(world.xz) * (ambient + env.sun_colour.rgb * max(ndl, 0.0));
+}
+
+// The terrain, shaded as the plane is at its interpolated normal, then hazed.
+@fragment
+fn fs_terrain(in: TerrainOut) -> @location(0) vec4<f32> {
+    return hazed(vec4<f32>(ground_shade(in.world, normalize(in.normal)), 1.0), in.world);
 }

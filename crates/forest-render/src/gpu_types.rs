@@ -221,7 +221,7 @@ pub struct SceneConsts {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuEnvironment {
-    /// Lit ground colour (linear RGB); `w` unused.
+    /// The ground's second albedo, moss (linear RGB); `w` unused.
     pub ground: [f32; 4],
     /// Sky colour at the horizon and haze colour (linear RGB); `w`: haze extinction per metre
     /// (0: no haze).
@@ -234,7 +234,7 @@ pub struct GpuEnvironment {
     pub sun: [f32; 4],
     /// The sun's colour (linear RGB); `w` unused.
     pub sun_colour: [f32; 4],
-    /// The ground's albedo (linear RGB), which the terrain shades by its normal; `w` unused.
+    /// The ground's first albedo, soil (linear RGB); `w` unused.
     pub albedo: [f32; 4],
     /// Sky irradiance on a surface facing up (linear RGB); `w` unused.
     pub sky_light: [f32; 4],

@@ -402,12 +402,54 @@ fn optical_depth(sigma: f32, k: f32, eye: glam::Vec3, point: glam::Vec3) -> f32 
 /// it shows at a few hundred pixels across).
 pub const SUN_DISC_DEGREES: f32 = 0.6;
 
-/// The ground's albedo (linear RGB): dry soil and leaf litter.
+/// The ground's first albedo (linear RGB): dry soil and leaf litter.
 pub const GROUND_ALBEDO: glam::Vec3 = glam::Vec3::new(0.16, 0.14, 0.09);
 
-/// The ground's albedo lit by the shared shading model (facing up, in sun), linear RGB.
+/// The ground's second albedo (linear RGB): moss and grass, in patches among the soil.
+pub const GROUND_MOSS: glam::Vec3 = glam::Vec3::new(0.075, 0.105, 0.04);
+
+/// Soil ([`GROUND_ALBEDO`]) lit by the shared shading model (facing up, in sun), linear RGB:
+/// the ground's colour where no moss grows, for hosts that draw their own ground.
 pub fn ground_colour(lighting: &Lighting) -> glam::Vec3 {
     lighting.shade(GROUND_ALBEDO, glam::Vec3::Y, 1.0, 0.0)
+}
+
+/// One of 2²⁴ values in [0, 1) per integer lattice point: a 32-bit integer hash (after
+/// Chris Wellons' "lowbias32"). Mirrors `ground_hash` in `shaders/ground.wgsl`.
+fn ground_hash(ix: i32, iz: i32) -> f32 {
+    let mut h = (ix as u32).wrapping_mul(0x8da6_b343) ^ (iz as u32).wrapping_mul(0xd816_3841);
+    h = (h ^ (h >> 16)).wrapping_mul(0x7feb_352d);
+    h = (h ^ (h >> 15)).wrapping_mul(0x846c_a68b);
+    h ^= h >> 16;
+    (h >> 8) as f32 / 16_777_216.0
+}
+
+/// Smooth value noise in [0, 1) with unit lattice spacing (mirrors `ground_noise`).
+fn ground_noise(x: f32, z: f32) -> f32 {
+    let (fx, fz) = (x.floor(), z.floor());
+    let (ix, iz) = (fx as i32, fz as i32);
+    let s = |t: f32| t * t * (3.0 - 2.0 * t);
+    let (tx, tz) = (s(x - fx), s(z - fz));
+    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let (jx, jz) = (ix.wrapping_add(1), iz.wrapping_add(1));
+    let a = lerp(ground_hash(ix, iz), ground_hash(jx, iz), tx);
+    let b = lerp(ground_hash(ix, jz), ground_hash(jx, jz), tx);
+    lerp(a, b, tz)
+}
+
+/// How much moss covers the ground at world (x, z), in [0, 1]: two octaves of value noise
+/// (23 m and 6.1 m) through a smooth step, the same on the plane and on the terrain. Mirrors
+/// `ground_moss` in `shaders/ground.wgsl` ([`crate::passes::GROUND_WGSL`]).
+pub fn ground_moss(x: f32, z: f32) -> f32 {
+    let m = 0.65 * ground_noise(x / 23.0, z / 23.0) + 0.35 * ground_noise(x / 6.1, z / 6.1);
+    let t = ((m - 0.3) / 0.4).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// The ground's albedo at world (x, z): [`GROUND_ALBEDO`] (soil) towards [`GROUND_MOSS`] by
+/// [`ground_moss`].
+pub fn ground_albedo(x: f32, z: f32) -> glam::Vec3 {
+    GROUND_ALBEDO.lerp(GROUND_MOSS, ground_moss(x, z))
 }
 
 /// The environment uniform: ground colour, sky, sun disc, haze and the terrain's grid (see
@@ -417,7 +459,7 @@ pub fn environment_uniform(
     atmosphere: &Atmosphere,
     terrain: &crate::terrain::TerrainGrid,
 ) -> GpuEnvironment {
-    let g = ground_colour(lighting);
+    let g = GROUND_MOSS;
     let [hr, hg, hb] = atmosphere.horizon;
     let [zr, zg, zb] = atmosphere.zenith;
     let s = lighting.sun_dir.normalize_or_zero();
@@ -479,5 +521,34 @@ impl RendererOptions {
             count: self.sample_count,
             ..Default::default()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ground_mixes_soil_and_moss_in_patches() {
+        let (mut soil, mut moss) = (0, 0);
+        for k in 0..4000 {
+            let (x, z) = ((k % 63) as f32 * 3.7 - 100.0, (k / 63) as f32 * 4.1 - 120.0);
+            let a = ground_albedo(x, z);
+            // On the segment from soil to moss.
+            let t = (a - GROUND_ALBEDO).length() / (GROUND_MOSS - GROUND_ALBEDO).length();
+            let back = GROUND_ALBEDO.lerp(GROUND_MOSS, t);
+            assert!(
+                (a - back).length() < 1e-5 && (0.0..=1.0).contains(&t),
+                "{a}"
+            );
+            soil += usize::from(t < 0.1);
+            moss += usize::from(t > 0.9);
+            // Continuous: a centimetre away, nearly the same.
+            assert!((ground_albedo(x + 0.01, z) - a).length() < 2e-3);
+        }
+        assert!(soil > 400 && moss > 400, "{soil} soil, {moss} moss of 4000");
+        // Far from the origin the lattice still works (no overflow, values in range).
+        let far = ground_albedo(9.9e6, -9.9e6);
+        assert!(far.is_finite() && far.min_element() >= 0.0);
     }
 }

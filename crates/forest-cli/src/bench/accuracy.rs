@@ -81,7 +81,9 @@ pub fn views(
         ),
         ("mid-range", {
             let eye = clear_eye(forest, Vec3::new(0.0, 1.7, side * 0.25), clearance);
-            cam(eye, Vec3::new(eye.x - 5.0, 3.0, eye.z - side * 0.25))
+            let eye = eye.with_y(forest.ground_height(eye.x, eye.z) + 1.7);
+            let (tx, tz) = (eye.x - 5.0, eye.z - side * 0.25);
+            cam(eye, Vec3::new(tx, forest.ground_height(tx, tz) + 3.0, tz))
         }),
         (
             "birds-eye",

@@ -86,6 +86,9 @@ pub struct Settings {
     pub extent: f32,
     /// The forest's terrain, which walking follows (`None`: flat ground at y = 0).
     pub terrain: Option<forest_format::terrain::Terrain>,
+    /// Where the walker starts without a path: eye and a point looked at (`None`: the origin
+    /// at eye height, looking along −Z).
+    pub start: Option<(Vec3, Vec3)>,
     /// The methods offered (see [`offered`]).
     pub methods: Vec<Method>,
     /// Index of the starting method in `methods`.
@@ -139,7 +142,7 @@ pub struct Viewer {
 }
 
 impl Viewer {
-    /// A viewer with these settings, standing at the origin (or at the path's first key).
+    /// A viewer with these settings, standing at its start (or at the path's first key).
     pub fn new(st: Settings) -> Self {
         let ground = |x: f32, z: f32| st.terrain.as_ref().map_or(0.0, |t| t.height(x, z));
         let walker = match &st.path {
@@ -149,6 +152,10 @@ impl Viewer {
                 5.0,
                 ground(p.keys[0].eye[0], p.keys[0].eye[2]),
             ),
+            None if st.start.is_some() => {
+                let (eye, target) = st.start.unwrap_or_default();
+                Walker::looking_at(eye, target, 5.0, ground(eye.x, eye.z))
+            }
             None => Walker {
                 eye: Vec3::new(0.0, ground(0.0, 0.0) + EYE_HEIGHT, 0.0),
                 yaw: 0.0,

@@ -179,6 +179,35 @@ fn main() {
         write("forest_json", &format!("seed-{i}.json"), &json);
     }
 
+    // A forest on a terrain (format version 2), binary and JSON.
+    let hills = sample_forest(4).with_terrain(forest_format::terrain::Terrain {
+        size: [3, 2],
+        origin: [-4.0, -2.0],
+        spacing: 4.0,
+        heights: vec![0.0, 1.0, 2.0, 3.0, 5.0, 8.0],
+    });
+    write("forest_binary", "seed-2", &hills.to_bytes());
+    let json = saved(dir, "f.json", |p| hills.save(p).expect("forest saves"));
+    write("forest_json", "seed-2.json", &json);
+
+    // Height fields: a 16-bit PNG and an EXR, behind the target's kind byte.
+    let heights_png = saved(dir, "h.png", |p| {
+        image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(5, 4, |x, y| {
+            image::Luma([(x * 9000 + y * 2000) as u16])
+        })
+        .save(p)
+        .expect("PNG saves")
+    });
+    write("terrain", "seed-0", &[&[0u8][..], &heights_png].concat());
+    let heights_exr = saved(dir, "h.exr", |p| {
+        image::DynamicImage::ImageRgb32F(image::ImageBuffer::from_fn(4, 3, |x, y| {
+            image::Rgb([x as f32 - y as f32, 0.0, 0.0])
+        }))
+        .save(p)
+        .expect("EXR saves")
+    });
+    write("terrain", "seed-1", &[&[1u8][..], &heights_exr].concat());
+
     // Camera paths.
     let mut path = CameraPath::new(60.0);
     path.push(Vec3::new(0.0, 1.7, 5.0), Vec3::ZERO);

@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use forest_render::options::{RendererOptions, SKY, ground_colour};
+use forest_render::options::{GROUND_MOSS, RendererOptions, SKY, ground_colour};
 use forest_render::{FrameParams, GpuScene, QuadStream, RenderError};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
@@ -16,28 +16,35 @@ use wgpu::util::DeviceExt;
 /// Depth format of the host's targets.
 pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-const GROUND_WGSL: &str = r#"
-struct Host { view_proj: mat4x4<f32>, colour: vec4<f32>, eye: vec4<f32> }
+/// The host's ground: a square around the eye, soil and moss in the library's pattern
+/// (`ground_moss` from [`forest_render::passes::GROUND_WGSL`], prepended).
+const HOST_GROUND_WGSL: &str = r#"
+struct Host { view_proj: mat4x4<f32>, colour: vec4<f32>, moss: vec4<f32>, eye: vec4<f32> }
 @group(0) @binding(0) var<uniform> host: Host;
+struct Out { @builtin(position) clip: vec4<f32>, @location(0) xz: vec2<f32> }
 
 @vertex
-fn vs(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+fn vs(@builtin(vertex_index) vi: u32) -> Out {
     let s = host.colour.w;
     let x = select(-s, s, (vi & 1u) == 1u) + host.eye.x;
     let z = select(-s, s, (vi >> 1u) == 1u) + host.eye.z;
-    return host.view_proj * vec4<f32>(x, 0.0, z, 1.0);
+    return Out(host.view_proj * vec4<f32>(x, 0.0, z, 1.0), vec2<f32>(x, z));
 }
 
 @fragment
-fn fs() -> @location(0) vec4<f32> { return vec4<f32>(host.colour.xyz, 1.0); }
+fn fs(in: Out) -> @location(0) vec4<f32> {
+    return vec4<f32>(mix(host.colour.xyz, host.moss.xyz, ground_moss(in.xz)), 1.0);
+}
 "#;
 
-/// The host's uniform: its view-projection, the ground's colour and half side, the eye.
+/// The host's uniform: its view-projection, the ground's soil colour and half side, its moss
+/// colour, the eye.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct HostUniform {
     view_proj: [[f32; 4]; 4],
     colour: [f32; 4],
+    moss: [f32; 4],
     eye: [f32; 4],
 }
 
@@ -47,6 +54,7 @@ pub struct Host {
     uniform: wgpu::Buffer,
     bind: wgpu::BindGroup,
     ground_colour: [f32; 4],
+    moss_colour: [f32; 4],
     depth: wgpu::TextureView,
     /// The forest of this view.
     pub forest: QuadStream,
@@ -108,10 +116,19 @@ impl Host {
         // The ground colour `forest render` uses, so that the two frames can be compared.
         // A 10 km square around the eye.
         let ground_colour = ground_colour(&opts.lighting).extend(5000.0).to_array();
+        let moss_colour = opts
+            .lighting
+            .shade(GROUND_MOSS, Vec3::Y, 1.0, 0.0)
+            .extend(0.0)
+            .to_array();
         let forest = QuadStream::new(device, scene, &opts)?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("host ground"),
-            source: wgpu::ShaderSource::Wgsl(GROUND_WGSL.into()),
+            source: wgpu::ShaderSource::Wgsl(
+                [forest_render::passes::GROUND_WGSL, HOST_GROUND_WGSL]
+                    .concat()
+                    .into(),
+            ),
         });
         let ground = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("host ground"),
@@ -148,6 +165,7 @@ impl Host {
             contents: bytemuck::bytes_of(&HostUniform {
                 view_proj: Mat4::IDENTITY.to_cols_array_2d(),
                 colour: ground_colour,
+                moss: moss_colour,
                 eye: [0.0; 4],
             }),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
@@ -165,6 +183,7 @@ impl Host {
             uniform,
             bind,
             ground_colour,
+            moss_colour,
             depth: depth_view(device, size),
             forest,
         })
@@ -189,6 +208,7 @@ impl Host {
         let host = HostUniform {
             view_proj: (frame.proj * frame.view).to_cols_array_2d(),
             colour: self.ground_colour,
+            moss: self.moss_colour,
             eye: eye.extend(1.0).to_array(),
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&host));

@@ -13,8 +13,11 @@ pub mod refine;
 /// The WGSL every module starts with: the camera, the scene's structs, the shared helpers
 /// (other crates' shaders that read the camera, such as the baselines', start with it too).
 pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
-/// The environment (sky and ground) and the haze every method's fragments go through (after
-/// a module declaring `camera`).
+/// The ground's pattern (soil and moss) as pure WGSL functions of world (x, z), no bindings:
+/// `ground_moss(xz) -> f32`. The environment uses it; a host drawing its own ground may too.
+pub const GROUND_WGSL: &str = include_str!("../../shaders/ground.wgsl");
+/// The environment (sky, ground, terrain) and the haze every method's fragments go through
+/// (after a module declaring `camera`, and [`GROUND_WGSL`]).
 pub const ENVIRONMENT_WGSL: &str = include_str!("../../shaders/environment.wgsl");
 
 /// WGSL of the compute passes.
@@ -28,9 +31,10 @@ pub const COMPUTE_WGSL: [&str; 6] = [
 ];
 
 /// WGSL of the draw pass.
-pub const DRAW_WGSL: [&str; 3] = [
+pub const DRAW_WGSL: [&str; 4] = [
     COMMON_WGSL,
     include_str!("../../shaders/draw.wgsl"),
+    GROUND_WGSL,
     ENVIRONMENT_WGSL,
 ];
 
