@@ -343,7 +343,7 @@ fn inside_view(forest: &Forest) -> (Vec3, Vec3) {
         })
         .map(|(_, p)| p)
     else {
-        return (Vec3::new(3.0, 1.7, 6.0), Vec3::new(-40.0, 3.0, -60.0));
+        return (ground(3.0, 6.0, 1.7), ground(-40.0, -60.0, 3.0));
     };
     let clear = |x: f32, z: f32| {
         forest
