@@ -251,7 +251,10 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             }
             let (lo, hi) = t.height_range();
             let prefs: Vec<f32> = p.species.iter().map(|s| species_altitude(s)).collect();
-            Some((t, g, lo, (hi - lo).max(1e-6), prefs))
+            // Ground within a metre of level has no altitudes to speak of: no treeline, no
+            // bands (every altitude would be 0, and the bands would thin some species only).
+            let hilly = hi - lo >= 1.0;
+            Some((t, g, lo, (hi - lo).max(1e-6), prefs, hilly))
         }
         None => None,
     };
@@ -259,10 +262,19 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
     let mut instances = Vec::with_capacity(p.trees as usize);
     let max_attempts = 1000u64 * u64::from(p.trees);
     let mut attempts = 0u64;
+    // Candidates the clump map kept, and those of them the ground's rules then refused.
+    let (mut clump_kept, mut refused_by_ground) = (0u64, 0u64);
     while instances.len() < p.trees as usize {
         attempts += 1;
         if attempts > max_attempts {
-            return Err("the clump map accepts too few points; raise the clump size".into());
+            return Err(if refused_by_ground * 10 > clump_kept * 9 {
+                "the terrain's rules refuse too many places (steep slopes, ground above the \
+                 treeline, altitudes far from the species' bands): raise --max-slope or \
+                 --treeline, or lower the relief"
+                    .into()
+            } else {
+                "the clump map accepts too few points; raise the clump size".into()
+            });
         }
         let x = (rng.next_f32() - 0.5) * side;
         let z = (rng.next_f32() - 0.5) * side;
@@ -278,15 +290,21 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
         let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
             .floor()
             .clamp(0.0, (p.species.len() - 1) as f32) as u32;
+        clump_kept += 1;
         let mut y = 0.0;
-        if let Some((t, g, low, range, prefs)) = &ground {
+        if let Some((t, g, low, range, prefs, hilly)) = &ground {
             y = t.height(x, z);
             let slope = t.slope(x, z).atan().to_degrees();
-            let alt = (y - low) / range;
-            let keep = ((g.max_slope_deg - slope) / 10.0).clamp(0.0, 1.0)
-                * ((g.treeline - alt) / 0.1).clamp(0.0, 1.0)
-                * (-((alt - prefs[pick as usize]) / g.band).powi(2)).exp();
-            if rng.next_f32() >= keep {
+            let mut keep = ((g.max_slope_deg - slope) / 10.0).clamp(0.0, 1.0);
+            if *hilly {
+                let alt = (y - low) / range;
+                keep *= ((g.treeline - alt) / 0.1).clamp(0.0, 1.0)
+                    * (-((alt - prefs[pick as usize]) / g.band).powi(2)).exp();
+            }
+            // (No draw where every rule keeps the place: level ground generates the same
+            // forest as no terrain, raised to its height.)
+            if keep < 1.0 && rng.next_f32() >= keep {
+                refused_by_ground += 1;
                 continue;
             }
         }
@@ -422,6 +440,32 @@ mod tests {
         let flat = generate(&p).unwrap();
         assert!(flat.instances.iter().all(|i| i.position[1] == 0.0));
         assert!(flat.terrain.is_none());
+        // Level ground keeps no bands: the same trees, species and places as without terrain.
+        let level = Terrain {
+            size: [3, 3],
+            origin: [-600.0, -600.0],
+            spacing: 600.0,
+            heights: vec![5.0; 9],
+        };
+        p.terrain = Some(level);
+        let on_level = generate(&p).unwrap();
+        for (a, b) in on_level.instances.iter().zip(&flat.instances) {
+            assert_eq!(
+                (a.position[0], a.position[2], a.species),
+                (b.position[0], b.position[2], b.species)
+            );
+            assert_eq!(a.position[1], 5.0);
+        }
+        // A wall everywhere: the ground's rules, not the clump map, are named.
+        let wall = Terrain {
+            size: [2, 2],
+            origin: [-600.0, -600.0],
+            spacing: 1200.0,
+            heights: vec![0.0, 5000.0, 0.0, 5000.0],
+        };
+        p.terrain = Some(wall);
+        let err = generate(&p).unwrap_err();
+        assert!(err.contains("terrain's rules"), "{err}");
         // A square larger than the terrain is refused.
         p.terrain = Some(terrain);
         p.area_per_tree = 1000.0;

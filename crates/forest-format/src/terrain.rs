@@ -88,10 +88,13 @@ impl Terrain {
                 self.spacing
             ));
         }
-        let far = self
-            .origin
+        if !self.origin.iter().all(|o| o.is_finite()) {
+            return Err(format!("grid origin {:?} must be finite", self.origin));
+        }
+        // The farthest grid coordinate from the origin on either axis.
+        let far = [(self.origin[0], nx), (self.origin[1], nz)]
             .iter()
-            .map(|o| o.abs() + self.spacing * (nx.max(nz) - 1) as f32)
+            .map(|&(o, n)| o.abs().max((o + self.spacing * (n - 1) as f32).abs()))
             .fold(0.0, f32::max);
         if far.is_nan() || far > crate::forest::MAX_COORDINATE {
             return Err(format!(
@@ -162,26 +165,28 @@ impl Terrain {
     }
 
     /// The slope of the drawn surface at world (x, z), as the tangent of its angle to the
-    /// horizontal (rise over run; 0 outside the grid).
+    /// horizontal (rise over run), from the gradient of the triangle holding (x, z) (0 outside
+    /// the grid).
     pub fn slope(&self, x: f32, z: f32) -> f32 {
         if !self.contains(x, z) {
             return 0.0;
         }
-        // Finite differences within the triangle holding (x, z): the surface is linear there.
-        let e = self.spacing * 1e-3;
-        let h = self.height(x, z);
-        let (lo, hi) = self.bounds();
-        let dx = if x + e <= hi[0] {
-            self.height(x + e, z) - h
+        let [nx, nz] = self.size;
+        let u = (x - self.origin[0]) / self.spacing;
+        let v = (z - self.origin[1]) / self.spacing;
+        let i = (u.floor() as usize).min(nx as usize - 2);
+        let j = (v.floor() as usize).min(nz as usize - 2);
+        let (fx, fz) = (u - i as f32, v - j as f32);
+        let h11 = self.sample(i + 1, j + 1);
+        // Rise per sample along x and z on the triangle (00, 10, 11) or (00, 11, 01).
+        let (dx, dz) = if fx >= fz {
+            let h10 = self.sample(i + 1, j);
+            (h10 - self.sample(i, j), h11 - h10)
         } else {
-            h - self.height((x - e).max(lo[0]), z)
+            let h01 = self.sample(i, j + 1);
+            (h11 - h01, h01 - self.sample(i, j))
         };
-        let dz = if z + e <= hi[1] {
-            self.height(x, z + e) - h
-        } else {
-            h - self.height(x, (z - e).max(lo[1]))
-        };
-        (dx * dx + dz * dz).sqrt() / e
+        (dx * dx + dz * dz).sqrt() / self.spacing
     }
 
     /// Lowest and highest sample, metres.
@@ -272,7 +277,8 @@ impl Terrain {
     /// Load a height field from an image, centred on the origin, `spacing` metres between
     /// pixels, row 0 at the smallest z:
     /// - a 16-bit greyscale PNG: 0 to 65535 map to 0 to `png_relief` metres;
-    /// - an OpenEXR file (`.exr`): its first channel holds heights in metres.
+    /// - an OpenEXR file (`.exr`): heights in metres, from its `Y` channel, else `R`, else
+    ///   `Z`, else the first (any sample type; single-channel files are the usual export).
     ///
     /// 8-bit or colour PNGs are refused (256 levels would terrace every slope; a colour image
     /// is rarely a height field), and so are images smaller than 2×2 or larger than
@@ -310,31 +316,20 @@ impl Terrain {
                 "relief {png_relief} m must be 0 to {MAX_HEIGHT} m"
             )));
         }
-        let format = if exr {
-            image::ImageFormat::OpenExr
+        let (w, h, heights) = if exr {
+            exr_heights(path, bytes)?
         } else {
-            image::ImageFormat::Png
-        };
-        let (w, h) = crate::bounded::image_dimensions(bytes, Some(format), path)?;
-        if !(2..=MAX_SIDE).contains(&w) || !(2..=MAX_SIDE).contains(&h) {
-            return Err(bad(format!(
-                "a {w}×{h} image: a height field needs 2 to {MAX_SIDE} pixels a side"
-            )));
-        }
-        let img = crate::bounded::decode_image(bytes, Some(format), path)?;
-        let heights: Vec<f32> = if exr {
-            let first = img.to_rgba32f();
-            first.pixels().map(|p| p.0[0]).collect()
-        } else {
-            match img {
-                image::DynamicImage::ImageLuma16(g) => g
-                    .pixels()
-                    .map(|p| f32::from(p.0[0]) / 65535.0 * png_relief)
-                    .collect(),
-                image::DynamicImage::ImageLumaA16(g) => g
-                    .pixels()
-                    .map(|p| f32::from(p.0[0]) / 65535.0 * png_relief)
-                    .collect(),
+            let format = image::ImageFormat::Png;
+            let (w, h) = crate::bounded::image_dimensions(bytes, Some(format), path)?;
+            if !(2..=MAX_SIDE).contains(&w) || !(2..=MAX_SIDE).contains(&h) {
+                return Err(bad(format!(
+                    "a {w}×{h} image: a height field needs 2 to {MAX_SIDE} pixels a side"
+                )));
+            }
+            let scale = |v: u16| f32::from(v) / 65535.0 * png_relief;
+            let heights: Vec<f32> = match crate::bounded::decode_image(bytes, Some(format), path)? {
+                image::DynamicImage::ImageLuma16(g) => g.pixels().map(|p| scale(p.0[0])).collect(),
+                image::DynamicImage::ImageLumaA16(g) => g.pixels().map(|p| scale(p.0[0])).collect(),
                 other => {
                     let c = other.color();
                     return Err(bad(format!(
@@ -344,7 +339,8 @@ impl Terrain {
                         c.channel_count()
                     )));
                 }
-            }
+            };
+            (w, h, heights)
         };
         let t = Terrain {
             size: [w, h],
@@ -400,6 +396,71 @@ impl Terrain {
     }
 }
 
+/// The heights of an EXR height field: its size read from the header and checked before any
+/// pixel is decoded, then one channel (`Y`, else `R`, else `Z`, else the first) of the first
+/// flat layer, as f32.
+fn exr_heights(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<f32>), FormatError> {
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let img_err = |e: exr::error::Error| FormatError::Image {
+        path: path.into(),
+        what: e.to_string(),
+    };
+    let bad = |what: String| FormatError::invalid(path, what);
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(img_err)?;
+    let header = meta
+        .headers
+        .iter()
+        .find(|h| !h.deep)
+        .ok_or_else(|| bad("an EXR without a flat (non-deep) layer".into()))?;
+    let size = header.layer_size;
+    let side = |n: usize| u32::try_from(n).ok().filter(|n| (2..=MAX_SIDE).contains(n));
+    let (Some(_), Some(_)) = (side(size.0), side(size.1)) else {
+        return Err(bad(format!(
+            "a {}×{} image: a height field needs 2 to {MAX_SIDE} pixels a side",
+            size.0, size.1
+        )));
+    };
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(img_err)?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.0, layer.size.1);
+    let (Some(w), Some(h)) = (side(w), side(h)) else {
+        return Err(bad(format!(
+            "a {w}×{h} image: a height field needs 2 to {MAX_SIDE} pixels a side"
+        )));
+    };
+    let channels = &layer.channel_data.list;
+    let named = |n: &str| channels.iter().find(|c| c.name.eq(n));
+    let channel = named("Y")
+        .or_else(|| named("R"))
+        .or_else(|| named("Z"))
+        .or_else(|| channels.first())
+        .ok_or_else(|| bad("an EXR without channels".into()))?;
+    use exr::prelude::FlatSamples as S;
+    let heights: Vec<f32> = match &channel.sample_data {
+        S::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+        S::F32(v) => v.clone(),
+        S::U32(v) => v.iter().map(|&x| x as f32).collect(),
+    };
+    if heights.len() != w as usize * h as usize {
+        return Err(bad(format!(
+            "channel {} holds {} samples for {w}×{h} pixels (subsampled channels are not \
+             height fields)",
+            channel.name,
+            heights.len()
+        )));
+    }
+    Ok((w, h, heights))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -435,7 +496,22 @@ mod tests {
             let want = 0.3 * x - 0.2 * z + 4.0;
             assert!((t.height(x, z) - want).abs() < 1e-4, "({x}, {z})");
             let s = t.slope(x, z);
-            assert!((s - (0.09f32 + 0.04).sqrt()).abs() < 2e-3, "slope {s}");
+            assert!((s - (0.09f32 + 0.04).sqrt()).abs() < 1e-5, "slope {s}");
+        }
+        // Exact on both sides of a cell's diagonal and on its edges.
+        let steep = plane(2.0, -1.5, 40.0);
+        for (x, z) in [
+            (-7.5, 5.5),
+            (-7.5 + 1e-4, 5.5),
+            (-7.5, 5.5 + 1e-4),
+            (0.0, 10.5),
+            (-10.0, 3.0),
+        ] {
+            assert!(
+                (steep.slope(x, z) - 2.5).abs() < 1e-5,
+                "({x}, {z}): {}",
+                steep.slope(x, z)
+            );
         }
         // Outside: the flat ground.
         assert_eq!(t.height(-10.5, 5.0), 0.0);
@@ -529,9 +605,25 @@ mod tests {
         let mut bad = t.clone();
         bad.heights.pop();
         assert!(bad.check().unwrap_err().contains("19 heights"));
-        let mut bad = t;
+        let mut bad = t.clone();
         bad.size = [1, 20];
         assert!(bad.check().unwrap_err().contains("1×20"));
+        let mut bad = t.clone();
+        bad.origin[1] = f32::NAN;
+        assert!(bad.check().unwrap_err().contains("origin"));
+        // A grid centred on the origin is measured by its own reach, not its span added on.
+        let wide = Terrain {
+            size: [2, 2],
+            origin: [-4.0e6, -4.0e6],
+            spacing: 8.0e6,
+            heights: vec![0.0; 4],
+        };
+        wide.check().unwrap();
+        let far = Terrain {
+            origin: [-4.0e6, 3.0e6],
+            ..wide
+        };
+        assert!(far.check().unwrap_err().contains("farther than"));
     }
 
     fn write_png16(path: &Path, w: u32, h: u32, f: impl Fn(u32, u32) -> u16) {
@@ -561,6 +653,24 @@ mod tests {
         let t = Terrain::from_image(&exr, 1.0, 0.0).unwrap();
         assert_eq!(t.size, [4, 3]);
         assert_eq!(t.heights[4 * 2 + 3], 2.0);
+
+        // A single-channel EXR (the usual height-map export), half floats, channel "Y".
+        let single = dir.path().join("y.exr");
+        {
+            use exr::prelude::*;
+            let samples: Vec<f16> = (0..15).map(|k| f16::from_f32(k as f32 * 0.5)).collect();
+            let channel = AnyChannel::new("Y", FlatSamples::F16(samples));
+            let layer = Layer::new(
+                (5, 3),
+                LayerAttributes::named("heights"),
+                Encoding::FAST_LOSSLESS,
+                AnyChannels::sort(SmallVec::from_vec(vec![channel])),
+            );
+            Image::from_layer(layer).write().to_file(&single).unwrap();
+        }
+        let t = Terrain::from_image(&single, 2.0, 0.0).unwrap();
+        assert_eq!(t.size, [5, 3]);
+        assert_eq!(t.heights[14], 7.0);
 
         let err = |p: &Path| Terrain::from_image(p, 1.0, 10.0).unwrap_err().to_string();
         let eight = dir.path().join("8bit.png");
