@@ -140,12 +140,10 @@ impl Terrain {
         self.heights[j * self.size[0] as usize + i]
     }
 
-    /// The drawn surface's height at world (x, z), metres: linear on each of a cell's two
-    /// triangles (see the module documentation); 0 outside the grid.
-    pub fn height(&self, x: f32, z: f32) -> f32 {
-        if !self.contains(x, z) {
-            return 0.0;
-        }
+    /// The triangle holding world (x, z), which must be on the grid: its first corner (i, j),
+    /// the height there, and the rise per sample along x and along z on the triangle
+    /// (00, 10, 11) when the fractions satisfy fx ≥ fz, else (00, 11, 01); with the fractions.
+    fn triangle(&self, x: f32, z: f32) -> (f32, f32, f32, f32, f32) {
         let [nx, nz] = self.size;
         let u = (x - self.origin[0]) / self.spacing;
         let v = (z - self.origin[1]) / self.spacing;
@@ -153,15 +151,25 @@ impl Terrain {
         let i = (u.floor() as usize).min(nx as usize - 2);
         let j = (v.floor() as usize).min(nz as usize - 2);
         let (fx, fz) = (u - i as f32, v - j as f32);
-        let h00 = self.sample(i, j);
-        let h11 = self.sample(i + 1, j + 1);
-        if fx >= fz {
+        let (h00, h11) = (self.sample(i, j), self.sample(i + 1, j + 1));
+        let (dx, dz) = if fx >= fz {
             let h10 = self.sample(i + 1, j);
-            h00 + fx * (h10 - h00) + fz * (h11 - h10)
+            (h10 - h00, h11 - h10)
         } else {
             let h01 = self.sample(i, j + 1);
-            h00 + fz * (h01 - h00) + fx * (h11 - h01)
+            (h11 - h01, h01 - h00)
+        };
+        (h00, dx, dz, fx, fz)
+    }
+
+    /// The drawn surface's height at world (x, z), metres: linear on each of a cell's two
+    /// triangles (see the module documentation); 0 outside the grid.
+    pub fn height(&self, x: f32, z: f32) -> f32 {
+        if !self.contains(x, z) {
+            return 0.0;
         }
+        let (h00, dx, dz, fx, fz) = self.triangle(x, z);
+        h00 + fx * dx + fz * dz
     }
 
     /// The slope of the drawn surface at world (x, z), as the tangent of its angle to the
@@ -171,21 +179,7 @@ impl Terrain {
         if !self.contains(x, z) {
             return 0.0;
         }
-        let [nx, nz] = self.size;
-        let u = (x - self.origin[0]) / self.spacing;
-        let v = (z - self.origin[1]) / self.spacing;
-        let i = (u.floor() as usize).min(nx as usize - 2);
-        let j = (v.floor() as usize).min(nz as usize - 2);
-        let (fx, fz) = (u - i as f32, v - j as f32);
-        let h11 = self.sample(i + 1, j + 1);
-        // Rise per sample along x and z on the triangle (00, 10, 11) or (00, 11, 01).
-        let (dx, dz) = if fx >= fz {
-            let h10 = self.sample(i + 1, j);
-            (h10 - self.sample(i, j), h11 - h10)
-        } else {
-            let h01 = self.sample(i, j + 1);
-            (h11 - h01, h01 - self.sample(i, j))
-        };
+        let (_, dx, dz, _, _) = self.triangle(x, z);
         (dx * dx + dz * dz).sqrt() / self.spacing
     }
 
