@@ -686,7 +686,12 @@ fn a_forest_on_hills_or_a_height_field_stands_on_it_and_bad_height_fields_are_na
         (
             "flat".into(),
             vec!["--relief", "5"],
-            "--relief needs a --terrain",
+            "--relief need(s) a --terrain",
+        ),
+        (
+            "flat".into(),
+            vec!["--max-slope", "20", "--treeline", "0.5"],
+            "--max-slope, --treeline need(s) a --terrain",
         ),
         ("hills".into(), vec!["--terrain-spacing", "0"], "spacing"),
         (

@@ -48,16 +48,17 @@ pub struct SceneArgs {
     /// [default: 100].
     #[arg(long, allow_negative_numbers = true)]
     pub relief: Option<f32>,
-    /// Metres between height samples (a height field's pixels, or the generated hills').
-    #[arg(long, allow_negative_numbers = true, default_value_t = 8.0)]
-    pub terrain_spacing: f32,
-    /// Steepest ground that carries trees, degrees.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 35.0)]
-    pub max_slope: f32,
+    /// Metres between height samples (a height field's pixels, or the generated hills')
+    /// [default: 8].
+    #[arg(long, allow_negative_numbers = true)]
+    pub terrain_spacing: Option<f32>,
+    /// Steepest ground that carries trees, degrees [default: 35].
+    #[arg(long, allow_negative_numbers = true)]
+    pub max_slope: Option<f32>,
     /// Treeline: the fraction of the way from the lowest to the highest ground above which no
-    /// tree grows.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.92)]
-    pub treeline: f32,
+    /// tree grows [default: 0.92].
+    #[arg(long, allow_negative_numbers = true)]
+    pub treeline: Option<f32>,
     /// Output: binary forest, or JSON when the name ends in .json.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -153,13 +154,30 @@ fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
 /// Relief of `--terrain hills` and of a PNG's full range when `--relief` is not given, metres.
 pub const DEFAULT_RELIEF: f32 = 100.0;
 
+/// Metres between height samples when `--terrain-spacing` is not given.
+pub const DEFAULT_TERRAIN_SPACING: f32 = 8.0;
+
 /// The terrain `--terrain` asks for (`None`: flat), for a forest `side` metres across.
 fn terrain(args: &SceneArgs, side: f32) -> Result<Option<Terrain>> {
     let relief = args.relief.unwrap_or(DEFAULT_RELIEF);
+    let spacing = args.terrain_spacing.unwrap_or(DEFAULT_TERRAIN_SPACING);
     match args.terrain.as_str() {
         "flat" => {
-            if args.relief.is_some() {
-                bail!("--relief needs a --terrain (hills, or a 16-bit PNG)");
+            let given: Vec<&str> = [
+                ("--relief", args.relief.is_some()),
+                ("--terrain-spacing", args.terrain_spacing.is_some()),
+                ("--max-slope", args.max_slope.is_some()),
+                ("--treeline", args.treeline.is_some()),
+            ]
+            .iter()
+            .filter(|(_, g)| *g)
+            .map(|(n, _)| *n)
+            .collect();
+            if !given.is_empty() {
+                bail!(
+                    "{} need(s) a --terrain (hills, or a height field): flat ground has none",
+                    given.join(", ")
+                );
             }
             Ok(None)
         }
@@ -170,7 +188,7 @@ fn terrain(args: &SceneArgs, side: f32) -> Result<Option<Terrain>> {
             let half = side.max(200.0);
             Terrain::generate(&TerrainParams {
                 half_extent: half,
-                spacing: args.terrain_spacing,
+                spacing,
                 relief,
                 hill_size: (side / 4.0).max(150.0),
                 fade: 0.5,
@@ -190,11 +208,7 @@ fn terrain(args: &SceneArgs, side: f32) -> Result<Option<Terrain>> {
             if path.extension().is_none() {
                 bail!("--terrain '{file}': give flat, hills, or a height field (.png or .exr)");
             }
-            Ok(Some(Terrain::from_image(
-                path,
-                args.terrain_spacing,
-                relief,
-            )?))
+            Ok(Some(Terrain::from_image(path, spacing, relief)?))
         }
     }
 }
@@ -237,8 +251,10 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     let forest = generate(&GenerateParams {
         terrain,
         ground: GroundRules {
-            max_slope_deg: args.max_slope,
-            treeline: args.treeline,
+            max_slope_deg: args
+                .max_slope
+                .unwrap_or(GroundRules::default().max_slope_deg),
+            treeline: args.treeline.unwrap_or(GroundRules::default().treeline),
             ..GroundRules::default()
         },
         trees: args.trees,
