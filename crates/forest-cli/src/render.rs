@@ -298,23 +298,25 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
 /// ("inside"), on the highest ground among the trees looking over the lowest ("hill"), and
 /// high above ("birds-eye").
 pub fn named_view(name: &str, forest: &Forest) -> (Vec3, Vec3) {
-    // The trees' extent (the terrain may reach much farther).
-    let r = forest
-        .instances
-        .iter()
-        .map(|i| Vec3::from_array(i.position).with_y(0.0).length())
-        .fold(10.0, f32::max);
-    let (_, top) = forest
-        .terrain
-        .as_ref()
-        .map_or((0.0, 0.0), |t| t.height_range());
     match name {
         "inside" => inside_view(forest),
         "hill" => hill_view(forest),
-        _ => (
-            Vec3::new(0.0, top + r * 0.35, r * 0.55),
-            Vec3::new(0.0, 0.0, -r * 0.1),
-        ),
+        _ => {
+            // The trees' extent (the terrain may reach much farther), above the highest ground.
+            let r = forest
+                .instances
+                .iter()
+                .map(|i| Vec3::from_array(i.position).with_y(0.0).length())
+                .fold(10.0, f32::max);
+            let (_, top) = forest
+                .terrain
+                .as_ref()
+                .map_or((0.0, 0.0), |t| t.height_range());
+            (
+                Vec3::new(0.0, top + r * 0.35, r * 0.55),
+                Vec3::new(0.0, 0.0, -r * 0.1),
+            )
+        }
     }
 }
 
@@ -377,8 +379,9 @@ fn inside_view(forest: &Forest) -> (Vec3, Vec3) {
     let mut best = seen(heading);
     for k in 1..8 {
         let h = -std::f32::consts::FRAC_PI_4 + k as f32 * std::f32::consts::FRAC_PI_4;
-        if seen(h) > best {
-            (heading, best) = (h, seen(h));
+        let n = seen(h);
+        if n > best {
+            (heading, best) = (h, n);
         }
     }
     let d = Vec3::new(heading.sin(), 0.0, -heading.cos()) * 60.0;

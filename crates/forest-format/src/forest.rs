@@ -430,7 +430,7 @@ impl Forest {
 
     /// Height of the ground at world (x, z): the terrain's, or 0 without one (metres).
     pub fn ground_height(&self, x: f32, z: f32) -> f32 {
-        self.terrain.as_ref().map_or(0.0, |t| t.height(x, z))
+        crate::terrain::ground_height(self.terrain.as_ref(), x, z)
     }
 
     /// The far-plane distance (metres) every front end uses for a camera at `eye`: three

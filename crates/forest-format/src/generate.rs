@@ -251,10 +251,7 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             }
             let (lo, hi) = t.height_range();
             let prefs: Vec<f32> = p.species.iter().map(|s| species_altitude(s)).collect();
-            // Ground within a metre of level has no altitudes to speak of: no treeline, no
-            // bands (every altitude would be 0, and the bands would thin some species only).
-            let hilly = hi - lo >= 1.0;
-            Some((t, g, lo, (hi - lo).max(1e-6), prefs, hilly))
+            Some((t, g, lo, hi - lo, prefs))
         }
         None => None,
     };
@@ -292,11 +289,13 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             .clamp(0.0, (p.species.len() - 1) as f32) as u32;
         clump_kept += 1;
         let mut y = 0.0;
-        if let Some((t, g, low, range, prefs, hilly)) = &ground {
+        if let Some((t, g, low, range, prefs)) = &ground {
             y = t.height(x, z);
             let slope = t.slope(x, z).atan().to_degrees();
             let mut keep = ((g.max_slope_deg - slope) / 10.0).clamp(0.0, 1.0);
-            if *hilly {
+            // Ground within a metre of level has no altitudes to speak of: no treeline, no
+            // bands (every altitude would be 0, and the bands would thin some species only).
+            if *range >= 1.0 {
                 let alt = (y - low) / range;
                 keep *= ((g.treeline - alt) / 0.1).clamp(0.0, 1.0)
                     * (-((alt - prefs[pick as usize]) / g.band).powi(2)).exp();

@@ -36,6 +36,12 @@ pub struct Terrain {
     pub heights: Vec<f32>,
 }
 
+/// The ground's height at world (x, z) over an optional terrain, metres: the terrain's
+/// [`Terrain::height`], or the flat ground's 0 without one.
+pub fn ground_height(terrain: Option<&Terrain>, x: f32, z: f32) -> f32 {
+    terrain.map_or(0.0, |t| t.height(x, z))
+}
+
 /// Parameters of [`Terrain::generate`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct TerrainParams {

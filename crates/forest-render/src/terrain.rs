@@ -85,16 +85,25 @@ impl GpuTerrain {
         self.heights.size()
     }
 
-    /// Record the terrain's draw into `pass`, whose pipeline is the caller's `vs_terrain`
-    /// pipeline and whose bind group holds the heights at binding 13. Returns the draws
-    /// recorded (0 or 1).
-    pub fn record(&self, pass: &mut wgpu::RenderPass, pipeline: &wgpu::RenderPipeline) -> u32 {
+    /// Record the ground into `pass`, whose bind group holds the environment uniform and the
+    /// heights at binding 13: the caller's `vs_environment` pipeline (sky and plane, one
+    /// triangle), then its `vs_terrain` pipeline over the mesh when there is a terrain. Every
+    /// method records the ground through here, so all draw it alike. Returns the draws
+    /// recorded (1 or 2).
+    pub fn record_ground(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        environment: &wgpu::RenderPipeline,
+        terrain: &wgpu::RenderPipeline,
+    ) -> u32 {
+        pass.set_pipeline(environment);
+        pass.draw(0..3, 0..1);
         if !self.grid.present() {
-            return 0;
+            return 1;
         }
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(terrain);
         pass.draw(0..self.grid.vertices(), 0..1);
-        1
+        2
     }
 }
 

@@ -568,12 +568,12 @@ impl GeometryRenderer {
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
         let ground = ground && self.background == Background::Sky;
         pass.set_bind_group(0, &self.draw_bg, &[]);
-        let mut environment = 0;
-        if ground {
-            pass.set_pipeline(&self.environment);
-            pass.draw(0..3, 0..1);
-            environment = 1 + self.terrain.record(pass, &self.terrain_pipeline);
-        }
+        let environment = if ground {
+            self.terrain
+                .record_ground(pass, &self.environment, &self.terrain_pipeline)
+        } else {
+            0
+        };
         // The statistics are the trees' alone (the environment is outside the query).
         if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::DRAW);

@@ -17,7 +17,7 @@ impl Viewer {
         let dt = elapsed.min(0.1);
         self.last = now;
         let terrain = self.terrain.as_ref();
-        let ground = |x: f32, z: f32| terrain.map_or(0.0, |t| t.height(x, z));
+        let ground = |x, z| forest_format::terrain::ground_height(terrain, x, z);
         self.walker.step(&self.keys, dt, ground);
         let cam = self.camera();
         if let (Some(p), Some(i)) = (&self.path, self.playing) {

@@ -144,7 +144,7 @@ pub struct Viewer {
 impl Viewer {
     /// A viewer with these settings, standing at its start (or at the path's first key).
     pub fn new(st: Settings) -> Self {
-        let ground = |x: f32, z: f32| st.terrain.as_ref().map_or(0.0, |t| t.height(x, z));
+        let ground = |x, z| forest_format::terrain::ground_height(st.terrain.as_ref(), x, z);
         let walker = match &st.path {
             Some(p) => Walker::looking_at(
                 Vec3::from_array(p.keys[0].eye),

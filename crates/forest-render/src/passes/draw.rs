@@ -184,12 +184,9 @@ impl DrawPass {
         statistics: Option<&wgpu::QuerySet>,
     ) -> u32 {
         pass.set_bind_group(0, bind_group, &[]);
-        let mut environment = 0;
-        if let Some(terrain) = ground {
-            pass.set_pipeline(&self.environment);
-            pass.draw(0..3, 0..1);
-            environment = 1 + terrain.record(pass, &self.terrain);
-        }
+        let environment = ground.map_or(0, |t| {
+            t.record_ground(pass, &self.environment, &self.terrain)
+        });
         if let Some(set) = statistics {
             pass.begin_pipeline_statistics_query(set, crate::work::DRAW);
         }
