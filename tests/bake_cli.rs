@@ -98,6 +98,32 @@ fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
         .map(|e| e.unwrap().metadata().unwrap().len())
         .sum();
     assert_eq!(v["disk_bytes"].as_u64().unwrap(), on_disk);
+    // The hybrid's switch, measured on the GPU and recorded in the manifest: a crossover
+    // inside the ladder of distances (or at its ends), with the pixels that follow from it.
+    let switch = &v["hybrid_switch"];
+    let radii = switch["crown_radii"].as_f64().unwrap();
+    let pixels = switch["finest_quad_pixels"].as_f64().unwrap();
+    assert!((1.25..=6.0).contains(&radii), "{switch}");
+    // 400×300 at 60° (focal 259.8 px), 5 levels: finest quads 2R/16.
+    assert!(
+        (pixels - 2.0 * 259.8076 / (16.0 * radii)).abs() < 1e-3,
+        "{switch}"
+    );
+    let ladder = v["hybrid_switch_ladder"].as_array().unwrap();
+    assert_eq!(ladder.len(), 9, "{v}");
+    assert!(
+        ladder
+            .iter()
+            .all(|r| r["flip_geometry"].as_f64().unwrap() > 0.0
+                && r["flip_quads"].as_f64().unwrap() > 0.0),
+        "{v}"
+    );
+    let recorded = forest_format::Atlas::load(&atlas)
+        .unwrap()
+        .manifest
+        .hybrid_switch
+        .unwrap();
+    assert!((f64::from(recorded.finest_quad_pixels) - pixels).abs() < 1e-6);
     let img = image::open(&sheet).unwrap();
     assert!(img.width() > 64 && img.height() > 64);
     assert!(exr.is_file());
@@ -239,6 +265,7 @@ fn degenerate_triangles_are_skipped_and_counted() {
         "-o",
         atlas.to_str().unwrap(),
         "--json",
+        "--no-hybrid-switch",
     ];
     args.extend_from_slice(&SMALL);
     let out = forest(&args);
@@ -250,6 +277,11 @@ fn degenerate_triangles_are_skipped_and_counted() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["triangles"], 1);
     assert_eq!(v["degenerate_triangles"], 1);
+    // Not measured: nothing recorded, and the manifest has no switch.
+    assert!(v["hybrid_switch"].is_null(), "{v}");
+    assert_eq!(v["hybrid_switch_ladder"].as_array().map(Vec::len), Some(0));
+    let manifest = std::fs::read_to_string(atlas.join("manifest.json")).unwrap();
+    assert!(!manifest.contains("hybrid_switch"));
 }
 
 #[test]
@@ -295,6 +327,7 @@ fn the_memory_estimate_bounds_a_measured_bake_and_refuses_what_cannot_fit() {
         "0",
         "--spp",
         "1",
+        "--no-hybrid-switch",
     ];
     // Refused before any work, with the figure and the limit; nothing written.
     let mut small = args.to_vec();

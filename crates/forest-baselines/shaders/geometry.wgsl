@@ -37,7 +37,8 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     // Trees drawn as quads alone (the hybrid method) are not drawn here.
-    if (quad_share(camera.forms, distance(camera.eye.xyz, c), r, i) == WEIGHT_ONE) {
+    if (quad_share(camera.forms, distance(camera.eye.xyz, c), sp.switch_unit * inst.scale, i)
+        == WEIGHT_ONE) {
         keys[i] = NONE;
         return;
     }

@@ -43,7 +43,7 @@ struct GeoOut {
 fn geo_form(id: u32, inst: Instance) -> vec2<u32> {
     let sp = geo_species[inst.species];
     let d = distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz));
-    return vec2<u32>(id, quad_share(camera.forms, d, sp.sphere.w * inst.scale, id));
+    return vec2<u32>(id, quad_share(camera.forms, d, sp.switch_unit * inst.scale, id));
 }
 
 // Whether a pixel of a tree in the transition band belongs to the quads.
@@ -68,7 +68,7 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
             if (method.area != 0u) { k = k * sqrt(lod_area_scale(sp.r, lambda)); }
             let c = leaf_centre[sp.leaf_base + v.element].xyz;
             p = c + (p - c) * k;
-            if (method.contrast != 0u) { contrast = vec4<f32>(sp.mean_leaf.rgb, sqrt(lambda)); }
+            if (method.contrast != 0u) { contrast = vec4<f32>(sp.mean_leaf, sqrt(lambda)); }
         }
     }
     let w = to_world(inst, p);

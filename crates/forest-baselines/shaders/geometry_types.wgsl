@@ -44,8 +44,11 @@ struct GeoSpecies {
     leaf_base: u32,
     // r of the area-preservation factor.
     r: f32,
-    // rgb: mean shaded leaf colour (linear) for contrast preservation.
-    mean_leaf: vec4<f32>,
+    // Mean shaded leaf colour (linear) for contrast preservation.
+    mean_leaf: vec3<f32>,
+    // The hybrid's switch unit (forest_render::forms::switch_unit): metres of switch distance
+    // per focal pixel at scale 1.
+    switch_unit: f32,
 }
 
 // The method and its parameters (forest_render::geometry::MeshMethod).

@@ -22,8 +22,10 @@ pub struct GpuGeoSpecies {
     pub leaf_base: u32,
     /// `r` of the area-preservation factor.
     pub r: f32,
-    /// Mean shaded leaf colour (linear RGB) for contrast preservation; w unused.
-    pub mean_leaf: [f32; 4],
+    /// Mean shaded leaf colour (linear RGB) for contrast preservation.
+    pub mean_leaf: [f32; 3],
+    /// The hybrid's switch unit ([`forest_render::forms::switch_unit`]).
+    pub switch_unit: f32,
 }
 
 /// The geometry method and its parameters (48 bytes; `Method` in

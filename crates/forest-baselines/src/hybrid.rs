@@ -17,27 +17,19 @@ use forest_render::forms::{FORMS_GEOMETRY, GEOMETRY_ALWAYS};
 use crate::geometry::MeshMethod;
 use forest_render::context::RenderError;
 
-/// [`Near::Auto`] switches where a tree's finest quads project this many pixels: nearer, the
-/// quad stream is less accurate than full geometry at 1× at every ε.
-pub const AUTO_MIN_PIXELS: f32 = 1.5;
-
 /// Where the near trees end.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Near {
-    /// Where the quad stream, out of levels, becomes less accurate than the tree's own
-    /// triangles: the distance below which a tree's finest quads project longer than
-    /// [`AUTO_MIN_PIXELS`], `2 R · focal / (2^(levels−1) · 1.5)` for a crown of radius `R` (it
-    /// follows the tree's size, the viewport and the field of view; 2.7 crown radii at
-    /// 400×300 and 60° with 8 levels). Measured on the bundled oak, pine and aspen (400×300,
-    /// 60°, 8 levels), the quad stream's FLIP against the 4×4 reference falls below that of
-    /// full geometry at 1× beyond 3, 2 and 2.2 crown radii: where the finest quads project
-    /// 1.35–2 px. Re-measured for all five bundled species (`scripts/crossover.py`, against
-    /// the quad stream at ε 2) the crossover lies at 1.8 (pine) to 3.0 (oak, ash) crown
-    /// radii, median 2.5: one switch for every species is a compromise that a per-species
-    /// switch would remove. ε does not move the switch: a coarser ε makes the near trees' quads
-    /// coarser still, not better, and the walkthrough's error is theirs (an ε-scaled switch,
-    /// 2.7 radii / max(ε/1.5, 1), left the hybrid at ε 8–32 less accurate than the discrete
-    /// LODs at the same time).
+    /// Per species, where its quad stream becomes as accurate as its own triangles: the
+    /// distance at which the species' finest quads project to the size its atlas records
+    /// ([`forest_format::atlas::HybridSwitch`], measured by `forest bake` against a 4×4
+    /// supersampled reference), else to [`forest_render::forms::DEFAULT_SWITCH_PIXELS`]. It follows the tree's size,
+    /// the viewport and the field of view ([`forest_render::forms::switch_unit`]); ε does not
+    /// move it: a coarser ε makes the near trees' quads coarser still, not better (an
+    /// ε-scaled switch left the hybrid at ε 8–32 less accurate than the discrete LODs at the
+    /// same time). Measured on the five bundled species (400×300, 60°, ε 2) the crossover lies
+    /// between 1.8 (pine) and 3.0 (oak, ash) crown radii: a single switch for every species
+    /// draws some trees in their less accurate form.
     Auto,
     /// A fixed distance in metres from the eye to a tree's bounding-sphere centre: 0 draws
     /// every tree as quads, infinity every tree as geometry.
@@ -90,27 +82,28 @@ impl Hybrid {
         self.near_form.validate()
     }
 
-    /// The camera's `forms` for a frame of `camera` over a scene whose coarsest species has
-    /// `levels` hierarchy levels (its finest quads are the largest).
-    pub fn forms(&self, camera: &Camera, levels: u32) -> [f32; 4] {
+    /// The camera's `forms` for a frame of `camera`: in [`Near::Auto`] its focal length in
+    /// pixels, which each tree's switch unit turns into its switch distance.
+    pub fn forms(&self, camera: &Camera) -> [f32; 4] {
         match self.near {
-            Near::Auto => [0.0, auto_radii(camera, levels), self.band, self.jitter],
+            Near::Auto => [0.0, camera.focal_pixels(), self.band, self.jitter],
             Near::Metres(m) if m >= GEOMETRY_ALWAYS => FORMS_GEOMETRY,
             Near::Metres(m) => [m, 0.0, self.band, self.jitter],
         }
     }
 }
 
-/// [`Near::Auto`]'s switch distance in crown radii: where the finest quads of a hierarchy of
-/// `levels` levels, `2R / 2^(levels−1)` wide, project to [`AUTO_MIN_PIXELS`] pixels.
-pub fn auto_radii(camera: &Camera, levels: u32) -> f32 {
+/// [`Near::Auto`]'s switch distance in crown radii for a species of `levels` hierarchy
+/// levels whose finest quads switch at `pixels` pixels: `2 · focal / (2^(levels−1) · pixels)`.
+pub fn auto_radii(camera: &Camera, levels: u32, pixels: f32) -> f32 {
     let finest = (1u64 << levels.clamp(1, 32).saturating_sub(1)) as f32;
-    2.0 * camera.focal_pixels() / (finest * AUTO_MIN_PIXELS)
+    2.0 * camera.focal_pixels() / (finest * pixels)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use forest_render::forms::DEFAULT_SWITCH_PIXELS;
     use glam::Vec3;
 
     fn cam(epsilon: f32) -> Camera {
@@ -125,23 +118,62 @@ mod tests {
         }
     }
 
+    /// A manifest of the default bake (8 levels) of a crown of radius `r` metres.
+    fn manifest(r: f32, switch: Option<f32>) -> forest_format::AtlasManifest {
+        let params = forest_format::BakeParams::default();
+        let mut m = forest_format::atlas::manifest_for(
+            params,
+            forest_format::atlas::SourceInfo {
+                file: "tree.obj".into(),
+                hash: "0".into(),
+                triangles: 1,
+                degenerate_triangles: 0,
+                materials: Vec::new(),
+                top: None,
+            },
+            forest_format::slab::Sphere {
+                center: Vec3::ZERO,
+                radius: r,
+            },
+            vec![None; params.layers() as usize],
+            vec![0; params.levels() as usize],
+        );
+        m.hybrid_switch = switch.map(|p| forest_format::atlas::HybridSwitch {
+            finest_quad_pixels: p,
+            crown_radii: 0.0,
+            viewport: [400, 300],
+            fov_y_deg: 60.0,
+            epsilon: 2.0,
+            cameras: 1,
+        });
+        m
+    }
+
     #[test]
-    fn auto_switch_is_where_the_finest_quads_project_to_one_and_a_half_pixels() {
+    fn auto_switch_is_where_the_finest_quads_project_to_the_recorded_pixels() {
         let c = cam(2.0);
-        let k = auto_radii(&c, 8);
-        // A crown of radius 5 m: finest quads 10/128 m wide, seen from k·5 m away.
-        let px = (10.0 / 128.0) * c.focal_pixels() / (k * 5.0);
-        assert!((px - AUTO_MIN_PIXELS).abs() < 1e-4, "{px}");
-        // 400×300 at 60°: focal 259.8 px, so 2·259.8/(128·1.5) ≈ 2.71 crown radii.
-        assert!((k - 2.0 * 259.8076 / (128.0 * 1.5)).abs() < 1e-3, "{k}");
-        // ε does not move it; the viewport and the levels do.
-        for e in [0.5, 1.0, 4.0, 32.0] {
-            assert_eq!(auto_radii(&cam(e), 8), k);
+        for (recorded, pixels) in [(None, DEFAULT_SWITCH_PIXELS), (Some(2.25), 2.25)] {
+            let m = manifest(5.0, recorded);
+            assert_eq!(m.levels, 8);
+            let unit = forest_render::forms::switch_unit(&m);
+            // A tree of scale 2: crown radius 10 m, finest quads 20/128 m wide.
+            let forms = Hybrid::default().forms(&c);
+            let s = forms[0] + forms[1] * unit * 2.0;
+            let px = (20.0 / 128.0) * c.focal_pixels() / s;
+            assert!((px - pixels).abs() < 1e-4, "{px} against {pixels}");
+            assert!((s / 10.0 - auto_radii(&c, 8, pixels)).abs() < 1e-4);
+            // ε does not move it; the viewport does.
+            for e in [0.5, 1.0, 4.0, 32.0] {
+                assert_eq!(Hybrid::default().forms(&cam(e)), forms);
+            }
+            let mut wide = c;
+            wide.viewport = (800, 600);
+            assert!((Hybrid::default().forms(&wide)[1] - 2.0 * forms[1]).abs() < 1e-3);
         }
-        assert!((auto_radii(&c, 9) - k / 2.0).abs() < 1e-5);
-        let mut wide = c;
-        wide.viewport = (800, 600);
-        assert!((auto_radii(&wide, 8) - 2.0 * k).abs() < 1e-4);
+        // 400×300 at 60°: focal 259.8 px, so by default 2·259.8/(128·1.5) ≈ 2.71 crown radii.
+        let k = auto_radii(&c, 8, DEFAULT_SWITCH_PIXELS);
+        assert!((k - 2.0 * 259.8076 / (128.0 * 1.5)).abs() < 1e-3, "{k}");
+        assert!((auto_radii(&c, 9, DEFAULT_SWITCH_PIXELS) - k / 2.0).abs() < 1e-5);
     }
 
     #[test]
@@ -161,6 +193,6 @@ mod tests {
             near: Near::Metres(f32::INFINITY),
             ..Default::default()
         };
-        assert_eq!(inf.forms(&cam(1.0), 8), FORMS_GEOMETRY);
+        assert_eq!(inf.forms(&cam(1.0)), FORMS_GEOMETRY);
     }
 }

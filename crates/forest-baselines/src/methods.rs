@@ -154,17 +154,6 @@ impl ForestRenderer {
         Ok(())
     }
 
-    /// Hierarchy levels of the scene's coarsest species (its finest quads are the largest):
-    /// what [`Hybrid::forms`] needs for its automatic switch distance.
-    pub fn coarsest_levels(&self) -> u32 {
-        let t = &self.stream.scene.tables;
-        t.species
-            .iter()
-            .map(|s| s.levels)
-            .min()
-            .unwrap_or(t.max_levels)
-    }
-
     /// Write the camera and record one frame of the current method.
     pub fn encode(
         &mut self,
@@ -174,12 +163,11 @@ impl ForestRenderer {
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) -> Result<(), CameraError> {
-        let levels = self.coarsest_levels();
         match (self.method, &mut self.geometry) {
             (Method::Mesh(_), Some(g)) => g.encode(ctx, camera, encoder, colour, depth),
             (Method::Hybrid(h), Some(g)) => {
                 camera.validate()?;
-                let forms = h.forms(camera, levels);
+                let forms = h.forms(camera);
                 self.stream.set_forms(forms);
                 g.set_forms(forms);
                 self.stream.set_camera(ctx, camera)?;

@@ -43,6 +43,7 @@ fn geometry_structs_match_the_host() {
                 ("leaf_base", offset_of!(GpuGeoSpecies, leaf_base)),
                 ("r", offset_of!(GpuGeoSpecies, r)),
                 ("mean_leaf", offset_of!(GpuGeoSpecies, mean_leaf)),
+                ("switch_unit", offset_of!(GpuGeoSpecies, switch_unit)),
             ],
         ),
         (

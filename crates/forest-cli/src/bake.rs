@@ -59,6 +59,13 @@ pub struct BakeArgs {
     /// the system reports available).
     #[arg(long, value_name = "GIB")]
     pub memory_limit: Option<f64>,
+    /// Do not measure the hybrid method's switch distance. By default the bake renders the
+    /// new atlas against its model on the GPU (54 views of one tree, 400×300) to find where
+    /// the quad stream becomes as accurate as the triangles, and records it in the manifest;
+    /// without it (or without a GPU) the hybrid switches where the finest quads project to
+    /// 1.5 pixels.
+    #[arg(long)]
+    pub no_hybrid_switch: bool,
 }
 
 /// Arguments of `forest info`.
@@ -213,24 +220,50 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         check_output_file(p, "depth EXR")?;
     }
 
-    let bar = indicatif::ProgressBar::new(0);
-    if args.json {
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:40}] {pos}/{len} rows, {elapsed} elapsed, ~{eta} left",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
+    let bar = crate::progress::bar(
+        format!("tracing {}", args.model.display()),
+        "rows",
+        args.json,
     );
-    bar.set_message(format!("tracing {}", args.model.display()));
     let progress = |done: u64, total: u64| {
         bar.set_length(total);
         bar.set_position(done);
     };
-    let out = forest_bake::bake_file(&args.model, &params, &progress)?;
+    let mut out = forest_bake::bake_file(&args.model, &params, &progress)?;
     bar.finish_and_clear();
+
+    // Where the hybrid should switch this model to the quad stream, measured before the atlas
+    // is written so that it is written once, whole.
+    let mut ladder = Vec::new();
+    let mut switch_note = None;
+    if !args.no_hybrid_switch {
+        match crate::gpu_context() {
+            Ok(ctx) => {
+                let bar =
+                    crate::progress::bar("measuring the hybrid switch".into(), "views", args.json);
+                let progress = |done: u64, total: u64| {
+                    bar.set_length(total);
+                    bar.set_position(done);
+                };
+                let species = forest_render::scene::SpeciesData {
+                    layers: out.atlas.decode_layers(&args.output)?,
+                    atlas: out.atlas.clone(),
+                };
+                let (switch, rungs) = crate::switch::measure(&ctx, species, &args.model, &progress)
+                    .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
+                bar.finish_and_clear();
+                out.atlas.manifest.hybrid_switch = Some(switch);
+                ladder = rungs;
+            }
+            Err(e) => {
+                switch_note = Some(format!(
+                    "no GPU adapter ({e}): the hybrid switch was not measured, the hybrid \
+                     switches where the finest quads project to {} px",
+                    forest_render::forms::DEFAULT_SWITCH_PIXELS
+                ));
+            }
+        }
+    }
 
     let disk = out.atlas.save(&args.output)?;
     if let Some(p) = &args.contact_sheet {
@@ -264,7 +297,19 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         "nodes_per_level": m.nodes_per_level,
         "node_count": m.node_count,
         "bounding_radius": m.bounding_sphere.radius,
+        "hybrid_switch": m.hybrid_switch,
+        "hybrid_switch_ladder": ladder
+            .iter()
+            .map(|r| serde_json::json!({
+                "crown_radii": r.radii,
+                "flip_geometry": r.geometry,
+                "flip_quads": r.quads,
+            }))
+            .collect::<Vec<_>>(),
     });
+    if let Some(note) = &switch_note {
+        eprintln!("forest: note: {note}");
+    }
     if args.json {
         println!("{report}");
     } else {
@@ -302,6 +347,26 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             mb(out.atlas.alpha_file.len() as u64),
             mb(m.gpu_bytes())
         );
+        if let Some(h) = &m.hybrid_switch {
+            let d = &crate::switch::DISTANCES;
+            let (first, last) = (d[0], d[d.len() - 1]);
+            let (_, inside) = crate::switch::crossover(&ladder);
+            println!(
+                "  hybrid switch: the quad stream (ε {}) is as accurate as the triangles from {:.2} \
+                 crown radii{} (finest quads {:.2} px at {}x{}, {}°)",
+                h.epsilon,
+                h.crown_radii,
+                if inside {
+                    String::new()
+                } else {
+                    format!(", the end of the measured {first}-{last}")
+                },
+                h.finest_quad_pixels,
+                h.viewport[0],
+                h.viewport[1],
+                h.fov_y_deg
+            );
+        }
         if let Some(p) = &args.contact_sheet {
             println!("  contact sheet {}", p.display());
         }

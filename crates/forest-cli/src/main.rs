@@ -12,6 +12,7 @@ mod guard;
 mod progress;
 mod render;
 mod scene;
+mod switch;
 mod view;
 mod window;
 

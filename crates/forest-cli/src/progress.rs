@@ -18,6 +18,24 @@ pub fn spinner(what: String) -> ProgressBar {
     s
 }
 
+/// A bar saying `what` is under way, counting `unit` (hidden when `hidden`, e.g. for JSON
+/// output).
+pub fn bar(what: String, unit: &str, hidden: bool) -> ProgressBar {
+    let bar = ProgressBar::new(0);
+    if hidden {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{msg}} [{{bar:40}}] {{pos}}/{{len}} {unit}, {{elapsed}} elapsed, ~{{eta}} left"
+        ))
+        .expect("a valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_message(what);
+    bar
+}
+
 /// Upload a scene with a bar over its colour layers.
 pub fn upload(ctx: &GpuContext, species: &[SpeciesData], forest: &Forest) -> Result<GpuScene> {
     let format = crate::colour_format();

@@ -130,9 +130,10 @@ pub struct MethodArgs {
     #[arg(long)]
     pub far_slabs: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
-    /// geometry; `auto`: where the quad stream, out of levels, becomes less accurate than
-    /// the tree's triangles, i.e. where a tree's finest quads project longer than 1.5 px (it
-    /// follows each tree's size and the view, not ε).
+    /// geometry; `auto`: per species, where its quad stream becomes less accurate than its
+    /// triangles, i.e. where its finest quads project wider than the crossover its bake
+    /// measured (1.5 px for atlases baked without a GPU; it follows each tree's size and the
+    /// view, not ε).
     #[arg(long, default_value = "auto", value_parser = parse_near)]
     pub near: Near,
     /// Hybrid: width of the transition band, as a fraction of the switch distance (a tree
@@ -701,6 +702,7 @@ pub fn prepare_models(models: &[PathBuf], species: &[SpeciesData]) -> Result<Pre
             Ok(GeometrySpecies {
                 mesh: forest_bake::Mesh::load(m)?,
                 lighting: s.atlas.manifest.lighting,
+                switch_unit: forest_render::forms::switch_unit(&s.atlas.manifest),
             })
         })
         .collect::<Result<Vec<_>>>()?;

@@ -54,6 +54,7 @@ fn prepared() -> &'static PreparedGeometry {
         PreparedGeometry::new(&[GeometrySpecies {
             mesh: forest_bake::Mesh::load(&model()).unwrap(),
             lighting: atlases().0.manifest.lighting,
+            switch_unit: forest_render::forms::switch_unit(&atlases().0.manifest),
         }])
     })
 }

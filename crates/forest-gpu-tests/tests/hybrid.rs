@@ -6,14 +6,15 @@
 
 mod common;
 
-use forest_baselines::geometry::{GeometryRenderer, MeshMethod};
+use forest_baselines::geometry::{GeometryRenderer, MeshMethod, PreparedGeometry};
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
+use forest_format::atlas::HybridSwitch;
 use forest_format::forest::Forest;
 use forest_render::forms as hybrid;
 use forest_render::options::{Atmosphere, Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
-use forest_render::{Camera, GpuContext, GpuScene, QuadStream, reference};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream, SpeciesData, reference};
 use glam::Vec3;
 
 const WEIGHT_ONE: u32 = forest_render::gpu_types::WEIGHT_ONE;
@@ -35,7 +36,29 @@ fn renderer_in(
     background: Background,
     atmosphere: Atmosphere,
 ) -> ForestRenderer {
-    let scene = GpuScene::new(ctx, &common::species(), forest).unwrap();
+    let species = common::species();
+    renderer_of(
+        ctx,
+        &species,
+        common::prepared(),
+        forest,
+        viewport,
+        background,
+        atmosphere,
+    )
+}
+
+/// Both forms of `species` (and their geometry, `prepared`).
+fn renderer_of(
+    ctx: &GpuContext,
+    species: &[SpeciesData],
+    prepared: &PreparedGeometry,
+    forest: &Forest,
+    viewport: (u32, u32),
+    background: Background,
+    atmosphere: Atmosphere,
+) -> ForestRenderer {
+    let scene = GpuScene::new(ctx, species, forest).unwrap();
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         viewport,
@@ -43,7 +66,7 @@ fn renderer_in(
         atmosphere,
         ..Default::default()
     };
-    let geometry = GeometryRenderer::with_targets(ctx, common::prepared(), forest, &opts).unwrap();
+    let geometry = GeometryRenderer::with_targets(ctx, prepared, forest, &opts).unwrap();
     ForestRenderer::new(
         QuadStream::new(&ctx.device, scene, &opts).unwrap(),
         Some(geometry),
@@ -116,8 +139,9 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
 
-/// The tree's bounding sphere in the world (centre, crown radius), as the GPU computes it.
-fn tree_sphere(r: &ForestRenderer, instance: usize) -> (Vec3, f32) {
+/// The tree's bounding sphere in the world (centre, crown radius) and its switch unit (times
+/// its scale), as the GPU computes them.
+fn tree_sphere(r: &ForestRenderer, instance: usize) -> (Vec3, f32, f32) {
     let t = &r.stream.scene.tables;
     let inst = &t.instances[instance];
     let sp = &t.species[inst.species as usize];
@@ -127,13 +151,13 @@ fn tree_sphere(r: &ForestRenderer, instance: usize) -> (Vec3, f32) {
         c.y,
         -inst.sin_rot * c.x + inst.cos_rot * c.z,
     ) + Vec3::from_array(inst.position);
-    (c, sp.sphere[3] * inst.scale)
+    (c, sp.sphere[3] * inst.scale, sp.switch_unit * inst.scale)
 }
 
-/// The tree's distance from the eye and crown radius, as the GPU computes them.
+/// The tree's distance from the eye and switch unit, as the GPU computes them.
 fn tree_distance(r: &ForestRenderer, cam: &Camera, instance: usize) -> (f32, f32) {
-    let (c, radius) = tree_sphere(r, instance);
-    (cam.eye.distance(c), radius)
+    let (c, _, unit) = tree_sphere(r, instance);
+    (cam.eye.distance(c), unit)
 }
 
 #[test]
@@ -143,7 +167,7 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
         let forest = common::one_tree(species, 0.4);
         let mut r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
         let cam = common::camera(Vec3::new(2.0, 2.0, 9.0), Vec3::new(0.0, 2.0, 0.0), 2.0);
-        let (d, radius) = tree_distance(&r, &cam, 0);
+        let (d, unit) = tree_distance(&r, &cam, 0);
         let quads = frame(&ctx, &mut r, hybrid_at(0.0), &cam);
         let geometry = frame(&ctx, &mut r, hybrid_at(f32::INFINITY), &cam);
         // The band [d/1.4, d/1.4 · 1.8] puts the tree half-way through.
@@ -157,7 +181,7 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
         let Method::Hybrid(h) = method else {
             unreachable!()
         };
-        let share = hybrid::quad_share(h.forms(&cam, r.coarsest_levels()), d, radius, 0);
+        let share = hybrid::quad_share(h.forms(&cam), d, unit, 0);
         assert!(
             (1500..2600).contains(&share),
             "the tree is inside the band: share {share}"
@@ -215,45 +239,87 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
 fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera() {
     let ctx = common::ctx();
     let forest = common::forest(2000);
-    let mut r = renderer(&ctx, &forest, (160, 120), Background::Transparent);
-    let target = Target::new(&ctx, 160, 120);
+    // A switch in metres for every tree; then the automatic switch, per species, where the
+    // pine's atlas records a measured switch at finest quads of 0.8 px (farther than the
+    // default 1.5 px the bush keeps).
+    let mut species = common::species();
+    species[1].atlas.manifest.hybrid_switch = Some(HybridSwitch {
+        finest_quad_pixels: 0.8,
+        crown_radii: 0.0,
+        viewport: [160, 120],
+        fov_y_deg: 60.0,
+        epsilon: 2.0,
+        cameras: 1,
+    });
+    let atlases: Vec<_> = species.iter().map(|s| s.atlas.clone()).collect();
+    let measured = common::prepared_for(&atlases);
+    let default = hybrid::switch_unit(&common::atlases()[1].manifest);
+    let unit = hybrid::switch_unit(&species[1].atlas.manifest);
+    assert!((unit / default - hybrid::DEFAULT_SWITCH_PIXELS / 0.8).abs() < 1e-5);
+    for (near, species, prepared) in [
+        (Near::Metres(10.0), common::species(), common::prepared()),
+        (Near::Auto, species, &measured),
+    ] {
+        classification_matches(&ctx, &forest, &species, prepared, near);
+    }
+}
+
+/// The GPU's classification of `forest` under the hybrid with switch `near` equals the CPU
+/// mirror's, and a frame writes only the camera.
+fn classification_matches(
+    ctx: &GpuContext,
+    forest: &Forest,
+    species: &[SpeciesData],
+    prepared: &PreparedGeometry,
+    near: Near,
+) {
+    let mut r = renderer_of(
+        ctx,
+        species,
+        prepared,
+        forest,
+        (160, 120),
+        Background::Transparent,
+        Atmosphere::CLEAR,
+    );
+    let target = Target::new(ctx, 160, 120);
     let h = Hybrid {
-        near: Near::Metres(10.0),
+        near,
         band: 0.5,
         jitter: 0.3,
         ..Default::default()
     };
-    r.set_method(&ctx, Method::Hybrid(h)).unwrap();
+    r.set_method(ctx, Method::Hybrid(h)).unwrap();
     let before = r.uploads();
     let (mut both, mut frames) = (0, 0);
     for (name, cam) in common::cameras(forest.extent()) {
-        r.render_frame(&ctx, &cam, &target).unwrap();
+        r.render_frame(ctx, &cam, &target).unwrap();
         frames += 1;
-        let forms = h.forms(&cam, r.coarsest_levels());
+        let forms = h.forms(&cam);
         let mut g = cam.to_gpu();
         g.forms = forms;
         // Quads: the CPU reference skips the trees drawn as geometry alone.
         let cpu = reference::run(&r.stream.scene.tables, &g, r.stream.capacity.quads);
         assert!(
-            r.stream.read_quads(&ctx) == cpu.quads,
+            r.stream.read_quads(ctx) == cpu.quads,
             "{name}: the GPU stream differs from the reference"
         );
         // Geometry: the visible trees whose quad share is below one.
         let mut near = 0;
         let planes = g.planes;
         for i in 0..r.stream.scene.tables.instances.len() {
-            let (c, radius) = tree_sphere(&r, i);
+            let (c, radius, unit) = tree_sphere(&r, i);
             let d = cam.eye.distance(c);
             let visible = planes
                 .iter()
                 .all(|p| p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] >= -radius);
-            let share = hybrid::quad_share(forms, d, radius, i as u32);
+            let share = hybrid::quad_share(forms, d, unit, i as u32);
             if visible && share < WEIGHT_ONE {
                 near += 1;
                 both += u32::from(share > 0);
             }
         }
-        let stats = r.read_stats(&ctx);
+        let stats = r.read_stats(ctx);
         assert_eq!(
             stats.geometry_trees, near,
             "{name}: trees drawn as geometry"

@@ -13,8 +13,8 @@ struct Camera {
     viewport: vec4<f32>,
     // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
     planes: array<vec4<f32>, 6>,
-    // Which form draws each tree (the hybrid method, see quad_share): x metres + y crown
-    // radii = the switch distance; z: the transition band's width as a fraction of it;
+    // Which form draws each tree (the hybrid method, see quad_share): x metres + y focal
+    // pixels × the tree's switch unit = the switch distance; z: the transition band's width as a fraction of it;
     // w: the per-instance jitter of the band's start, a fraction of the switch distance.
     // (0, 0, ·, ·): every tree is drawn as quads; x ≥ 3e38: every tree as geometry.
     forms: vec4<f32>,
@@ -45,8 +45,10 @@ struct Species {
     lower_tri_count: u32,
     // Slab image side in texels.
     resolution: u32,
-    pad1: u32,
-    pad2: u32,
+    // The hybrid's switch unit: metres of switch distance per focal pixel at scale 1
+    // (forms::switch_unit).
+    switch_unit: f32,
+    pad: u32,
 }
 
 // One direction frame: dir, right, up (xyz of each), object space.
@@ -155,9 +157,10 @@ fn instance_hash(instance: u32) -> f32 {
 // from the end of its transition band on (quads only), and in between the fraction of its
 // pixels the quads draw. The band starts at s·(1 + jitter·h) with h the instance's hash, so
 // a ring of trees at one distance does not change form in the same frame, and is
-// band·start wide. `d`: eye to bounding-sphere centre, `radius`: the crown's radius (metres).
-fn quad_share(forms: vec4<f32>, d: f32, radius: f32, instance: u32) -> u32 {
-    let s = forms.x + forms.y * radius;
+// band·start wide. `d`: eye to bounding-sphere centre (metres), `unit`: the species' switch
+// unit times the tree's scale.
+fn quad_share(forms: vec4<f32>, d: f32, unit: f32, instance: u32) -> u32 {
+    let s = forms.x + forms.y * unit;
     if (s <= 0.0) { return WEIGHT_ONE; }
     if (s >= 3.0e38) { return 0u; }
     let start = s * (1.0 + forms.w * instance_hash(instance));

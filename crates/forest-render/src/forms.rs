@@ -11,6 +11,8 @@
 //! others, and its near trees are drawn by the geometry renderer with the same functions in
 //! `shaders/common.wgsl`.
 
+use forest_format::AtlasManifest;
+
 use crate::gpu_types::WEIGHT_ONE;
 
 /// `forms` of the quad stream on its own: every tree as quads.
@@ -29,13 +31,32 @@ pub fn instance_hash(instance: u32) -> f32 {
     (h >> 8) as f32 / 16_777_216.0
 }
 
+/// Where a model's atlas records no measured switch ([`forest_format::atlas::HybridSwitch`]), the hybrid switches
+/// where the model's finest quads project this many pixels (2.7 crown radii at 400×300, 60°
+/// and 8 levels).
+pub const DEFAULT_SWITCH_PIXELS: f32 = 1.5;
+
+/// A species' switch unit (metres per pixel of focal length, at tree scale 1): the width of
+/// its finest quads, `2R / 2^(levels−1)`, over the pixels they project to where the hybrid
+/// switches to them (the atlas's measured [`forest_format::atlas::HybridSwitch::finest_quad_pixels`], else
+/// [`DEFAULT_SWITCH_PIXELS`]). A tree of scale `k` seen with focal length `f` pixels switches
+/// at `f · k · unit` metres from its crown's centre.
+pub fn switch_unit(m: &AtlasManifest) -> f32 {
+    let finest = 2.0 * m.bounding_sphere.radius / (1u64 << (m.levels.clamp(1, 32) - 1)) as f32;
+    let pixels = m
+        .hybrid_switch
+        .map_or(DEFAULT_SWITCH_PIXELS, |h| h.finest_quad_pixels);
+    finest / pixels
+}
+
 /// The quad stream's share of a tree, in units of 1/[`WEIGHT_ONE`] (`quad_share` in
 /// `shaders/common.wgsl`, the same operations in the same order): 0 while the eye is nearer
-/// than the tree's switch distance `s = forms.x + forms.y · radius`, [`WEIGHT_ONE`] past its
+/// than the tree's switch distance `s = forms.x + forms.y · unit`, [`WEIGHT_ONE`] past its
 /// band `[start, start · (1 + forms.z)]` with `start = s · (1 + forms.w · hash)`, linear in
-/// between. `distance`: eye to the bounding-sphere centre; `radius`: the crown's (metres).
-pub fn quad_share(forms: [f32; 4], distance: f32, radius: f32, instance: u32) -> u32 {
-    let s = forms[0] + forms[1] * radius;
+/// between. `distance`: eye to the bounding-sphere centre (metres); `unit`: the species'
+/// [`switch_unit`] times the tree's scale.
+pub fn quad_share(forms: [f32; 4], distance: f32, unit: f32, instance: u32) -> u32 {
+    let s = forms[0] + forms[1] * unit;
     if s <= 0.0 {
         return WEIGHT_ONE;
     }
@@ -84,7 +105,7 @@ mod tests {
         assert_eq!(quad_share(forms, 15.0, 3.0, 7), WEIGHT_ONE);
         assert_eq!(quad_share(FORMS_QUADS, 0.0, 3.0, 7), WEIGHT_ONE);
         assert_eq!(quad_share(FORMS_GEOMETRY, 1e30, 3.0, 7), 0);
-        // Crown radii: 2 radii of a 3 m crown.
+        // Focal length times the tree's unit: 2 px × 3 m/px.
         assert_eq!(quad_share([0.0, 2.0, 0.0, 0.0], 5.9, 3.0, 7), 0);
         assert_eq!(quad_share([0.0, 2.0, 0.0, 0.0], 6.0, 3.0, 7), WEIGHT_ONE);
     }

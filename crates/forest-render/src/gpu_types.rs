@@ -18,8 +18,8 @@ pub struct GpuCamera {
     pub viewport: [f32; 4],
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],
-    /// Which form draws each tree (see [`crate::forms::quad_share`]): metres, crown radii,
-    /// band fraction, jitter fraction.
+    /// Which form draws each tree (see [`crate::forms::quad_share`]): metres, focal pixels
+    /// (times each tree's switch unit), band fraction, jitter fraction.
     pub forms: [f32; 4],
 }
 
@@ -68,8 +68,11 @@ pub struct GpuSpecies {
     pub lower_tri_count: u32,
     /// Slab image side in texels (the same for every species of a scene).
     pub resolution: u32,
+    /// The hybrid's switch unit ([`crate::forms::switch_unit`], metres per focal pixel at
+    /// scale 1).
+    pub switch_unit: f32,
     /// Padding to 16 bytes.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// A sampling direction's frame (48 bytes; `w` unused).

@@ -127,7 +127,7 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     if crate::forms::quad_share(
         cam.forms,
         xyz(cam.eye).distance(centre),
-        sp.sphere[3] * inst.scale,
+        sp.switch_unit * inst.scale,
         inst_id,
     ) == 0
     {

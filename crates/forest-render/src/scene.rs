@@ -99,7 +99,8 @@ impl SceneTables {
                 node_base,
                 lower_tri_count: m.lower_triangles.len() as u32,
                 resolution: m.params.resolution,
-                pad: [0; 2],
+                switch_unit: crate::forms::switch_unit(m),
+                pad: 0,
             });
             t.frames.extend(m.directions.iter().map(|f| GpuFrame {
                 dir: f.dir.extend(0.0).to_array(),

@@ -15,6 +15,9 @@ pub struct GeometrySpecies {
     pub mesh: Mesh,
     /// The lighting its atlas was baked with (so every method shades alike).
     pub lighting: Lighting,
+    /// The hybrid's switch unit of its atlas ([`forest_render::forms::switch_unit`]), so that
+    /// both forms agree where each tree switches (any value when the hybrid is not used).
+    pub switch_unit: f32,
 }
 
 /// Stochastic simplification parameters (Cook et al. 2007; seeds 000/001).

@@ -91,7 +91,8 @@ impl PreparedGeometry {
                 leaves: set.leaf_end.len() as u32,
                 leaf_base: leaf_end.len() as u32,
                 r: set.r,
-                mean_leaf: mean.extend(0.0).to_array(),
+                mean_leaf: mean.to_array(),
+                switch_unit: s.switch_unit,
             });
             leaf_end.extend(&set.leaf_end);
             leaf_centre.extend(set.leaf_centre.iter().map(|c| c.extend(0.0).to_array()));

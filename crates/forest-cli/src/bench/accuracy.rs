@@ -450,6 +450,7 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
         })
         .collect::<Vec<_>>()
         .join("; ");
+    let switches = b.switch_summary();
     let text = format!(
         "{trees} trees over {side:.0} m, {}x{}, transparent background (trees only). The \
          reference is full geometry supersampled 4×4; every other image is compared with it \
@@ -459,7 +460,8 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
          (nothing both faster and more accurate). On a CPU rasteriser full geometry and \
          stochastic simplification are timed over one frame. The hybrid draws trees nearer \
          than its switch distance as full geometry and the rest as the quad stream (`near=auto`: \
-         where a tree's finest quads project longer than 1.5 px, at every ε). The walkthrough \
+         per species, where its finest quads project to the width at which its bake measured \
+         the stream as accurate as the triangles, at every ε: {switches}). The walkthrough \
          view is the mean over {walk} seeded random eye-height cameras inside the forest (seed \
          {WALK_SEED:#x}; none rejected). Hybrid in the walkthrough, with its automatic switch: \
          {walk_ratio}.\n\nThe work charts put the same settings against the shader \

@@ -188,6 +188,32 @@ impl Bench {
             .fold(1.0, f32::max)
     }
 
+    /// The hybrid's automatic switch of each species, for the reports: the finest quads'
+    /// projected width there and, where the bake measured it, the crossover in crown radii
+    /// at the measurement's view.
+    pub fn switch_summary(&self) -> String {
+        self.species_paths
+            .iter()
+            .zip(&self.species)
+            .map(|(p, s)| {
+                let name = p.file_stem().map_or_else(String::new, |n| {
+                    n.to_string_lossy().trim_end_matches(".atlas").to_string()
+                });
+                match s.atlas.manifest.hybrid_switch {
+                    Some(h) => format!(
+                        "{name} {:.2} px ({:.2} crown radii at {}x{})",
+                        h.finest_quad_pixels, h.crown_radii, h.viewport[0], h.viewport[1]
+                    ),
+                    None => format!(
+                        "{name} {} px (not measured: the default)",
+                        forest_render::forms::DEFAULT_SWITCH_PIXELS
+                    ),
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The geometry methods' preparation of the species (once).
     pub fn prepared(&self) -> Result<&PreparedGeometry> {
         if let Some(p) = self.prepared.get() {

@@ -238,12 +238,13 @@ pub fn run(b: &Bench) -> Result<Section> {
          4×4 supersampled reference per frame; `flicker` is the method's mean frame-to-frame \
          FLIP minus the reference's over the same move (above 0: changes the reference does \
          not have); `pops` counts frames whose change exceeds the reference's by more than \
-         {POP_MARGIN}. The hybrid (near trees as full geometry, switch where a tree's finest \
-         quads project longer than 1.5 px, a dithered band jittered per tree) must add no pops at \
-         its switch. Worst case per method: quad stream {}; impostors {}; stochastic {}; LODs \
-         {}; hybrid {}.",
+         {POP_MARGIN}. The hybrid (near trees as full geometry, switch per species where its \
+         bake measured the stream as accurate as the triangles: {}; a dithered band jittered \
+         per tree) must add no pops at its switch. Worst case per method: quad stream {}; \
+         impostors {}; stochastic {}; LODs {}; hybrid {}.",
         viewport.0,
         viewport.1,
+        b.switch_summary(),
         worst("quads"),
         worst("impostor"),
         worst("stochastic"),

@@ -63,6 +63,43 @@ pub struct AtlasManifest {
     pub nodes_per_level: Vec<u64>,
     /// Total nodes.
     pub node_count: u64,
+    /// Where the hybrid method should switch this model from its triangles to the quad
+    /// stream, measured by `forest bake` on the GPU. Absent in atlases baked without a GPU
+    /// or before it was measured: the hybrid then uses its default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hybrid_switch: Option<HybridSwitch>,
+}
+
+/// Where the quad stream becomes as accurate as the model's own triangles (full geometry at
+/// 1×), both compared with 4×4 supersampled full geometry (mean FLIP over seeded cameras
+/// around one tree). The distance is stored as the size the finest quads project to there,
+/// `finest_quad_pixels`, which carries over to any viewport, field of view and tree size:
+/// at focal length `f` pixels a tree of crown radius `R` switches at
+/// `d = f · (2R / 2^(levels−1)) / finest_quad_pixels`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HybridSwitch {
+    /// Projected width (pixels) of the finest quads at the crossover; in
+    /// [`HybridSwitch::MIN_PIXELS`, `HybridSwitch::MAX_PIXELS`].
+    pub finest_quad_pixels: f32,
+    /// The crossover in crown radii from the crown's centre, at the viewport and field of
+    /// view it was measured with.
+    pub crown_radii: f32,
+    /// Viewport it was measured at (pixels).
+    pub viewport: [u32; 2],
+    /// Vertical field of view it was measured at (degrees).
+    pub fov_y_deg: f32,
+    /// ε of the quad stream it was measured at (pixels).
+    pub epsilon: f32,
+    /// Cameras per distance.
+    pub cameras: u32,
+}
+
+impl HybridSwitch {
+    /// Smallest accepted [`HybridSwitch::finest_quad_pixels`].
+    pub const MIN_PIXELS: f32 = 0.05;
+    /// Largest accepted [`HybridSwitch::finest_quad_pixels`].
+    pub const MAX_PIXELS: f32 = 64.0;
 }
 
 impl AtlasManifest {
@@ -194,6 +231,16 @@ impl AtlasManifest {
         if !lighting_ok {
             return bad("lighting has a non-finite value".into());
         }
+        if let Some(h) = &self.hybrid_switch {
+            let p = h.finest_quad_pixels;
+            if !(HybridSwitch::MIN_PIXELS..=HybridSwitch::MAX_PIXELS).contains(&p) {
+                return bad(format!(
+                    "hybrid_switch.finest_quad_pixels = {p}, outside [{}, {}]",
+                    HybridSwitch::MIN_PIXELS,
+                    HybridSwitch::MAX_PIXELS
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -240,5 +287,6 @@ pub fn manifest_for(
         node_count: nodes_per_level.iter().sum(),
         nodes_per_level,
         params,
+        hybrid_switch: None,
     }
 }

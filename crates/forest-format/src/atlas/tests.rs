@@ -119,6 +119,32 @@ fn the_loader_names_what_is_wrong() {
     reset();
     std::fs::remove_file(path.join(ALPHA_FILE)).unwrap();
     assert!(err(&path).contains(ALPHA_FILE), "{}", err(&path));
+    // A measured hybrid switch round-trips; one outside its range is named.
+    let mut measured = atlas.clone();
+    measured.manifest.hybrid_switch = Some(HybridSwitch {
+        finest_quad_pixels: 2.0,
+        crown_radii: 2.03,
+        viewport: [400, 300],
+        fov_y_deg: 60.0,
+        epsilon: 2.0,
+        cameras: 6,
+    });
+    measured.save(&path).unwrap();
+    assert_eq!(Atlas::load(&path).unwrap(), measured);
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(
+        &manifest,
+        text.replace(
+            "\"finest_quad_pixels\": 2.0",
+            "\"finest_quad_pixels\": -1.0",
+        ),
+    )
+    .unwrap();
+    assert!(
+        err(&path).contains("finest_quad_pixels = -1"),
+        "{}",
+        err(&path)
+    );
     assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
 }
 

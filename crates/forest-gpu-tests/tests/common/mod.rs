@@ -191,18 +191,23 @@ pub fn cameras(side: f32) -> Vec<(&'static str, Camera)> {
 /// The geometry methods' CPU preparation of bush and pine, lit as their test atlases.
 pub fn prepared() -> &'static forest_baselines::geometry::PreparedGeometry {
     static P: OnceLock<forest_baselines::geometry::PreparedGeometry> = OnceLock::new();
-    P.get_or_init(|| {
-        let species: Vec<forest_baselines::geometry::GeometrySpecies> = ["bush", "pine"]
-            .iter()
-            .zip(atlases())
-            .map(|(s, a)| forest_baselines::geometry::GeometrySpecies {
-                mesh: forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj")))
-                    .unwrap(),
-                lighting: a.manifest.lighting,
-            })
-            .collect();
-        forest_baselines::geometry::PreparedGeometry::new(&species)
-    })
+    P.get_or_init(|| prepared_for(atlases()))
+}
+
+/// The geometry methods' CPU preparation of bush and pine for `atlases` (their lighting and
+/// hybrid switch), not cached.
+pub fn prepared_for(atlases: &[Atlas]) -> forest_baselines::geometry::PreparedGeometry {
+    let species: Vec<forest_baselines::geometry::GeometrySpecies> = ["bush", "pine"]
+        .iter()
+        .zip(atlases)
+        .map(|(s, a)| forest_baselines::geometry::GeometrySpecies {
+            mesh: forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj")))
+                .unwrap(),
+            lighting: a.manifest.lighting,
+            switch_unit: forest_render::forms::switch_unit(&a.manifest),
+        })
+        .collect();
+    forest_baselines::geometry::PreparedGeometry::new(&species)
 }
 
 /// The tests' small view: a quad stream over `scene` for a 160×120 target refined down to

@@ -87,8 +87,8 @@ pub fn shared() -> Vec<Expect> {
                 ("node_base", offset_of!(GpuSpecies, node_base)),
                 ("lower_tri_count", offset_of!(GpuSpecies, lower_tri_count)),
                 ("resolution", offset_of!(GpuSpecies, resolution)),
-                ("pad1", offset_of!(GpuSpecies, pad)),
-                ("pad2", offset_of!(GpuSpecies, pad) + 4),
+                ("switch_unit", offset_of!(GpuSpecies, switch_unit)),
+                ("pad", offset_of!(GpuSpecies, pad)),
             ],
         ),
         (

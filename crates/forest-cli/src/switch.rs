@@ -1,0 +1,236 @@
+//! The hybrid's switch of one model, measured at bake: where its quad stream becomes as
+//! accurate as its own triangles.
+//!
+//! One tree (scale 1, unrotated) is seen from seeded random cameras at a ladder of distances
+//! from its crown's centre (in crown radii; azimuth uniform, elevation −20° to 40°, eyes kept
+//! 0.3 m above the ground, looking at the centre; 400×300, 60°, transparent background).
+//! Each view is drawn as full geometry at 1× and as the quad stream at ε 2, and both are
+//! compared (mean FLIP) with the 4×4 supersampled full geometry. The crossover is where the
+//! stream's mean error, minus the geometry's, first reaches zero (linear between the two
+//! distances around it); it is recorded as the width the finest quads project to there
+//! ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree size.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
+use forest_baselines::methods::{ForestRenderer, Method};
+use forest_format::atlas::HybridSwitch;
+use forest_format::forest::{Forest, Instance};
+use forest_format::generate::SplitMix64;
+use forest_render::options::{Background, RendererOptions};
+use forest_render::scene::SpeciesData;
+use forest_render::target::{TARGET_FORMAT, Target};
+use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+use glam::Vec3;
+
+/// Distances of the ladder, crown radii from the crown's centre.
+pub const DISTANCES: [f32; 9] = [1.25, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0];
+/// Seeded cameras per distance (the same directions at every distance).
+pub const CAMERAS: u32 = 6;
+/// Viewport of the measurement (pixels).
+pub const VIEWPORT: (u32, u32) = (400, 300);
+/// Vertical field of view (degrees).
+pub const FOV_Y_DEG: f32 = 60.0;
+/// The quad stream's ε (pixels).
+pub const EPSILON: f32 = 2.0;
+/// Supersampling of the reference, per axis.
+const REFERENCE_SS: u32 = 4;
+/// Seed of the camera directions.
+const SEED: u64 = 0x5717_c400;
+
+/// The mean FLIP of both forms at one distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rung {
+    /// Crown radii from the crown's centre.
+    pub radii: f32,
+    /// Full geometry at 1×.
+    pub geometry: f32,
+    /// The quad stream at [`EPSILON`].
+    pub quads: f32,
+}
+
+/// The crossover of a ladder (crown radii): where `quads − geometry` first reaches zero,
+/// linear between the rungs around it; the first rung when the stream is already the more
+/// accurate there, the last when it never is. The flag tells whether it lies inside the
+/// ladder.
+pub fn crossover(ladder: &[Rung]) -> (f32, bool) {
+    let Some(first) = ladder.first() else {
+        return (0.0, false);
+    };
+    let diff = |r: &Rung| r.quads - r.geometry;
+    if diff(first) <= 0.0 {
+        return (first.radii, false);
+    }
+    for w in ladder.windows(2) {
+        let (a, b) = (diff(&w[0]), diff(&w[1]));
+        if b <= 0.0 {
+            let t = a / (a - b);
+            return (w[0].radii + t * (w[1].radii - w[0].radii), true);
+        }
+    }
+    (ladder[ladder.len() - 1].radii, false)
+}
+
+/// The finest quads' projected width (pixels) at `radii` crown radii, for a hierarchy of
+/// `levels` levels at the measurement's view: `2 · focal / (2^(levels−1) · radii)`.
+pub fn finest_quad_pixels(levels: u32, radii: f32) -> f32 {
+    let focal = VIEWPORT.1 as f32 * 0.5 / (FOV_Y_DEG.to_radians() * 0.5).tan();
+    let finest = (1u64 << levels.clamp(1, 32).saturating_sub(1)) as f32;
+    2.0 * focal / (finest * radii)
+}
+
+/// Measure the switch of the model `model` baked into `species`; `progress(done, total)`
+/// counts the views. Returns the record and the ladder it came from.
+pub fn measure(
+    ctx: &GpuContext,
+    species: SpeciesData,
+    model: &Path,
+    progress: &dyn Fn(u64, u64),
+) -> Result<(HybridSwitch, Vec<Rung>)> {
+    let manifest = species.atlas.manifest.clone();
+    let sphere = manifest.bounding_sphere;
+    let forest = Forest::new(
+        vec!["measured".into()],
+        vec![Instance {
+            position: [0.0; 3],
+            rotation: 0.0,
+            scale: 1.0,
+            species: 0,
+        }],
+        1,
+    );
+    let prepared = PreparedGeometry::new(&[GeometrySpecies {
+        mesh: forest_bake::Mesh::load(model)
+            .with_context(|| format!("loading {} for the geometry", model.display()))?,
+        lighting: manifest.lighting,
+        switch_unit: forest_render::forms::switch_unit(&manifest),
+    }]);
+    let opts = RendererOptions {
+        format: TARGET_FORMAT,
+        viewport: VIEWPORT,
+        min_epsilon: EPSILON,
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let scene = GpuScene::with_format(ctx, &[species], &forest, crate::colour_format())?;
+    let stream = QuadStream::new(&ctx.device, scene, &opts)?;
+    let geometry = GeometryRenderer::with_targets(ctx, &prepared, &forest, &opts)?;
+    let mut r = ForestRenderer::new(stream, Some(geometry));
+    let small = Target::new(ctx, VIEWPORT.0, VIEWPORT.1);
+    let big = Target::new(ctx, VIEWPORT.0 * REFERENCE_SS, VIEWPORT.1 * REFERENCE_SS);
+    let full = Method::Mesh(MeshMethod::Full { depth_sort: true });
+
+    let mut rng = SplitMix64(SEED);
+    let directions: Vec<(f32, f32)> = (0..CAMERAS)
+        .map(|_| {
+            let azimuth = rng.next_f32() * std::f32::consts::TAU;
+            let elevation = (-20.0 + 60.0 * rng.next_f32()).to_radians();
+            (azimuth, elevation)
+        })
+        .collect();
+    let total = (DISTANCES.len() * directions.len()) as u64;
+    let mut ladder = Vec::with_capacity(DISTANCES.len());
+    for (i, &radii) in DISTANCES.iter().enumerate() {
+        let (mut g_sum, mut q_sum) = (0.0f32, 0.0f32);
+        for (j, &(azimuth, elevation)) in directions.iter().enumerate() {
+            let d = radii * sphere.radius;
+            let offset = Vec3::new(
+                elevation.cos() * azimuth.cos(),
+                elevation.sin(),
+                elevation.cos() * azimuth.sin(),
+            ) * d;
+            let mut eye = sphere.center + offset;
+            eye.y = eye.y.max(0.3);
+            let cam = Camera {
+                eye,
+                target: sphere.center,
+                fov_y_deg: FOV_Y_DEG,
+                near: 0.05,
+                far: d + 4.0 * sphere.radius,
+                viewport: VIEWPORT,
+                epsilon: EPSILON,
+            };
+            let mut cam_big = cam;
+            cam_big.viewport = (VIEWPORT.0 * REFERENCE_SS, VIEWPORT.1 * REFERENCE_SS);
+            r.set_method(ctx, full)?;
+            r.render_fitted(ctx, &cam_big, &big)?;
+            let reference = forest_baselines::geometry::downsample(&big.read(ctx), REFERENCE_SS);
+            r.render_fitted(ctx, &cam, &small)?;
+            let geometry = small.read(ctx);
+            r.set_method(ctx, Method::Quads)?;
+            r.render_fitted(ctx, &cam, &small)?;
+            let quads = small.read(ctx);
+            ctx.check_errors()?;
+            g_sum += forest_metrics::flip(&reference, &geometry)?.0;
+            q_sum += forest_metrics::flip(&reference, &quads)?.0;
+            progress((i * directions.len() + j + 1) as u64, total);
+        }
+        let n = directions.len() as f32;
+        ladder.push(Rung {
+            radii,
+            geometry: g_sum / n,
+            quads: q_sum / n,
+        });
+    }
+    let (radii, _) = crossover(&ladder);
+    let pixels = finest_quad_pixels(manifest.levels, radii)
+        .clamp(HybridSwitch::MIN_PIXELS, HybridSwitch::MAX_PIXELS);
+    Ok((
+        HybridSwitch {
+            finest_quad_pixels: pixels,
+            crown_radii: radii,
+            viewport: [VIEWPORT.0, VIEWPORT.1],
+            fov_y_deg: FOV_Y_DEG,
+            epsilon: EPSILON,
+            cameras: CAMERAS,
+        },
+        ladder,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rung(radii: f32, geometry: f32, quads: f32) -> Rung {
+        Rung {
+            radii,
+            geometry,
+            quads,
+        }
+    }
+
+    #[test]
+    fn the_crossover_is_where_the_stream_first_catches_up() {
+        // 0.02 worse at 2, 0.01 better at 3: a third of the way.
+        let ladder = [
+            rung(1.0, 0.10, 0.20),
+            rung(2.0, 0.05, 0.07),
+            rung(3.0, 0.03, 0.02),
+            rung(4.0, 0.01, 0.02),
+        ];
+        let (k, inside) = crossover(&ladder);
+        assert!((k - (2.0 + 2.0 / 3.0)).abs() < 1e-5, "{k}");
+        assert!(inside);
+        // Better from the first rung, or never: the ladder's ends, flagged.
+        assert_eq!(
+            crossover(&[rung(1.0, 0.2, 0.1), rung(2.0, 0.1, 0.2)]),
+            (1.0, false)
+        );
+        assert_eq!(
+            crossover(&[rung(1.0, 0.1, 0.2), rung(2.0, 0.1, 0.2)]),
+            (2.0, false)
+        );
+        assert_eq!(crossover(&[]), (0.0, false));
+    }
+
+    #[test]
+    fn finest_quads_at_the_crossover_follow_the_view_formula() {
+        // 400×300 at 60°: focal 259.81 px; 8 levels: finest quads 2R/128 wide.
+        let p = finest_quad_pixels(8, 2.0);
+        assert!((p - 2.0 * 259.8076 / (128.0 * 2.0)).abs() < 1e-3, "{p}");
+        assert!((finest_quad_pixels(9, 2.0) - p / 2.0).abs() < 1e-5);
+        assert!((finest_quad_pixels(8, 4.0) - p / 2.0).abs() < 1e-5);
+    }
+}
