@@ -14,9 +14,10 @@ species=()
 models=()
 for s in oak ash aspen pine bush; do
   atlas="out/atlases/$s.atlas"
-  # Cached: re-bake only when the model, its materials or textures are newer than the atlas.
+  # Cached: re-bake only when the model, its materials or textures are newer than the atlas,
+  # or the atlas predates the measured hybrid switch.
   if [ -f "$atlas/manifest.json" ] && [ -z "$(find "assets/trees/$s" -newer "$atlas/manifest.json" -type f)" ] \
-     && $forest info "$atlas" >/dev/null 2>&1; then
+     && grep -q '"hybrid_switch"' "$atlas/manifest.json" && $forest info "$atlas" >/dev/null 2>&1; then
     echo "cached: $atlas"
   else
     $forest bake "assets/trees/$s/$s.obj" -o "$atlas" --contact-sheet "out/contact/$s.png"

@@ -133,6 +133,13 @@ fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
     let v2: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
     assert_eq!(v2["node_count"], v["node_count"]);
     assert_eq!(v2["gpu_bytes"], v["gpu_bytes"]);
+    assert_eq!(v2["hybrid_switch"], v["hybrid_switch"]);
+    let text = forest(&["info", atlas.to_str().unwrap()]);
+    assert!(
+        String::from_utf8_lossy(&text.stdout).contains("hybrid switch: finest quads"),
+        "{}",
+        String::from_utf8_lossy(&text.stdout)
+    );
 }
 
 #[test]

@@ -389,6 +389,7 @@ pub fn info(args: &InfoArgs) -> Result<()> {
                 "node_count": m.node_count,
                 "gpu_bytes": m.gpu_bytes(),
                 "bounding_sphere": m.bounding_sphere,
+                "hybrid_switch": m.hybrid_switch,
             })
         );
     } else {
@@ -405,6 +406,16 @@ pub fn info(args: &InfoArgs) -> Result<()> {
             m.node_count,
             m.gpu_bytes() as f64 / 1e6
         );
+        match &m.hybrid_switch {
+            Some(h) => println!(
+                "  hybrid switch: finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°)",
+                h.finest_quad_pixels, h.crown_radii, h.viewport[0], h.viewport[1], h.fov_y_deg
+            ),
+            None => println!(
+                "  hybrid switch: not measured (the hybrid switches at finest quads of {} px)",
+                forest_render::forms::DEFAULT_SWITCH_PIXELS
+            ),
+        }
     }
     Ok(())
 }
