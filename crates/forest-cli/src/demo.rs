@@ -165,7 +165,15 @@ mod tests {
                 std::fs::copy(e.path(), d.join(e.file_name())).unwrap();
             }
         }
-        let small = ["--resolution", "32", "--directions", "3", "--spp", "1"];
+        let small = [
+            "--resolution",
+            "32",
+            "--directions",
+            "3",
+            "--spp",
+            "1",
+            "--no-hybrid-switch",
+        ];
         let stamp = |p: &Path| modified(p).unwrap();
         let demo = prepare_in(tmp.path(), &small).unwrap();
         assert_eq!(demo.models.len(), SPECIES.len());
