@@ -406,16 +406,7 @@ pub fn info(args: &InfoArgs) -> Result<()> {
             m.node_count,
             m.gpu_bytes() as f64 / 1e6
         );
-        match &m.hybrid_switch {
-            Some(h) => println!(
-                "  hybrid switch: finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°)",
-                h.finest_quad_pixels, h.crown_radii, h.viewport[0], h.viewport[1], h.fov_y_deg
-            ),
-            None => println!(
-                "  hybrid switch: not measured (the hybrid switches at finest quads of {} px)",
-                forest_render::forms::DEFAULT_SWITCH_PIXELS
-            ),
-        }
+        println!("  hybrid switch: {}", crate::switch::describe(m));
     }
     Ok(())
 }

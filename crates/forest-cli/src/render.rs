@@ -699,11 +699,10 @@ pub fn prepare_models(models: &[PathBuf], species: &[SpeciesData]) -> Result<Pre
         .iter()
         .zip(species)
         .map(|(m, s)| {
-            Ok(GeometrySpecies {
-                mesh: forest_bake::Mesh::load(m)?,
-                lighting: s.atlas.manifest.lighting,
-                switch_unit: forest_render::forms::switch_unit(&s.atlas.manifest),
-            })
+            Ok(GeometrySpecies::new(
+                forest_bake::Mesh::load(m)?,
+                &s.atlas.manifest,
+            ))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(PreparedGeometry::new(&geo_species))

@@ -14,6 +14,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
+use forest_baselines::hybrid::auto_radii;
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::atlas::HybridSwitch;
 use forest_format::forest::{Forest, Instance};
@@ -73,11 +74,34 @@ pub fn crossover(ladder: &[Rung]) -> (f32, bool) {
 }
 
 /// The finest quads' projected width (pixels) at `radii` crown radii, for a hierarchy of
-/// `levels` levels at the measurement's view: `2 · focal / (2^(levels−1) · radii)`.
+/// `levels` levels at the measurement's view: `2 · focal / (2^(levels−1) · radii)`, the
+/// relation [`auto_radii`] solves for the radii (crown radii × pixels is fixed).
 pub fn finest_quad_pixels(levels: u32, radii: f32) -> f32 {
-    let focal = VIEWPORT.1 as f32 * 0.5 / (FOV_Y_DEG.to_radians() * 0.5).tan();
-    let finest = (1u64 << levels.clamp(1, 32).saturating_sub(1)) as f32;
-    2.0 * focal / (finest * radii)
+    let view = Camera {
+        eye: Vec3::ZERO,
+        target: Vec3::NEG_Z,
+        fov_y_deg: FOV_Y_DEG,
+        near: 0.05,
+        far: 1.0,
+        viewport: VIEWPORT,
+        epsilon: EPSILON,
+    };
+    auto_radii(&view, levels, radii)
+}
+
+/// The hybrid's automatic switch of an atlas in words: the finest quads' width there and,
+/// where the bake measured it, the crossover in crown radii at the measurement's view.
+pub fn describe(m: &forest_format::AtlasManifest) -> String {
+    match &m.hybrid_switch {
+        Some(h) => format!(
+            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°)",
+            h.finest_quad_pixels, h.crown_radii, h.viewport[0], h.viewport[1], h.fov_y_deg
+        ),
+        None => format!(
+            "finest quads {} px (not measured: the default)",
+            forest_render::forms::DEFAULT_SWITCH_PIXELS
+        ),
+    }
 }
 
 /// Measure the switch of the model `model` baked into `species`; `progress(done, total)`
@@ -100,12 +124,9 @@ pub fn measure(
         }],
         1,
     );
-    let prepared = PreparedGeometry::new(&[GeometrySpecies {
-        mesh: forest_bake::Mesh::load(model)
-            .with_context(|| format!("loading {} for the geometry", model.display()))?,
-        lighting: manifest.lighting,
-        switch_unit: forest_render::forms::switch_unit(&manifest),
-    }]);
+    let mesh = forest_bake::Mesh::load(model)
+        .with_context(|| format!("loading {} for the geometry", model.display()))?;
+    let prepared = PreparedGeometry::new(&[GeometrySpecies::new(mesh, &manifest)]);
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         viewport: VIEWPORT,

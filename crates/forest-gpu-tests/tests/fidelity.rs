@@ -51,11 +51,10 @@ fn atlases() -> &'static (Atlas, Atlas) {
 fn prepared() -> &'static PreparedGeometry {
     static P: OnceLock<PreparedGeometry> = OnceLock::new();
     P.get_or_init(|| {
-        PreparedGeometry::new(&[GeometrySpecies {
-            mesh: forest_bake::Mesh::load(&model()).unwrap(),
-            lighting: atlases().0.manifest.lighting,
-            switch_unit: forest_render::forms::switch_unit(&atlases().0.manifest),
-        }])
+        PreparedGeometry::new(&[GeometrySpecies::new(
+            forest_bake::Mesh::load(&model()).unwrap(),
+            &atlases().0.manifest,
+        )])
     })
 }
 

@@ -110,16 +110,7 @@ impl GpuTerrain {
 /// The bind-group layout entry of the terrain's heights (binding 13, read in the vertex
 /// stage), in every draw group that draws the ground.
 pub fn heights_entry() -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding: HEIGHTS_BINDING,
-        visibility: wgpu::ShaderStages::VERTEX,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
+    crate::passes::draw::vertex_storage_entry(HEIGHTS_BINDING)
 }
 
 /// Binding of the terrain's heights in the draw groups (`shaders/environment.wgsl`).

@@ -20,6 +20,18 @@ pub struct GeometrySpecies {
     pub switch_unit: f32,
 }
 
+impl GeometrySpecies {
+    /// The model `mesh` of the species baked into the atlas of `manifest`: its lighting and
+    /// hybrid switch come from the atlas, so the geometry shades and switches as its quads do.
+    pub fn new(mesh: Mesh, manifest: &forest_format::AtlasManifest) -> Self {
+        Self {
+            mesh,
+            lighting: manifest.lighting,
+            switch_unit: forest_render::forms::switch_unit(manifest),
+        }
+    }
+}
+
 /// Stochastic simplification parameters (Cook et al. 2007; seeds 000/001).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stochastic {

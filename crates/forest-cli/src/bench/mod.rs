@@ -199,16 +199,7 @@ impl Bench {
                 let name = p.file_stem().map_or_else(String::new, |n| {
                     n.to_string_lossy().trim_end_matches(".atlas").to_string()
                 });
-                match s.atlas.manifest.hybrid_switch {
-                    Some(h) => format!(
-                        "{name} {:.2} px ({:.2} crown radii at {}x{})",
-                        h.finest_quad_pixels, h.crown_radii, h.viewport[0], h.viewport[1]
-                    ),
-                    None => format!(
-                        "{name} {} px (not measured: the default)",
-                        forest_render::forms::DEFAULT_SWITCH_PIXELS
-                    ),
-                }
+                format!("{name}: {}", crate::switch::describe(&s.atlas.manifest))
             })
             .collect::<Vec<_>>()
             .join(", ")

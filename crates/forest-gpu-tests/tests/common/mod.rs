@@ -200,11 +200,11 @@ pub fn prepared_for(atlases: &[Atlas]) -> forest_baselines::geometry::PreparedGe
     let species: Vec<forest_baselines::geometry::GeometrySpecies> = ["bush", "pine"]
         .iter()
         .zip(atlases)
-        .map(|(s, a)| forest_baselines::geometry::GeometrySpecies {
-            mesh: forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj")))
-                .unwrap(),
-            lighting: a.manifest.lighting,
-            switch_unit: forest_render::forms::switch_unit(&a.manifest),
+        .map(|(s, a)| {
+            forest_baselines::geometry::GeometrySpecies::new(
+                forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj"))).unwrap(),
+                &a.manifest,
+            )
         })
         .collect();
     forest_baselines::geometry::PreparedGeometry::new(&species)

@@ -7,13 +7,10 @@ use super::{args, draw_source};
 /// a host chooses its own in [`crate::options::RendererOptions`].
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
-/// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
-/// environment, layer roots, the frame's state (where the plain quads start), and the
-/// terrain's heights at [`crate::terrain::HEIGHTS_BINDING`].
-pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
+/// A read-only storage buffer at `binding`, read in the vertex stage (the scene tables, the
+/// stream and the terrain's heights).
+pub fn vertex_storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX,
         ty: wgpu::BindingType::Buffer {
@@ -22,7 +19,16 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             min_binding_size: None,
         },
         count: None,
-    };
+    }
+}
+
+/// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
+/// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
+/// environment, layer roots, the frame's state (where the plain quads start), and the
+/// terrain's heights at [`crate::terrain::HEIGHTS_BINDING`].
+pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let storage = vertex_storage_entry;
     let uniform = |binding| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: vf,
