@@ -60,9 +60,10 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
     ] {
         assert!(!header(f).is_empty(), "{f}");
     }
-    // Quick mode's fidelity variants: the baseline, one run-time swap and the paper's method.
+    // Quick mode's fidelity variants: the baseline, one run-time swap, the paper's method and
+    // the yardstick (full geometry at 1x).
     let fidelity = std::fs::read_to_string(results.join("fidelity.csv")).unwrap();
-    for v in ["baseline", "blend=dither", "paper"] {
+    for v in ["baseline", "blend=dither", "paper", "full geometry 1x"] {
         assert!(
             fidelity.lines().any(|l| l.starts_with(&format!("{v},"))),
             "{v}"

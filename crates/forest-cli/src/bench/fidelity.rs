@@ -1,11 +1,13 @@
 //! Fidelity: the quad stream's accuracy around single trees where people look — close up,
 //! under the crown, between sampling directions, far away — and the error split by swapping
-//! one factor of the bake or the runtime at a time (and the paper's method in one row).
+//! one factor of the bake or the runtime at a time (and the paper's method in one row), beside
+//! full geometry drawn at 1×, the yardstick of the stream's accuracy targets.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use forest_baselines::geometry::MeshMethod;
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::{DEFAULT_PRESORT_DIRECTIONS, Forest, Instance};
 use forest_format::generate::SplitMix64;
@@ -45,7 +47,12 @@ struct Variant {
     bake: Option<BakeChange>,
     options: StreamOptions,
     epsilon: f32,
+    /// Not the quad stream: full geometry at 1× (the yardstick of the stream's accuracy).
+    geometry: bool,
 }
+
+/// The yardstick row's name: full geometry at 1×, the same triangles as the reference.
+const GEOMETRY: &str = "full geometry 1x";
 
 fn variants(quick: bool) -> Vec<Variant> {
     let default = StreamOptions::default();
@@ -54,12 +61,18 @@ fn variants(quick: bool) -> Vec<Variant> {
         bake: None,
         options,
         epsilon: EPS,
+        geometry: false,
     };
     let baked = |name, bake: BakeChange| Variant {
         name,
         bake: Some(bake),
         options: default,
         epsilon: EPS,
+        geometry: false,
+    };
+    let geometry = Variant {
+        geometry: true,
+        ..runtime(GEOMETRY, default)
     };
     let paper = Variant {
         name: "paper",
@@ -76,6 +89,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             far_composite: false,
         },
         epsilon: EPS,
+        geometry: false,
     };
     let dither = runtime(
         "blend=dither",
@@ -85,7 +99,7 @@ fn variants(quick: bool) -> Vec<Variant> {
         },
     );
     if quick {
-        return vec![runtime("baseline", default), dither, paper];
+        return vec![runtime("baseline", default), dither, paper, geometry];
     }
     vec![
         runtime("baseline", default),
@@ -130,6 +144,16 @@ fn variants(quick: bool) -> Vec<Variant> {
             ..p
         }),
         baked("slabs=4", |p| BakeParams { slabs: 4, ..p }),
+        // Texels twice and four times as fine (4× and 16× the memory): whether the close-up
+        // error is the slab images' magnification.
+        baked("resolution=1024", |p| BakeParams {
+            resolution: 1024,
+            ..p
+        }),
+        baked("resolution=2048", |p| BakeParams {
+            resolution: 2048,
+            ..p
+        }),
         baked("lossless", |p| BakeParams {
             colour: ColourEncoding::Png,
             ..p
@@ -144,6 +168,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             ..p
         }),
         paper,
+        geometry,
     ]
 }
 
@@ -214,6 +239,31 @@ fn views(data: &SpeciesData, n: usize, viewport: (u32, u32), seed: u64) -> Vec<V
                 between,
             }
         })
+        .collect()
+}
+
+/// Relative change of the mean FLIP from the baseline's from which a variant is charted.
+const CHART_SHARE: f64 = 0.05;
+/// Bin edges of the distance chart (crown radii).
+const DISTANCE_BINS: [f64; 9] = [0.0, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0, 30.0, f64::INFINITY];
+/// Bin edges of the elevation chart (degrees).
+const ELEVATION_BINS: [f64; 11] = [
+    -90.0, -60.0, -45.0, -30.0, -15.0, 0.0, 15.0, 30.0, 45.0, 60.0, 90.0,
+];
+
+/// Points (x, y) averaged per bin `[edges[i], edges[i + 1])`: (mean x, mean y) of every bin
+/// that holds a point, in the edges' order.
+fn binned(points: impl Iterator<Item = (f64, f64)>, edges: &[f64]) -> Vec<(f64, f64)> {
+    let bins = edges.len().saturating_sub(1);
+    let mut sum = vec![(0.0, 0.0, 0u32); bins];
+    for (x, y) in points {
+        if let Some(i) = (0..bins).find(|&i| x >= edges[i] && x < edges[i + 1]) {
+            sum[i] = (sum[i].0 + x, sum[i].1 + y, sum[i].2 + 1);
+        }
+    }
+    sum.into_iter()
+        .filter(|s| s.2 > 0)
+        .map(|(x, y, n)| (x / f64::from(n), y / f64::from(n)))
         .collect()
 }
 
@@ -334,7 +384,9 @@ pub fn run(b: &Bench) -> Result<Section> {
                 let mut scratch_r;
                 let r = match v.bake {
                     None => {
-                        gpu_bytes[vi] += data.atlas.manifest.gpu_bytes();
+                        if !v.geometry {
+                            gpu_bytes[vi] += data.atlas.manifest.gpu_bytes();
+                        }
                         &mut r0
                     }
                     Some(change) => {
@@ -359,7 +411,11 @@ pub fn run(b: &Bench) -> Result<Section> {
                             });
                         match baked {
                             Ok((r, gpu)) => {
-                                bake_resolutions.push(params.resolution);
+                                // Rows that do not swap the resolution itself: bake at the
+                                // base's (below the given atlases' in quick mode).
+                                if params.resolution == base.resolution {
+                                    bake_resolutions.push(params.resolution);
+                                }
                                 gpu_bytes[vi] += gpu;
                                 scratch_r = r;
                                 &mut scratch_r
@@ -378,7 +434,12 @@ pub fn run(b: &Bench) -> Result<Section> {
                 for (ci, (view, rf)) in views.iter().zip(&refs).enumerate() {
                     let mut cam = view.cam;
                     cam.epsilon = v.epsilon;
-                    let (s, frame_ms) = b.measure(r, Method::Quads, &cam, &target, b.frames)?;
+                    let method = if v.geometry {
+                        Method::Mesh(MeshMethod::Full { depth_sort: true })
+                    } else {
+                        Method::Quads
+                    };
+                    let (s, frame_ms) = b.measure(r, method, &cam, &target, b.frames)?;
                     if s.overflow > 0 {
                         eprintln!(
                             "fidelity: {species} {} camera {ci}: {} quads overflowed",
@@ -473,25 +534,39 @@ pub fn run(b: &Bench) -> Result<Section> {
             cell(stats(vi, &|r| r.elevation_deg < 0.0), 5),
             cell(ratio, 3),
             cell(mean(mine.iter().map(|r| r.frame_ms)), 3),
-            format!("{:.2}", gpu_bytes[vi] as f64 / 1048576.0),
+            if v.geometry {
+                "-".into()
+            } else {
+                format!("{:.2}", gpu_bytes[vi] as f64 / 1048576.0)
+            },
         ]);
     }
     b.write("fidelity_summary.csv", &summary.csv())?;
     println!("{}", summary.markdown());
 
-    // Charts: FLIP against distance and elevation, one series per variant.
-    let series = |x: &dyn Fn(&Row) -> f64| -> Vec<Series> {
+    // Charts: mean FLIP per bin of distance and of elevation, one line per variant drawn
+    // (the baseline, the paper's method, the yardstick, and every row CHART_SHARE or more
+    // away from the baseline; the table has them all).
+    let drawn = |v: &Variant| {
+        matches!(v.name, "baseline" | "paper" | GEOMETRY)
+            || ratios
+                .iter()
+                .any(|r| r.0 == v.name && (r.2 - 1.0).abs() >= CHART_SHARE)
+    };
+    let series = |x: &dyn Fn(&Row) -> f64, edges: &[f64]| -> Vec<Series> {
         variants
             .iter()
             .enumerate()
-            .filter(|(vi, _)| rows.iter().any(|r| r.variant == *vi))
+            .filter(|&(vi, v)| drawn(v) && rows.iter().any(|r| r.variant == vi))
             .map(|(vi, v)| Series {
                 name: v.name.into(),
-                points: rows
-                    .iter()
-                    .filter(|r| r.variant == vi)
-                    .map(|r| (x(r), f64::from(r.flip)))
-                    .collect(),
+                points: binned(
+                    rows.iter()
+                        .filter(|r| r.variant == vi)
+                        .map(|r| (x(r), f64::from(r.flip))),
+                    edges,
+                ),
+                line: true,
                 ..Default::default()
             })
             .collect()
@@ -503,21 +578,21 @@ pub fn run(b: &Bench) -> Result<Section> {
     b.chart(
         "fidelity-distance",
         &Chart {
-            title: format!("Single-tree fidelity against distance ({what})"),
+            title: format!("Single-tree fidelity against distance ({what}; binned)"),
             x_label: "distance from the crown centre (crown radii)".into(),
             y_label: "mean FLIP against the reference".into(),
             log_x: true,
-            series: series(&|r| f64::from(r.distance_radii)),
+            series: series(&|r| f64::from(r.distance_radii), &DISTANCE_BINS),
             ..Default::default()
         },
     )?;
     b.chart(
         "fidelity-elevation",
         &Chart {
-            title: format!("Single-tree fidelity against elevation ({what})"),
+            title: format!("Single-tree fidelity against elevation ({what}; binned)"),
             x_label: "camera elevation seen from the crown centre (degrees)".into(),
             y_label: "mean FLIP against the reference".into(),
-            series: series(&|r| f64::from(r.elevation_deg)),
+            series: series(&|r| f64::from(r.elevation_deg), &ELEVATION_BINS),
             ..Default::default()
         },
     )?;
@@ -537,6 +612,35 @@ pub fn run(b: &Bench) -> Result<Section> {
         table: summary,
         charts: vec!["fidelity-distance".into(), "fidelity-elevation".into()],
     })
+}
+
+/// Summary rows `a` and `b` compared per bucket of cameras ("LABEL A against B", with the
+/// ratio A / B when `ratio`; over all cameras first when `ratio`); empty when either is missing.
+fn buckets(summary: &Table, a: &str, b: &str, ratio: bool) -> Vec<String> {
+    let row = |name: &str| summary.rows.iter().find(|r| r[0] == name);
+    let (Some(ra), Some(rb)) = (row(a), row(b)) else {
+        return Vec::new();
+    };
+    let all = [
+        (2, "over all cameras"),
+        (4, "under 2 radii"),
+        (5, "2–10 radii"),
+        (6, "beyond 10 radii"),
+        (7, "from below"),
+    ];
+    all.iter()
+        .skip(usize::from(!ratio))
+        .filter_map(|&(c, label)| {
+            let (x, y) = (ra[c].parse::<f64>().ok()?, rb[c].parse::<f64>().ok()?);
+            (y > 0.0).then(|| {
+                if ratio {
+                    format!("{label} {x:.4} against {y:.4} ({:.2}×)", x / y)
+                } else {
+                    format!("{label} {x:.4} against {y:.4}")
+                }
+            })
+        })
+        .collect()
 }
 
 /// The report's reading, from the measured figures.
@@ -593,7 +697,7 @@ fn paragraph(
             others.sort_by(|a, b| b.2.total_cmp(&a.2));
             let factors: Vec<String> = others
                 .iter()
-                .filter(|r| r.0 != "paper")
+                .filter(|r| r.0 != "paper" && r.0 != GEOMETRY)
                 .map(|&&(name, f, q)| {
                     let verdict = if q > 1.0 {
                         format!("{:.0} % more error than the baseline", (q - 1.0) * 100.0)
@@ -619,26 +723,25 @@ fn paragraph(
                     if q >= 1.0 { "less" } else { "more" }
                 );
                 // Where the two differ most: the buckets' ratios.
-                let row = |name: &str| summary.rows.iter().find(|r| r[0] == name);
-                if let (Some(p), Some(bl)) = (row("paper"), row("baseline")) {
-                    let buckets = [
-                        (4, "under 2 radii"),
-                        (5, "2–10 radii"),
-                        (6, "beyond 10 radii"),
-                        (7, "from below"),
-                    ];
-                    let parts: Vec<String> = buckets
-                        .iter()
-                        .filter_map(|&(c, label)| {
-                            let (x, y) = (p[c].parse::<f64>().ok()?, bl[c].parse::<f64>().ok()?);
-                            (y > 0.0).then(|| format!("{label} {x:.4} against {y:.4}"))
-                        })
-                        .collect();
-                    if !parts.is_empty() {
-                        let _ = write!(s, ": {}", parts.join(", "));
-                    }
+                let parts = buckets(summary, "paper", "baseline", false);
+                if !parts.is_empty() {
+                    let _ = write!(s, ": {}", parts.join(", "));
                 }
                 s += ". ";
+            }
+            // The yardstick: how far the stream is from the triangles drawn at 1×, per bucket.
+            let row = |name: &str| summary.rows.iter().find(|r| r[0] == name);
+            let parts = buckets(summary, "baseline", GEOMETRY, true);
+            if let (Some(g), Some(bl), false) = (row(GEOMETRY), row("baseline"), parts.is_empty()) {
+                let _ = write!(
+                    s,
+                    "Against full geometry drawn at 1× (the same triangles as the reference, \
+                     without its supersampling), the baseline's mean FLIP is {}; coverage IoU \
+                     {} against {}. ",
+                    parts.join(", "),
+                    bl[3],
+                    g[3]
+                );
             }
         }
         None => s += "The baseline was not measured. ",
@@ -658,4 +761,24 @@ fn paragraph(
         let _ = write!(s, "\n\nNot measured (failed): {}.", failed.join("; "));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn binned_averages_each_occupied_bin_and_drops_points_outside() {
+        let pts = [
+            (0.5, 1.0),
+            (0.7, 3.0),
+            (2.5, 5.0),
+            (9.0, 7.0),
+            (-1.0, 100.0),
+        ];
+        let got = binned(pts.into_iter(), &[0.0, 1.0, 2.0, 3.0, 10.0]);
+        // [0, 1): two points; [1, 2): empty, left out; [2, 3): one; [3, 10): one; −1 is outside.
+        assert_eq!(got, vec![(0.6, 2.0), (2.5, 5.0), (9.0, 7.0)]);
+        assert!(binned(pts.into_iter(), &[0.0]).is_empty());
+    }
 }
