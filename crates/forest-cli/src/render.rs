@@ -483,38 +483,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(m) = mesh_method {
         return render_geometry(args, m, &ctx, &forest, &species, &cameras);
     }
-    let (sw, sh) = stream_viewport(args);
     let mut stream = stream_for(args, &ctx, &species, &forest)?;
-    stream.set_options(args.m.stream_options());
     stream.set_pipeline_statistics(args.json);
-    let target = Target::new(&ctx, sw, sh);
-    for (name, cam) in &cameras {
-        let mut cam = *cam;
-        cam.viewport = (sw, sh);
-        let cam = &cam;
-        let stats = stream.render_fitted(&ctx, cam, &target)?;
-        let out = finish_view(&ctx, &target, args, name, cameras.len())?;
+    render_views(args, &ctx, &cameras, |cam, target| {
+        let stats = stream.render_fitted(&ctx, cam, target)?;
         let t = stats.times.unwrap_or_default();
-        if args.json {
-            println!(
-                "{}",
-                serde_json::json!({
-                    "view": name, "output": out.display().to_string(),
-                    "eye": cam.eye.to_array(), "target": cam.target.to_array(),
-                    "adapter": ctx.adapter_info.name,
-                    "visible_trees": stats.visible_trees, "quads": stats.quads,
-                    "composited_quads": stats.composites,
-                    "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
-                    "overflow_refine": stats.overflow_refine,
-                    "capacity_quads": stream.capacity.quads,
-                    "stream_bytes": stream.capacity.bytes(),
-                    "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
-                    "work": work_json(&stats.work),
-                })
-            );
-        } else {
-            println!(
-                "{name}: {} visible trees, {} quads ({} composited) {:?}, overflow {}/{}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms ({}) -> {}",
+        Ok(ViewReport {
+            json: serde_json::json!({
+                "visible_trees": stats.visible_trees, "quads": stats.quads,
+                "composited_quads": stats.composites,
+                "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
+                "overflow_refine": stats.overflow_refine,
+                "capacity_quads": stream.capacity.quads,
+                "stream_bytes": stream.capacity.bytes(),
+                "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+                "work": work_json(&stats.work),
+            }),
+            line: format!(
+                "{} visible trees, {} quads ({} composited) {:?}, overflow {}/{}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms",
                 stats.visible_trees,
                 stats.quads,
                 stats.composites,
@@ -524,6 +510,50 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 t.cull_ms,
                 t.refine_ms,
                 t.draw_ms,
+            ),
+        })
+    })
+}
+
+/// What one rendered view reports: its figures for `--json` (merged with the view's name,
+/// output, camera and adapter) and, without it, the middle of its line of text.
+struct ViewReport {
+    json: serde_json::Value,
+    line: String,
+}
+
+/// Render every camera through `frame` into one target of the rendered viewport (the
+/// output size times the supersampling), fail on any GPU error, save each view's PNG and
+/// print its report: one JSON line with `--json`, else `NAME: LINE (ADAPTER) -> OUTPUT`.
+fn render_views(
+    args: &RenderArgs,
+    ctx: &GpuContext,
+    cameras: &[(String, Camera)],
+    mut frame: impl FnMut(&Camera, &Target) -> Result<ViewReport>,
+) -> Result<()> {
+    let (sw, sh) = stream_viewport(args);
+    let target = Target::new(ctx, sw, sh);
+    for (name, cam) in cameras {
+        let mut cam = *cam;
+        cam.viewport = (sw, sh);
+        let report = frame(&cam, &target)?;
+        let out = finish_view(ctx, &target, args, name, cameras.len())?;
+        if args.json {
+            let mut json = serde_json::json!({
+                "view": name, "output": out.display().to_string(),
+                "eye": cam.eye.to_array(), "target": cam.target.to_array(),
+                "adapter": ctx.adapter_info.name,
+            });
+            if let (Some(all), serde_json::Value::Object(figures)) =
+                (json.as_object_mut(), report.json)
+            {
+                all.extend(figures);
+            }
+            println!("{json}");
+        } else {
+            println!(
+                "{name}: {} ({}) -> {}",
+                report.line,
                 ctx.adapter_info.name,
                 out.display()
             );
@@ -586,47 +616,32 @@ fn render_hybrid(
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
     r.set_pipeline_statistics(args.json);
-    let (sw, sh) = stream_viewport(args);
-    let target = Target::new(ctx, sw, sh);
-    for (name, cam) in cameras {
-        let mut cam = *cam;
-        cam.viewport = (sw, sh);
-        let stats = r.render_fitted(ctx, &cam, &target)?;
-        let out = finish_view(ctx, &target, args, name, cameras.len())?;
+    render_views(args, ctx, cameras, |cam, target| {
+        let stats = r.render_fitted(ctx, cam, target)?;
         let t = stats.times.unwrap_or_default();
         let quads: u32 = stats.per_level.iter().sum();
-        if args.json {
-            println!(
-                "{}",
-                serde_json::json!({
-                    "view": name, "output": out.display().to_string(),
-                    "eye": cam.eye.to_array(), "target": cam.target.to_array(),
-                    "adapter": ctx.adapter_info.name, "method": "hybrid",
-                    "visible_trees": stats.visible_trees,
-                    "geometry_trees": stats.geometry_trees, "quads": quads,
-                    "triangles": stats.primitives - u64::from(quads),
-                    "overflow": stats.overflow,
-                    "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
-                    "work": work_json(&stats.work),
-                })
-            );
-        } else {
-            println!(
-                "{name}: hybrid: {} visible trees, {} as geometry, {} quads + {} triangles, overflow {}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms ({}) -> {}",
+        let triangles = stats.primitives - u64::from(quads);
+        Ok(ViewReport {
+            json: serde_json::json!({
+                "method": "hybrid",
+                "visible_trees": stats.visible_trees,
+                "geometry_trees": stats.geometry_trees, "quads": quads,
+                "triangles": triangles,
+                "overflow": stats.overflow,
+                "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+                "work": work_json(&stats.work),
+            }),
+            line: format!(
+                "hybrid: {} visible trees, {} as geometry, {quads} quads + {triangles} triangles, overflow {}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms",
                 stats.visible_trees,
                 stats.geometry_trees,
-                quads,
-                stats.primitives - u64::from(quads),
                 stats.overflow,
                 t.cull_ms,
                 t.refine_ms,
                 t.draw_ms,
-                ctx.adapter_info.name,
-                out.display()
-            );
-        }
-    }
-    Ok(())
+            ),
+        })
+    })
 }
 
 /// What both forms draw into and over: the crate's own targets, the background and the
@@ -721,33 +736,19 @@ fn render_geometry(
     let prepared = prepare_models(&args.m.models, species)?;
     let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
-    let (sw, sh) = (
-        args.size.0 * args.supersample,
-        args.size.1 * args.supersample,
-    );
-    let target = Target::new(ctx, sw, sh);
-    for (name, cam) in cameras {
-        let mut cam = *cam;
-        cam.viewport = (sw, sh);
-        geo.render_frame(ctx, &cam, &target)?;
+    render_views(args, ctx, cameras, |cam, target| {
+        geo.render_frame(ctx, cam, target)?;
         let stats = geo.read_stats(ctx);
-        let out = finish_view(ctx, &target, args, name, cameras.len())?;
         let t = stats.times.unwrap_or_default();
-        if args.json {
-            println!(
-                "{}",
-                serde_json::json!({
-                    "view": name, "output": out.display().to_string(),
-                    "eye": cam.eye.to_array(), "target": cam.target.to_array(),
-                    "adapter": ctx.adapter_info.name, "method": args.m.method,
-                    "visible_trees": stats.visible_trees, "triangles": stats.triangles,
-                    "billboards": stats.billboards, "per_band": stats.per_band,
-                    "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
-                })
-            );
-        } else {
-            println!(
-                "{name}: {} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms ({}) -> {}",
+        Ok(ViewReport {
+            json: serde_json::json!({
+                "method": args.m.method,
+                "visible_trees": stats.visible_trees, "triangles": stats.triangles,
+                "billboards": stats.billboards, "per_band": stats.per_band,
+                "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
+            }),
+            line: format!(
+                "{} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms",
                 args.m.method,
                 args.supersample,
                 stats.visible_trees,
@@ -755,12 +756,9 @@ fn render_geometry(
                 stats.billboards,
                 t.cull_ms,
                 t.draw_ms,
-                ctx.adapter_info.name,
-                out.display()
-            );
-        }
-    }
-    Ok(())
+            ),
+        })
+    })
 }
 
 fn output_for(base: &Path, view: &str, views: usize) -> PathBuf {
