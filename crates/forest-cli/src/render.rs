@@ -531,7 +531,7 @@ fn render_views(
     cameras: &[(String, Camera)],
     mut frame: impl FnMut(&Camera, &Target) -> Result<ViewReport>,
 ) -> Result<()> {
-    let (sw, sh) = stream_viewport(args);
+    let (sw, sh) = rendered_viewport(args);
     let target = Target::new(ctx, sw, sh);
     for (name, cam) in cameras {
         let mut cam = *cam;
@@ -575,8 +575,8 @@ fn work_json(w: &forest_render::work::FrameWork) -> serde_json::Value {
     })
 }
 
-/// The viewport rendered (the image size times the supersampling).
-fn stream_viewport(args: &RenderArgs) -> (u32, u32) {
+/// The viewport every method renders at (the image size times the supersampling).
+fn rendered_viewport(args: &RenderArgs) -> (u32, u32) {
     (
         args.size.0 * args.supersample,
         args.size.1 * args.supersample,
@@ -593,7 +593,7 @@ fn stream_for(
     let scene = crate::progress::upload(ctx, species, forest)?;
     let opts = RendererOptions {
         min_epsilon: args.epsilon.min(8.0),
-        viewport: stream_viewport(args),
+        viewport: rendered_viewport(args),
         refine: args.m.method != "impostor",
         ..target_options(args)
     };
