@@ -1,15 +1,17 @@
 //! Ray tracing the slab images (layered depth images) of one model.
 //!
 //! For every direction, pixel and jittered sample, one ray enters the bounding sphere at its
-//! front (sphere depth 0) and runs along `−dir`. Its first solid hit in each slab is shaded
-//! (with an alpha-tested shadow ray towards the sun) and averaged into that slab's pixel:
-//! premultiplied colour = Σ radiance / spp, alpha = hits / spp, depth = mean sphere depth of
-//! the hits. Per sample the hits are opaque (alpha-tested), so front-to-back compositing within
+//! front (sphere depth 0) and runs along `−dir`. Its first solid hit in each slab gives what
+//! the run-time light needs, averaged into that slab's pixel: premultiplied albedo =
+//! Σ albedo / spp, alpha = hits / spp, depth = mean sphere depth of the hits, and the surface
+//! attributes (normal facing the ray, sky visibility from [`crate::sky`], translucency) as
+//! coverage-weighted means stored premultiplied. No light is traced. Per sample the hits are opaque (alpha-tested), so front-to-back compositing within
 //! a slab reduces to taking its first hit; partial coverage comes from the samples.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use forest_format::shading::{Lighting, srgb_decode_table, srgb_encode};
+use forest_format::shading::Surface;
+use forest_format::shading::{hemi_oct_encode, srgb_decode_table, srgb_encode};
 use forest_format::slab::{DirectionFrame, Sphere};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -23,8 +25,13 @@ pub struct SlabImages {
     pub resolution: u32,
     /// Number of layers.
     pub layers: u32,
-    /// RGBA8 per layer pixel: premultiplied, sRGB-encoded RGB; linear alpha.
+    /// RGBA8 per layer pixel: premultiplied, sRGB-encoded albedo; linear alpha.
     pub rgba: Vec<u8>,
+    /// RGBA8 per layer pixel, linear and premultiplied by the alpha: the hemispherical
+    /// octahedral code of the mean normal in the direction's frame
+    /// ([`forest_format::shading::hemi_oct_encode`]) in R and G, sky visibility in B,
+    /// translucency in A.
+    pub surface: Vec<u8>,
     /// Mean sphere depth of the hits per layer pixel, in `[0,1]` (0 where blank).
     pub depth: Vec<f32>,
 }
@@ -61,7 +68,7 @@ pub fn sample_offset(seed: u32, k: u32, spp: u32) -> Vec2 {
     }
 }
 
-/// What to trace: the framing sphere, the direction frames, the slab layout and the light.
+/// What to trace: the framing sphere, the direction frames and the slab layout.
 #[derive(Clone, Copy, Debug)]
 pub struct SlabSetup<'a> {
     /// The sphere every image frames.
@@ -74,8 +81,6 @@ pub struct SlabSetup<'a> {
     pub resolution: u32,
     /// Samples per pixel.
     pub spp: u32,
-    /// Lighting of the shading model.
-    pub lighting: Lighting,
 }
 
 /// Trace every layer. `progress(done, total)` is called as image rows complete.
@@ -90,27 +95,27 @@ pub fn trace_layers(
         slabs,
         resolution,
         spp,
-        ref lighting,
     } = *setup;
+    let sky = crate::sky::triangle_sky(scene);
     let sphere = &sphere;
     let r = resolution as usize;
     let layers = frames.len() as u32 * slabs;
     let total_rows = (frames.len() * r) as u64;
     let done = AtomicU64::new(0);
     let table = srgb_decode_table();
-    let eps = sphere.radius * 1e-5;
     let diameter = 2.0 * sphere.radius;
-    // One task per (direction, row); each returns `slabs` rows of colour and depth.
-    let rows: Vec<(Vec<[u8; 4]>, Vec<f32>)> = (0..frames.len() * r)
+    // One task per (direction, row); each returns `slabs` rows of colour, surface and depth.
+    let rows: Vec<(Vec<[u8; 4]>, Vec<[u8; 4]>, Vec<f32>)> = (0..frames.len() * r)
         .into_par_iter()
         .map(|task| {
             let (di, y) = (task / r, task % r);
             let frame = &frames[di];
             let mut rgba = vec![[0u8; 4]; slabs as usize * r];
+            let mut surface = vec![[0u8; 4]; slabs as usize * r];
             let mut depth = vec![0f32; slabs as usize * r];
-            let mut acc = vec![(Vec3::ZERO, 0u32, 0f32); slabs as usize];
+            let mut acc = vec![Acc::default(); slabs as usize];
             for x in 0..r {
-                acc.iter_mut().for_each(|a| *a = (Vec3::ZERO, 0, 0.0));
+                acc.iter_mut().for_each(|a| *a = Acc::default());
                 let seed = hash((di as u32) << 26 ^ (y as u32) << 13 ^ x as u32);
                 for k in 0..spp {
                     let off = sample_offset(seed, k, spp);
@@ -122,11 +127,14 @@ pub fn trace_layers(
                     while let Some(hit) = scene.closest(origin, dir, tmin, diameter) {
                         let d = hit.t / diameter;
                         let s = ((d * slabs as f32) as u32).min(slabs - 1);
-                        let radiance = shade_hit(scene, lighting, &table, &hit, origin, dir, eps);
+                        let hit_surface = surface_at(scene, &sky, &table, &hit, dir);
                         let a = &mut acc[s as usize];
-                        a.0 += radiance;
-                        a.1 += 1;
-                        a.2 += d;
+                        a.albedo += hit_surface.albedo;
+                        a.normal += hit_surface.normal;
+                        a.sky += hit_surface.sky_visibility;
+                        a.translucency += hit_surface.translucency;
+                        a.hits += 1;
+                        a.depth += d;
                         if s + 1 >= slabs {
                             break;
                         }
@@ -134,12 +142,12 @@ pub fn trace_layers(
                     }
                 }
                 for s in 0..slabs as usize {
-                    let (c, hits, dsum) = acc[s];
-                    if hits == 0 {
+                    let a = &acc[s];
+                    if a.hits == 0 {
                         continue;
                     }
-                    let alpha = hits as f32 / spp as f32;
-                    let colour = (c / spp as f32).min(Vec3::splat(alpha));
+                    let alpha = a.hits as f32 / spp as f32;
+                    let colour = (a.albedo / spp as f32).min(Vec3::splat(alpha));
                     let a8 = (alpha * 255.0).round() as u8;
                     rgba[s * r + x] = [
                         (srgb_encode(colour.x) * 255.0).round() as u8,
@@ -147,29 +155,41 @@ pub fn trace_layers(
                         (srgb_encode(colour.z) * 255.0).round() as u8,
                         a8,
                     ];
-                    depth[s * r + x] = dsum / hits as f32;
+                    // The mean normal in the direction's frame (z towards the viewer).
+                    let n = a.normal.try_normalize().unwrap_or(frame.dir);
+                    let local = Vec3::new(n.dot(frame.right), n.dot(frame.up), n.dot(frame.dir));
+                    let e = hemi_oct_encode(local);
+                    let hits = a.hits as f32;
+                    // Premultiplied by the stored alpha, never above it.
+                    let q = |v: f32| ((v.clamp(0.0, 1.0) * f32::from(a8)).round() as u8).min(a8);
+                    surface[s * r + x] =
+                        [q(e.x), q(e.y), q(a.sky / hits), q(a.translucency / hits)];
+                    depth[s * r + x] = a.depth / hits;
                 }
             }
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
             if n.is_multiple_of(64) || n == total_rows {
                 progress(n, total_rows);
             }
-            (rgba, depth)
+            (rgba, surface, depth)
         })
         .collect();
     let mut out = SlabImages {
         resolution,
         layers,
         rgba: vec![0; layers as usize * r * r * 4],
+        surface: vec![0; layers as usize * r * r * 4],
         depth: vec![0.0; layers as usize * r * r],
     };
-    for (task, (rgba, depth)) in rows.into_iter().enumerate() {
+    for (task, (rgba, surface, depth)) in rows.into_iter().enumerate() {
         let (di, y) = (task / r, task % r);
         for s in 0..slabs as usize {
             let layer = di * slabs as usize + s;
             let base = (layer * r + y) * r;
             for x in 0..r {
                 out.rgba[(base + x) * 4..(base + x) * 4 + 4].copy_from_slice(&rgba[s * r + x]);
+                out.surface[(base + x) * 4..(base + x) * 4 + 4]
+                    .copy_from_slice(&surface[s * r + x]);
                 out.depth[base + x] = depth[s * r + x];
             }
         }
@@ -177,16 +197,26 @@ pub fn trace_layers(
     out
 }
 
-/// Radiance of a hit seen along `dir`: the shading model of [`forest_format::shading`].
-fn shade_hit(
+/// One slab pixel's sums over its samples' hits.
+#[derive(Clone, Copy, Default)]
+struct Acc {
+    albedo: Vec3,
+    normal: Vec3,
+    sky: f32,
+    translucency: f32,
+    hits: u32,
+    depth: f32,
+}
+
+/// What the shading model needs of a hit seen along `dir`: albedo, the normal turned towards
+/// the viewer, the sky visibility of that side and the translucency.
+pub fn surface_at(
     scene: &Scene,
-    lighting: &Lighting,
+    sky: &[crate::sky::TriangleSky],
     table: &[f32; 256],
     hit: &crate::trace::Hit,
-    origin: Vec3,
     dir: Vec3,
-    eps: f32,
-) -> Vec3 {
+) -> Surface {
     let tri = &scene.tris[hit.tri as usize];
     let (b1, b2) = (hit.bary.x, hit.bary.y);
     let b0 = 1.0 - b1 - b2;
@@ -202,29 +232,12 @@ fn shade_hit(
         Some(t) => material.kd * scene.mesh.textures[t].linear_rgb(uv, table),
         None => material.kd,
     };
-    let p = origin + dir * hit.t;
-    // The shadow ray leaves from the side of the surface facing the sun.
-    let geo = (tri.p[1] - tri.p[0])
-        .cross(tri.p[2] - tri.p[0])
-        .normalize_or_zero();
-    let side = if geo.dot(lighting.sun_dir) >= 0.0 {
-        geo
-    } else {
-        -geo
-    };
-    let lit = !scene.occluded(
-        p + side * eps,
-        lighting.sun_dir,
-        eps,
-        f32::INFINITY,
-        hit.tri,
-    );
-    lighting.shade(
+    Surface {
         albedo,
-        n,
-        if lit { 1.0 } else { 0.0 },
-        material.translucency,
-    )
+        normal: n,
+        sky_visibility: crate::sky::sky_at(scene, sky, hit.tri, hit.bary, dir),
+        translucency: material.translucency,
+    }
 }
 
 #[cfg(test)]

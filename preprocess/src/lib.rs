@@ -14,6 +14,7 @@ pub mod ldi;
 pub mod lod;
 pub mod mesh;
 pub mod quadtree;
+pub mod sky;
 pub mod texture;
 pub mod trace;
 
@@ -122,14 +123,12 @@ pub fn bake_mesh(
         .iter()
         .map(|&d| forest_format::slab::DirectionFrame::new(d))
         .collect();
-    let lighting = params.lighting();
     let setup = ldi::SlabSetup {
         sphere,
         frames: &frames,
         slabs: params.slabs,
         resolution: params.resolution,
         spp: params.spp,
-        lighting,
     };
     let images = ldi::trace_layers(&scene, &setup, progress);
 
@@ -221,7 +220,12 @@ pub fn bake_mesh(
         count: params.layers(),
         rgba: images.rgba.clone(),
     };
-    let atlas = Atlas::from_layers(manifest, &layers, nodes)?;
+    let surface = Layers {
+        resolution: params.resolution,
+        count: params.layers(),
+        rgba: images.surface.clone(),
+    };
+    let atlas = Atlas::from_layers(manifest, &layers, &surface, nodes)?;
     Ok(BakeOutput {
         atlas,
         images,
@@ -253,14 +257,15 @@ pub fn write_depth_exr(path: &Path, out: &BakeOutput) -> Result<(), BakeError> {
 }
 
 /// One vertex of the full-geometry reference (48 bytes, as `GeoVertex` in
-/// `shaders/geometry.wgsl`): object-space position, sun visibility, normal, material, uv.
+/// `shaders/geometry_types.wgsl`): object-space position, sky visibility of both sides,
+/// normal (towards the front side), material, uv.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct RefVertex {
     /// Object-space position (metres).
     pub pos: [f32; 3],
-    /// Fraction of sun visibility traced at this corner, in `[0, 1]`.
-    pub sun_visibility: f32,
+    /// Sky visibility of the front side (the side `normal` faces) at this corner, `[0, 1]`.
+    pub sky_front: f32,
     /// Unit normal.
     pub normal: [f32; 3],
     /// Material index.
@@ -269,66 +274,39 @@ pub struct RefVertex {
     pub uv: [f32; 2],
     /// Leaf rank for stochastic simplification ([`lod::NONE`] when not a leaf, or unused).
     pub element: u32,
-    /// Padding.
-    pub pad: u32,
+    /// Sky visibility of the back side at this corner, `[0, 1]`.
+    pub sky_back: f32,
 }
 
-/// Per-vertex sun visibility for the full-geometry reference. Each triangle traces alpha-tested
-/// shadow rays from `SUN_SAMPLES` stratified points; points on transparent texels are skipped
-/// (the bake never shades them), and each corner gets the mean of the others weighted by its
-/// barycentric coordinate, so the interpolated visibility follows the shadows the bake traces
-/// per pixel. Non-indexed: three vertices per triangle.
-pub fn reference_vertices(
-    mesh: &Mesh,
-    lighting: &forest_format::shading::Lighting,
-) -> Vec<RefVertex> {
-    const SIDE: u32 = 4;
+/// The full-geometry reference's vertices: the model's triangles, non-indexed (three vertices
+/// per triangle, in the tracer's order), each corner with the sky visibility of both sides
+/// from [`sky::triangle_sky`], the same values the slab images are baked with. No light: the
+/// renderers light them at run time.
+pub fn reference_vertices(mesh: &Mesh) -> Vec<RefVertex> {
     let scene = trace::Scene::new(mesh);
-    let eps = bounding_sphere(mesh).radius * 1e-5;
-    let sun = lighting.sun_dir;
+    let sky = sky::triangle_sky(&scene);
     scene
         .tris
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(ti, t)| {
-            let geo = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalize_or_zero();
-            let side = if geo.dot(sun) >= 0.0 { geo } else { -geo };
-            let tested = mesh.materials[t.material as usize].alpha.is_some();
-            // Stratified points on the triangle (square → triangle warp), corner-weighted sums.
-            let (mut lit, mut weight) = ([0f32; 3], [0f32; 3]);
-            let (mut lit_all, mut weight_all) = ([0f32; 3], [0f32; 3]);
-            for s in 0..SIDE * SIDE {
-                let u = ((s % SIDE) as f32 + 0.5) / SIDE as f32;
-                let v = ((s / SIDE) as f32 + 0.5) / SIDE as f32;
-                let r = u.sqrt();
-                let b = [1.0 - r, r * (1.0 - v), r * v];
-                let p = t.p[0] * b[0] + t.p[1] * b[1] + t.p[2] * b[2];
-                let uv = t.uv[0] * b[0] + t.uv[1] * b[1] + t.uv[2] * b[2];
-                let seen = !scene.occluded(p + side * eps, sun, eps, f32::INFINITY, ti as u32);
-                let opaque = !tested || mesh.alpha(t.material, uv) >= mesh::ALPHA_CUTOFF;
-                for k in 0..3 {
-                    lit_all[k] += b[k] * f32::from(u8::from(seen));
-                    weight_all[k] += b[k];
-                    if opaque {
-                        lit[k] += b[k] * f32::from(u8::from(seen));
-                        weight[k] += b[k];
-                    }
-                }
-            }
+        .iter()
+        .zip(&sky)
+        .flat_map(|(t, s)| {
+            // Vertex normals turned to the front side, so that "the side the normal faces"
+            // is the front one on the GPU as in the bake.
+            let front = sky::front_normal(t);
             (0..3).map(move |k| {
-                let visibility = if weight[k] > 0.0 {
-                    lit[k] / weight[k]
+                let n = if t.n[k].dot(front) >= 0.0 {
+                    t.n[k]
                 } else {
-                    lit_all[k] / weight_all[k].max(1e-9)
+                    -t.n[k]
                 };
                 RefVertex {
                     pos: t.p[k].to_array(),
-                    sun_visibility: visibility,
-                    normal: t.n[k].to_array(),
+                    sky_front: s[0][k],
+                    normal: n.to_array(),
                     material: t.material,
                     uv: t.uv[k].to_array(),
                     element: lod::NONE,
-                    pad: 0,
+                    sky_back: s[1][k],
                 }
             })
         })

@@ -441,15 +441,11 @@ pub fn build_lods(vertices: &[RefVertex], leaf: &[bool], params: &LodParams) -> 
     set
 }
 
-/// Mean shaded colour (linear RGB) of a species' leaves, the `c̄` of contrast preservation:
-/// over the leaf triangles of `lod0` (area-weighted), the material's mean texture colour (over
-/// texels with alpha ≥ ½) × Kd, shaded with the per-vertex sun visibility and averaged over the
-/// two sides of the leaf. Black when there are no leaves.
-pub fn mean_leaf_colour(
-    mesh: &crate::Mesh,
-    lod0: &[RefVertex],
-    lighting: &forest_format::shading::Lighting,
-) -> Vec3 {
+/// Mean albedo (linear RGB) of a species' leaves, the `c̄` of contrast preservation (applied to
+/// the albedo, before the run-time light): over the leaf triangles of `lod0` (area-weighted),
+/// the material's mean texture colour (over texels with alpha ≥ ½) × Kd. Black when there are
+/// no leaves.
+pub fn mean_leaf_colour(mesh: &crate::Mesh, lod0: &[RefVertex]) -> Vec3 {
     let table = forest_format::shading::srgb_decode_table();
     let albedo: Vec<Vec3> = mesh
         .materials
@@ -477,23 +473,7 @@ pub fn mean_leaf_colour(
     for t in lod0.chunks_exact(3).filter(|t| t[0].element != NONE) {
         let p = [0, 1, 2].map(|k| Vec3::from_array(t[k].pos));
         let a = tri_area(&p);
-        let m = &mesh.materials[t[0].material as usize];
-        for v in t {
-            let n = Vec3::from_array(v.normal);
-            let c = 0.5
-                * (lighting.shade(
-                    albedo[v.material as usize],
-                    n,
-                    v.sun_visibility,
-                    m.translucency,
-                ) + lighting.shade(
-                    albedo[v.material as usize],
-                    -n,
-                    v.sun_visibility,
-                    m.translucency,
-                ));
-            sum += c * (a / 3.0);
-        }
+        sum += albedo[t[0].material as usize] * a;
         area += a;
     }
     if area > 0.0 { sum / area } else { Vec3::ZERO }
@@ -502,17 +482,22 @@ pub fn mean_leaf_colour(
 /// Elevations (degrees above the horizon) of the billboard images, seed 004's four.
 pub const BILLBOARD_ELEVATIONS: [f32; 4] = [0.0, 30.0, 60.0, 90.0];
 
-/// Billboard images of a model: one ray-traced view (the bake's tracer and shading, one slab)
-/// per [`BILLBOARD_ELEVATIONS`] entry, seen from azimuth +Z, framing the bounding sphere.
-/// Each is `resolution²` RGBA8 with straight alpha and sRGB colour; blank texels take the
-/// colour of the nearest covered one so filtering does not darken edges. Image x runs along
+/// A billboard's two images: albedo with coverage, and its surface attributes.
+pub struct BillboardImage {
+    /// RGBA8, straight alpha, sRGB albedo; blank texels take the colour of the nearest covered
+    /// one so filtering does not darken edges.
+    pub albedo: image::RgbaImage,
+    /// RGBA8, straight (not premultiplied), linear: the hemispherical octahedral code of the
+    /// normal in the image's frame in R and G ([`forest_format::shading::hemi_oct_encode`]),
+    /// sky visibility in B, translucency in A; dilated like the albedo.
+    pub surface: image::RgbaImage,
+}
+
+/// Billboard images of a model: one ray-traced view (the bake's tracer, one slab) per
+/// [`BILLBOARD_ELEVATIONS`] entry, seen from azimuth +Z, framing the bounding sphere, each
+/// `resolution²`. They hold no light: the renderer lights them at run time. Image x runs along
 /// the view frame's `right`, y down its `up` ([`forest_format::slab::DirectionFrame`]).
-pub fn billboard_images(
-    mesh: &crate::Mesh,
-    lighting: &forest_format::shading::Lighting,
-    resolution: u32,
-    spp: u32,
-) -> Vec<image::RgbaImage> {
+pub fn billboard_images(mesh: &crate::Mesh, resolution: u32, spp: u32) -> Vec<BillboardImage> {
     use forest_format::shading::{srgb_decode_table, srgb_encode};
     let scene = crate::trace::Scene::new(mesh);
     let frames: Vec<_> = BILLBOARD_ELEVATIONS
@@ -528,7 +513,6 @@ pub fn billboard_images(
         slabs: 1,
         resolution,
         spp,
-        lighting: *lighting,
     };
     let images = crate::ldi::trace_layers(&scene, &setup, &|_, _| {});
     let table = srgb_decode_table();
@@ -536,7 +520,8 @@ pub fn billboard_images(
     images
         .rgba
         .chunks_exact(4 * n)
-        .map(|layer| {
+        .zip(images.surface.chunks_exact(4 * n))
+        .map(|(layer, surface)| {
             // Unpremultiply in linear space.
             let mut img = image::RgbaImage::from_fn(resolution, resolution, |x, y| {
                 let i = 4 * (y * resolution + x) as usize;
@@ -550,7 +535,33 @@ pub fn billboard_images(
                 image::Rgba([c(p[0]), c(p[1]), c(p[2]), p[3]])
             });
             dilate_colour(&mut img);
-            img
+            // Unpremultiply the surface attributes (linear).
+            let mut surf = image::RgbaImage::from_fn(resolution, resolution, |x, y| {
+                let i = 4 * (y * resolution + x) as usize;
+                let a = layer[i + 3];
+                if a == 0 {
+                    return image::Rgba([0, 0, 0, 0]);
+                }
+                let c = |v: u8| ((f32::from(v) / f32::from(a)).min(1.0) * 255.0).round() as u8;
+                let p = &surface[i..i + 4];
+                image::Rgba([c(p[0]), c(p[1]), c(p[2]), c(p[3])])
+            });
+            // The dilation copies covered neighbours' values into blank texels; the coverage
+            // the shader reads is the albedo image's, so the surface's alpha channel (its
+            // translucency) is restored afterwards from the dilated copy of itself.
+            let keep_alpha: Vec<u8> = surf.pixels().map(|p| p[3]).collect();
+            let cover: Vec<u8> = img.pixels().map(|p| p[3]).collect();
+            for (p, &a) in surf.pixels_mut().zip(&cover) {
+                p[3] = a;
+            }
+            dilate_colour(&mut surf);
+            for ((p, &t), &a) in surf.pixels_mut().zip(&keep_alpha).zip(&cover) {
+                p[3] = if a > 0 { t } else { 0 };
+            }
+            BillboardImage {
+                albedo: img,
+                surface: surf,
+            }
         })
         .collect()
 }

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use forest_bake::{Mesh, ldi, trace::Scene};
-use forest_format::shading::{Lighting, srgb_decode, srgb_encode};
+use forest_format::shading::{hemi_oct_decode, srgb_decode, srgb_encode};
 use forest_format::slab::{DirectionFrame, Sphere};
 use forest_format::{Atlas, BakeParams, ColourEncoding};
 use glam::Vec3;
@@ -50,22 +50,23 @@ fn alpha_textured_quad_seen_head_on_covers_exactly_the_expected_pixels() {
         radius: 2.0,
     };
     let frames = [DirectionFrame::new(Vec3::Y)];
-    let lighting = Lighting::with_sun(0.0, 90.0);
     let setup = ldi::SlabSetup {
         sphere,
         frames: &frames,
         slabs: 1,
         resolution: 32,
         spp: 4,
-        lighting,
     };
     let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
-    // Expected colour: Kd 0.5 (sRGB) × white texture, facing the sun, lit, no translucency.
+    // Expected colour: the albedo, Kd 0.5 (sRGB) × white texture; no light is baked.
     let albedo = Vec3::splat(srgb_decode(0.5));
-    let radiance = lighting.shade(albedo, Vec3::Y, 1.0, 0.35);
-    let want = radiance
+    let want = albedo
         .to_array()
         .map(|c| (srgb_encode(c) * 255.0).round() as u8);
+    // Expected surface: the normal +Y is the frame's pole (code ½, ½), an isolated card sees
+    // all of its sky, and a leaf material's translucency.
+    let tau = forest_format::shading::LEAF_TRANSLUCENCY;
+    let want_surface = [128u8, 128, 255, (tau * 255.0).round() as u8];
     let frame = &frames[0];
     let mut covered = 0;
     for y in 0..32usize {
@@ -90,6 +91,7 @@ fn alpha_textured_quad_seen_head_on_covers_exactly_the_expected_pixels() {
                         "pixel ({x},{y}): {px:?} vs {want:?}"
                     );
                 }
+                assert_eq!(&img.surface[i * 4..i * 4 + 4], &want_surface, "({x},{y})");
                 assert!((img.depth[i] - 0.5).abs() < 1e-6, "depth {}", img.depth[i]);
             } else {
                 assert_eq!(px, &[0, 0, 0, 0], "pixel ({x},{y}) at {p} is blank");
@@ -100,52 +102,92 @@ fn alpha_textured_quad_seen_head_on_covers_exactly_the_expected_pixels() {
 }
 
 #[test]
-fn shadows_darken_a_card_under_another() {
-    // Two stacked horizontal squares, the lower one in the upper one's shadow (sun overhead).
+fn texel_normals_of_tilted_cards_match_the_geometry() {
+    // A square tilted by 30° about +X, seen from the zenith and from +Z: the decoded normal of
+    // every covered texel, in the direction's frame, is the card's normal turned towards the
+    // viewer.
     let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("two.obj");
+    let obj = dir.path().join("tilted.obj");
+    let (s, c) = (30f32.to_radians().sin(), 30f32.to_radians().cos());
     std::fs::write(
         &obj,
-        "v -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\n\
-         v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n\
-         f 1 2 3 4\nf 5 6 7 8\n",
+        format!(
+            "v -1 {y0} {z0}\nv 1 {y0} {z0}\nv 1 {y1} {z1}\nv -1 {y1} {z1}\nf 1 2 3 4\n",
+            y0 = -s,
+            z0 = c,
+            y1 = s,
+            z1 = -c
+        ),
     )
     .unwrap();
     let mesh = Mesh::load(&obj).unwrap();
     let scene = Scene::new(&mesh);
+    let normal = Vec3::new(0.0, c, s);
     let sphere = Sphere {
-        center: Vec3::new(0.0, 0.5, 0.0),
-        radius: 4.0,
+        center: Vec3::ZERO,
+        radius: 1.5,
     };
-    let lighting = Lighting::with_sun(0.0, 90.0);
-    // Two slabs seen from the zenith: the upper square in slab 0, the lower one in slab 1.
-    let frames = [DirectionFrame::new(Vec3::Y)];
-    let setup = ldi::SlabSetup {
-        sphere,
-        frames: &frames,
-        slabs: 2,
-        resolution: 16,
-        spp: 1,
-        lighting,
-    };
-    let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
-    let grey = Vec3::splat(0.5);
-    let lit = lighting.shade(grey, Vec3::Y, 1.0, 0.0);
-    let shadowed = lighting.shade(grey, Vec3::Y, 0.0, 0.0);
-    let enc = |v: Vec3| (srgb_encode(v.x) * 255.0).round() as u8;
-    let centre = 8 * 16 + 8;
-    let back = 16 * 16 + centre;
-    assert_eq!(img.rgba[centre * 4], enc(lit), "upper square lit");
-    assert_eq!(
-        img.rgba[back * 4],
-        enc(shadowed),
-        "lower square shadowed under it"
-    );
-    // Beside the upper square (pixel 5 is at x = -1.25 m) the lower square is lit.
-    let edge = 16 * 16 + 8 * 16 + 5;
-    assert_eq!(img.rgba[edge * 4], enc(lit));
-    // The lower square lies at sphere depth (4 - (0 - 0.5)) / 8 = 0.5625.
-    assert!((img.depth[back] - 0.5625).abs() < 1e-6);
+    for view in [Vec3::Y, Vec3::Z, Vec3::new(0.3, 0.5, -0.8).normalize()] {
+        let frames = [DirectionFrame::new(view)];
+        let setup = ldi::SlabSetup {
+            sphere,
+            frames: &frames,
+            slabs: 1,
+            resolution: 16,
+            spp: 1,
+        };
+        let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
+        let f = &frames[0];
+        let facing = if normal.dot(view) >= 0.0 {
+            normal
+        } else {
+            -normal
+        };
+        let want = Vec3::new(facing.dot(f.right), facing.dot(f.up), facing.dot(f.dir));
+        let mut covered = 0;
+        for p in img.surface.chunks_exact(4).zip(img.rgba.chunks_exact(4)) {
+            let (g, a) = (p.0, p.1[3]);
+            if a == 0 {
+                continue;
+            }
+            covered += 1;
+            let e = glam::Vec2::new(f32::from(g[0]), f32::from(g[1])) / f32::from(a);
+            let n = hemi_oct_decode(e);
+            assert!(n.dot(want) > 0.999, "view {view}: {n} vs {want}");
+            // An isolated card sees all of its sky.
+            assert_eq!(g[2], a);
+        }
+        assert!(covered > 20, "view {view}: {covered} texels");
+    }
+}
+
+#[test]
+fn sky_visibility_is_zero_inside_a_closed_box_and_one_outside() {
+    // A cube: each face's inner side sees only the cube, its outer side the whole sky.
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("cube.obj");
+    std::fs::write(
+        &obj,
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 5 8 4\nf 2 3 7 6\nf 1 2 6 5\nf 4 8 7 3\n",
+    )
+    .unwrap();
+    let mesh = Mesh::load(&obj).unwrap();
+    let scene = Scene::new(&mesh);
+    let sky = forest_bake::sky::triangle_sky(&scene);
+    assert_eq!(sky.len(), 12);
+    for (t, s) in scene.tris.iter().zip(&sky) {
+        let centre = (t.p[0] + t.p[1] + t.p[2]) / 3.0;
+        let front = forest_bake::sky::front_normal(t);
+        // The side facing the cube's centre is the inner one.
+        let (inner, outer) = if front.dot(centre) < 0.0 {
+            (s[0], s[1])
+        } else {
+            (s[1], s[0])
+        };
+        assert_eq!(inner, [0.0; 3], "inner side of {t:?}");
+        assert_eq!(outer, [1.0; 3], "outer side of {t:?}");
+    }
 }
 
 fn small_params() -> BakeParams {

@@ -2,12 +2,13 @@
 // geometry_types.wgsl; environment.wgsl follows (the sky, the ground
 // and the haze every fragment goes through).
 //
-// Meshes are shaded with the project's one shading model (forest_format::shading) in the
-// tree's object space — the bake's lighting rotates with the tree, so every method must too —
-// with per-vertex sun visibility traced by the bake's ray tracer. Under stochastic
-// simplification a leaf vertex is moved towards its leaf's centre by the fade × area factor
-// and the leaf's colour pulled towards the species' mean by √λ; at λ = 1 nothing is touched,
-// so the image is exactly the full geometry's.
+// Meshes are shaded with the project's one shading model (shade_light, forest_format::shading)
+// in world space under the frame's light (the camera uniform's): an instance's rotation turns
+// its normals, not the sun. Sky visibility is per vertex and per side, traced by the bake's
+// ray tracer (the values the slab images are baked with). Under stochastic simplification a
+// leaf vertex is moved towards its leaf's centre by the fade × area factor and the leaf's
+// albedo pulled towards the species' mean by √λ; at λ = 1 nothing is touched, so the image is
+// exactly the full geometry's.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -16,7 +17,9 @@
 @group(0) @binding(4) var<storage, read> materials: array<GeoMaterial>;
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 @group(0) @binding(6) var tex_sampler: sampler;
-@group(0) @binding(7) var<uniform> light: Light;
+// The billboards' surface attributes (hemispherical octahedral normal code in the image's
+// frame, sky visibility, translucency; straight, linear), layered as `billboards`.
+@group(0) @binding(7) var billboard_surface: texture_2d_array<f32>;
 // binding 8: the environment (environment.wgsl).
 @group(0) @binding(9) var<storage, read> geo_species: array<GeoSpecies>;
 @group(0) @binding(10) var<uniform> method: Method;
@@ -26,9 +29,11 @@
 struct GeoOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
+    // World space.
     @location(1) normal: vec3<f32>,
     @location(2) to_eye: vec3<f32>,
-    @location(3) sun_visibility: f32,
+    // Sky visibility of the front (x) and back (y) sides.
+    @location(3) sky: vec2<f32>,
     @location(4) @interpolate(flat) material: u32,
     // rgb: mean leaf colour; a: contrast weight α = √λ (1: untouched).
     @location(5) @interpolate(flat) contrast: vec4<f32>,
@@ -76,9 +81,9 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.world = w;
     out.uv = v.uv;
-    out.normal = v.normal;
-    out.to_eye = to_object_dir(inst, camera.eye.xyz - w);
-    out.sun_visibility = v.sun_visibility;
+    out.normal = to_world_dir(inst, v.normal);
+    out.to_eye = camera.eye.xyz - w;
+    out.sky = vec2<f32>(v.sky_front, v.sky_back);
     out.material = v.material;
     out.contrast = contrast;
     out.form = geo_form(id, inst);
@@ -96,14 +101,16 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
         if (m.alpha_tested != 0u && t.a < 0.5) { discard; }
         albedo = albedo * t.rgb;
     }
+    if (in.contrast.a < 1.0) {
+        albedo = in.contrast.rgb + in.contrast.a * (albedo - in.contrast.rgb);
+    }
     var n = normalize(in.normal);
-    if (dot(n, in.to_eye) < 0.0) { n = -n; }
-    let ndl = dot(n, light.sun_dir.xyz);
-    let direct = max(ndl, 0.0) + m.kd.a * max(-ndl, 0.0);
-    let hemi = 0.5 + 0.5 * n.y;
-    let ambient = light.sky.rgb * hemi + light.ground.rgb * (1.0 - hemi);
-    var c = albedo * (ambient + light.sun.rgb * (in.sun_visibility * direct));
-    if (in.contrast.a < 1.0) { c = in.contrast.rgb + in.contrast.a * (c - in.contrast.rgb); }
+    var sky = in.sky.x;
+    if (dot(n, in.to_eye) < 0.0) {
+        n = -n;
+        sky = in.sky.y;
+    }
+    let c = shade_light(albedo, n, 1.0, sky, m.kd.a);
     return hazed(vec4<f32>(c, 1.0), in.world);
 }
 
@@ -113,6 +120,10 @@ struct BillboardOut {
     @location(1) @interpolate(flat) layer: u32,
     @location(2) @interpolate(flat) form: vec2<u32>,
     @location(3) world: vec3<f32>,
+    // The billboard's frame (world): image x, image up, towards the viewer.
+    @location(4) @interpolate(flat) right: vec3<f32>,
+    @location(5) @interpolate(flat) up: vec3<f32>,
+    @location(6) @interpolate(flat) back: vec3<f32>,
 }
 
 // A camera-facing quad over the tree's bounding sphere showing the billboard image whose
@@ -143,6 +154,9 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.uv = vec2<f32>(0.5 + 0.5 * x, 0.5 - 0.5 * y);
     out.layer = sp.lod_first.w + e;
     out.form = geo_form(id, inst);
+    out.right = right;
+    out.up = up;
+    out.back = -f;
     return out;
 }
 
@@ -150,6 +164,9 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
 fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     if (quads_own(in.clip.xy, in.form)) { discard; }
     let t = textureSample(billboards, tex_sampler, in.uv, in.layer);
+    let g = textureSample(billboard_surface, tex_sampler, in.uv, in.layer);
     if (t.a < 0.5) { discard; }
-    return hazed(vec4<f32>(t.rgb, 1.0), in.world);
+    let local = hemi_oct_decode(g.xy);
+    let n = normalize(local.x * in.right + local.y * in.up + local.z * in.back);
+    return hazed(vec4<f32>(shade_light(t.rgb, n, 1.0, g.z, g.w), 1.0), in.world);
 }

@@ -6,13 +6,15 @@
 
 struct GeoVertex {
     pos: vec3<f32>,
-    sun_visibility: f32,
+    // Sky visibility of the side `normal` faces (the front) at this corner.
+    sky_front: f32,
     normal: vec3<f32>,
     material: u32,
     uv: vec2<f32>,
     // Leaf rank in the species' shuffled order; NONE for branches and LOD 1/2 vertices.
     element: u32,
-    pad: u32,
+    // Sky visibility of the back side.
+    sky_back: f32,
 }
 
 struct GeoMaterial {
@@ -22,13 +24,6 @@ struct GeoMaterial {
     layer: u32,
     alpha_tested: u32,
     pad: vec2<u32>,
-}
-
-struct Light {
-    sun_dir: vec4<f32>,
-    sun: vec4<f32>,
-    sky: vec4<f32>,
-    ground: vec4<f32>,
 }
 
 struct GeoSpecies {

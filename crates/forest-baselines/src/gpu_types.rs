@@ -66,17 +66,3 @@ pub struct GpuGeoMaterial {
     /// Padding.
     pub pad: [u32; 2],
 }
-
-/// The light of the geometry renderer (64 bytes; `Light`), linear RGB.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuLight {
-    /// Unit vector towards the sun.
-    pub sun_dir: [f32; 4],
-    /// Sun irradiance.
-    pub sun: [f32; 4],
-    /// Sky irradiance.
-    pub sky: [f32; 4],
-    /// Ground bounce.
-    pub ground: [f32; 4],
-}

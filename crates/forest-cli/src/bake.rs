@@ -37,9 +37,10 @@ pub struct BakeArgs {
     /// Jittered samples per pixel.
     #[arg(long, default_value_t = 4)]
     pub spp: u32,
-    /// Sun direction as AZIMUTH,ELEVATION in degrees (azimuth from +Z towards +X).
-    #[arg(long, default_value = "30,55", value_parser = parse_sun, allow_hyphen_values = true)]
-    pub sun: (f32, f32),
+    /// Refused: atlases store no light since format 3. The sun is chosen at run time
+    /// (`forest render --sun AZ,EL`, `forest view`, every bench).
+    #[arg(long, hide = true, allow_hyphen_values = true)]
+    pub sun: Option<String>,
     /// JPEG quality of the colour mosaic (1–100).
     #[arg(long, default_value_t = 80, conflicts_with = "lossless")]
     pub quality: u8,
@@ -78,23 +79,6 @@ pub struct InfoArgs {
     pub json: bool,
 }
 
-fn parse_sun(s: &str) -> Result<(f32, f32), String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let [az, el] = parts.as_slice() else {
-        return Err(format!(
-            "{s:?}: expected AZIMUTH,ELEVATION in degrees, e.g. 30,55"
-        ));
-    };
-    let num = |x: &str| {
-        x.trim()
-            .parse::<f32>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("{x:?} is not a finite number of degrees"))
-    };
-    Ok((num(az)?, num(el)?))
-}
-
 impl BakeArgs {
     fn params(&self) -> BakeParams {
         BakeParams {
@@ -109,8 +93,6 @@ impl BakeArgs {
             resolution: self.resolution,
             min_quad: self.min_quad,
             spp: self.spp,
-            sun_azimuth_deg: self.sun.0,
-            sun_elevation_deg: self.sun.1,
             colour: if self.lossless {
                 ColourEncoding::Png
             } else {
@@ -158,6 +140,12 @@ fn peak_resident() -> Option<u64> {
 
 /// Run `forest bake`.
 pub fn run(args: &BakeArgs) -> Result<()> {
+    if let Some(sun) = &args.sun {
+        bail!(
+            "--sun {sun}: atlases store no light since format 3, so the bake takes no sun; \
+             choose it at run time: `forest render --sun AZ,EL`, `forest view --sun AZ,EL`"
+        );
+    }
     let params = args.params();
     params.validate()?;
     if args.output.exists()
@@ -245,10 +233,8 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                     bar.set_length(total);
                     bar.set_position(done);
                 };
-                let species = forest_render::scene::SpeciesData {
-                    layers: out.atlas.decode_layers(&args.output)?,
-                    atlas: out.atlas.clone(),
-                };
+                let species =
+                    forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
                 let (switch, rungs) = crate::switch::measure(&ctx, species, &args.model, &progress)
                     .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
                 bar.finish_and_clear();

@@ -60,9 +60,58 @@ pub struct RenderArgs {
     pub haze_height: f32,
     #[command(flatten)]
     pub m: MethodArgs,
+    #[command(flatten)]
+    pub light: LightArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1)]
     pub supersample: u32,
+}
+
+/// The light every method shades with (shared by `forest render`, `forest view` and the
+/// benches): the sun's direction and the exposure. Nothing of it is baked.
+#[derive(clap::Args, Debug, Clone)]
+pub struct LightArgs {
+    /// Sun direction as AZIMUTH,ELEVATION in degrees (azimuth from +Z towards +X, elevation
+    /// 0 to 90 above the horizon).
+    #[arg(long, default_value = "30,55", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: (f32, f32),
+    /// Exposure: every radiance is scaled by it (above 0).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    pub exposure: f32,
+}
+
+impl LightArgs {
+    /// The light asked for, checked: the error names the bad value.
+    pub fn lighting(&self) -> Result<forest_format::shading::Lighting> {
+        let (az, el) = self.sun;
+        if !(0.0..=90.0).contains(&el) {
+            anyhow::bail!("--sun {az},{el}: the elevation must be 0 to 90 degrees");
+        }
+        let l = forest_format::shading::Lighting {
+            exposure: self.exposure,
+            ..forest_format::shading::Lighting::with_sun(az, el)
+        };
+        l.validate()
+            .map_err(|e| anyhow::anyhow!("--exposure {}: {e}", self.exposure))?;
+        Ok(l)
+    }
+}
+
+pub(crate) fn parse_sun(s: &str) -> Result<(f32, f32), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [az, el] = parts.as_slice() else {
+        return Err(format!(
+            "{s:?}: expected AZIMUTH,ELEVATION in degrees, e.g. 30,55"
+        ));
+    };
+    let num = |x: &str| {
+        x.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{x:?} is not a finite number of degrees"))
+    };
+    Ok((num(az)?, num(el)?))
 }
 
 /// The `--method` values.
@@ -426,6 +475,7 @@ fn hill_view(forest: &Forest) -> (Vec3, Vec3) {
 
 /// Run `forest render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    args.light.lighting()?;
     let mut views: Vec<(String, Vec3, Vec3)> = Vec::new();
     let (forest, species) = load_scene(&args.forest)?;
     for v in &args.views {
@@ -651,6 +701,8 @@ fn target_options(args: &RenderArgs) -> RendererOptions {
         format: TARGET_FORMAT,
         background: background(args),
         atmosphere: atmosphere(args),
+        // Checked in `run` before anything is loaded.
+        lighting: args.light.lighting().unwrap_or_default(),
         ..Default::default()
     }
 }

@@ -2,6 +2,7 @@
 //! `--path FILE --frames DIR`, a recorded camera path played back headless to numbered PNGs.
 //! Without a forest file it opens the bundled demo forest ([`crate::demo`]).
 
+use forest_format::shading::Lighting;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -51,6 +52,8 @@ pub struct ViewArgs {
     pub epsilon: f32,
     #[command(flatten)]
     pub m: MethodArgs,
+    #[command(flatten)]
+    pub light: crate::render::LightArgs,
 }
 
 fn parse_debug_view(s: &str) -> Result<DebugView, String> {
@@ -69,11 +72,12 @@ fn quad_stream(
     format: wgpu::TextureFormat,
     viewport: (u32, u32),
     min_epsilon: f32,
+    light: Lighting,
 ) -> Result<QuadStream> {
     let opts = RendererOptions {
         viewport,
         min_epsilon,
-        ..viewer_options(format)
+        ..viewer_options(format, light)
     };
     Ok(QuadStream::new(
         &ctx.device,
@@ -89,22 +93,24 @@ fn geometry(
     prepared: &PreparedGeometry,
     forest: &Forest,
     format: wgpu::TextureFormat,
+    light: Lighting,
 ) -> Result<GeometryRenderer> {
     Ok(GeometryRenderer::with_targets(
         ctx,
         prepared,
         forest,
-        &viewer_options(format),
+        &viewer_options(format, light),
     )?)
 }
 
 /// What both forms draw into and over in the viewer: `format` targets, the sky and ground, the
-/// demo's haze (one source, so that the hybrid's two forms always agree).
-fn viewer_options(format: wgpu::TextureFormat) -> RendererOptions {
+/// demo's haze, under `light` (one source, so that the hybrid's two forms always agree).
+fn viewer_options(format: wgpu::TextureFormat, light: Lighting) -> RendererOptions {
     RendererOptions {
         format,
         background: Background::Sky,
         atmosphere: Atmosphere::hazy(Atmosphere::DEMO_VISIBILITY),
+        lighting: light,
         ..Default::default()
     }
 }
@@ -112,6 +118,7 @@ fn viewer_options(format: wgpu::TextureFormat) -> RendererOptions {
 /// Far plane (metres): beyond the farthest tree from anywhere in the forest.
 /// Run `forest view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
+    let light = args.light.lighting()?;
     let mut args_models = args.m.clone();
     let forest_file = match &args.forest {
         Some(f) => f.clone(),
@@ -150,7 +157,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     crate::guard::extension(&args.record, "--record", "a camera path (JSON)", &["json"])?;
     crate::guard::not_in_atlas(&args.screenshots, "screenshot folder")?;
     let Some(frames) = &args.frames else {
-        return interactive(args, &forest_file, &args_models);
+        return interactive(args, &forest_file, &args_models, light);
     };
     let path_file = args
         .path
@@ -176,6 +183,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             &prepare_models(&args_models.models, &species)?,
             &forest,
             TARGET_FORMAT,
+            light,
         )?),
         None => None,
     };
@@ -187,6 +195,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             TARGET_FORMAT,
             args.size,
             args.epsilon,
+            light,
         )?,
         geometry,
     );
@@ -226,7 +235,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 }
 
 /// The window: walk through the forest with every method at hand.
-fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()> {
+fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Lighting) -> Result<()> {
     let (forest, species) = load_scene(forest_file)?;
     let mesh_method = m.checked_method(forest.species.len())?;
     let prepared = if m.models.is_empty() {
@@ -247,12 +256,12 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs) -> Result<()
     let forest = Rc::new(forest);
     let f = forest.clone();
     let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
-        quad_stream(ctx, &species, &f, format, viewport, eps)
+        quad_stream(ctx, &species, &f, format, viewport, eps, light)
     });
     let build_geometry: crate::window::BuildGeometry = Box::new(move |ctx, format| {
         prepared
             .as_ref()
-            .map(|p| geometry(ctx, p, &forest, format))
+            .map(|p| geometry(ctx, p, &forest, format, light))
             .transpose()
     });
     crate::window::Viewer::new(crate::window::Settings {

@@ -160,7 +160,7 @@ fn sky_ground_and_sun_have_their_analytic_colours() {
     let zenith = Vec3::from_array(atmosphere.zenith);
     let ground = |p: Vec3| {
         opts.lighting
-            .shade(ground_albedo(p.x, p.z), Vec3::Y, 1.0, 0.0)
+            .shade(ground_albedo(p.x, p.z), Vec3::Y, 1.0, 1.0, 0.0)
     };
     // Looking north, a little up: the ground in the lower rows, the sky above.
     let cam = camera(Vec3::new(3.0, 2.0, -4.0), Vec3::new(3.0, 2.5, 20.0));
@@ -458,11 +458,11 @@ fn a_planar_terrain_is_drawn_where_and_as_the_plane_is() {
     let normal = Vec3::new(-a, 1.0, -b).normalize();
     let slope = |p: Vec3| {
         opts.lighting
-            .shade(ground_albedo(p.x, p.z), normal, 1.0, 0.0)
+            .shade(ground_albedo(p.x, p.z), normal, 1.0, 1.0, 0.0)
     };
     let flat = |p: Vec3| {
         opts.lighting
-            .shade(ground_albedo(p.x, p.z), Vec3::Y, 1.0, 0.0)
+            .shade(ground_albedo(p.x, p.z), Vec3::Y, 1.0, 1.0, 0.0)
     };
     // From the south-west, above the slope, looking at its middle and past its east edge.
     let cam = Camera {

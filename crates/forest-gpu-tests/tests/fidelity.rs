@@ -114,10 +114,7 @@ fn render_quads(
     cam: &Camera,
 ) -> image::RgbaImage {
     let forest = one_pine();
-    let species = vec![SpeciesData {
-        layers: atlas.decode_layers(std::path::Path::new("test")).unwrap(),
-        atlas: atlas.clone(),
-    }];
+    let species = vec![SpeciesData::decode(atlas.clone(), std::path::Path::new("test")).unwrap()];
     let scene = GpuScene::new(ctx, &species, &forest).unwrap();
     let opts = RendererOptions {
         viewport: SIZE,

@@ -18,6 +18,41 @@ struct Camera {
     // w: the per-instance jitter of the band's start, a fraction of the switch distance.
     // (0, 0, ·, ·): every tree is drawn as quads; x ≥ 3e38: every tree as geometry.
     forms: vec4<f32>,
+    // The light (forest_format::shading::Lighting), world space, linear RGB. xyz: unit
+    // direction towards the sun; w: exposure.
+    sun: vec4<f32>,
+    // xyz: sun irradiance; w unused.
+    sun_colour: vec4<f32>,
+    // xyz: sky irradiance on a surface facing up; w unused.
+    sky_light: vec4<f32>,
+    // xyz: ground-bounce irradiance on a surface facing down; w unused.
+    ground_light: vec4<f32>,
+}
+
+// The project's one shading model (mirrors forest_format::shading::Lighting::shade): albedo
+// `a`, unit world normal `n` facing the viewer, sun visibility `v`, sky visibility `s`,
+// translucency `tau`, under the frame's light; linear RGB, exposure applied.
+fn shade_light(a: vec3<f32>, n: vec3<f32>, v: f32, s: f32, tau: f32) -> vec3<f32> {
+    let ndl = dot(n, camera.sun.xyz);
+    let direct = max(ndl, 0.0) + tau * max(-ndl, 0.0);
+    let hemi = 0.5 + 0.5 * n.y;
+    let ambient = (camera.sky_light.rgb * hemi + camera.ground_light.rgb * (1.0 - hemi)) * s;
+    return a * (ambient + camera.sun_colour.rgb * (v * direct)) * camera.sun.w;
+}
+
+// Object direction -> world direction (the instance's rotation about +Y).
+fn to_world_dir(inst: Instance, d: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(inst.cos_rot * d.x + inst.sin_rot * d.z, d.y,
+                     -inst.sin_rot * d.x + inst.cos_rot * d.z);
+}
+
+// Unit vector (z ≥ 0) of a hemispherical octahedral code (mirrors
+// forest_format::shading::hemi_oct_decode).
+fn hemi_oct_decode(e: vec2<f32>) -> vec3<f32> {
+    let a = e * 2.0 - 1.0;
+    let p = vec2<f32>(a.x + a.y, a.x - a.y) * 0.5;
+    let v = vec3<f32>(p.x, p.y, max(1.0 - abs(p.x) - abs(p.y), 0.0));
+    return v / max(length(v), 1e-6);
 }
 
 struct Instance {

@@ -1,8 +1,9 @@
 // Pass 3, draw: the environment (environment.wgsl), then every quad of the final stream becomes 4 vertices (a triangle strip, one
 // instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
 // the sampling frame of its direction and slab (object space), then the instance transform.
-// Textured from the colour array (premultiplied, sRGB-decoded by the format) and blended
-// colour = src + dst·(1 − src.a). A tree's 1–3 aspects combine by an ordered dither (each
+// Textured from the colour array (premultiplied albedo, sRGB-decoded by the format) and the
+// surface array (premultiplied normal code, sky visibility, translucency), lit by the frame's
+// light in world space (shade_light in common.wgsl), and blended colour = src + dst·(1 − src.a). A tree's 1–3 aspects combine by an ordered dither (each
 // pixel shows the aspect whose share [lo, hi) of the blend holds the pixel's threshold, so
 // coverage is the weighted mean of the aspects' coverages) or, without FLAG_DITHER, "over"
 // each other with alpha (hi − lo) / hi.
@@ -33,6 +34,8 @@
 @group(0) @binding(9) var<storage, read> roots: array<u32>;
 // The frame's counters: where the plain quads start in the stream.
 @group(0) @binding(10) var<storage, read> state: State;
+// Surface attributes, the colour array's layout (see forest_format::atlas).
+@group(0) @binding(11) var surface: texture_2d_array<f32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -56,6 +59,11 @@ struct VsOut {
     @location(8) @interpolate(flat) depths: vec4<f32>,
     // The quad's point (world, metres), for the haze.
     @location(9) world: vec3<f32>,
+    // The sampling direction's frame turned into world space (the instance's rotation): the
+    // axes the baked normal codes are relative to.
+    @location(10) @interpolate(flat) frame_right: vec3<f32>,
+    @location(11) @interpolate(flat) frame_up: vec3<f32>,
+    @location(12) @interpolate(flat) frame_dir: vec3<f32>,
 }
 
 // 1 inside a slab image, 0 outside (a shifted sample must not repeat the edge texels).
@@ -236,7 +244,22 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
     out.share = vec4<u32>(lo, hi, q.instance, form);
     out.level = quad_level(q);
     out.dir = dir;
+    out.frame_right = to_world_dir(inst, f.right.xyz);
+    out.frame_up = to_world_dir(inst, f.up.xyz);
+    out.frame_dir = to_world_dir(inst, f.dir.xyz);
     return out;
+}
+
+// The radiance of a texel (premultiplied albedo and coverage `c`, premultiplied surface `g`)
+// under the frame's light: premultiplied, linear.
+fn lit_texel(in: VsOut, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
+    if (c.a <= 0.0) { return vec4<f32>(0.0); }
+    let inv = 1.0 / c.a;
+    let local = hemi_oct_decode(g.xy * inv);
+    let n = normalize(local.x * in.frame_right + local.y * in.frame_up + local.z * in.frame_dir);
+    let sky = min(g.z * inv, 1.0);
+    let tau = min(g.w * inv, 1.0);
+    return vec4<f32>(shade_light(c.rgb * inv, n, 1.0, sky, tau) * c.a, c.a);
 }
 
 // Debug views (camera.viewport.z, see renderer::DebugView): 0 off, 1 levels, 2 blend weights,
@@ -264,22 +287,28 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 
 @fragment
 fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
-    return shade(in, textureSample(colour, colour_sampler, in.uv, in.layer));
+    let c = textureSample(colour, colour_sampler, in.uv, in.layer);
+    let g = textureSample(surface, colour_sampler, in.uv, in.layer);
+    return shade(in, lit_texel(in, c, g));
 }
 
 @fragment
 fn fs_composite(in: VsOut) -> @location(0) vec4<f32> {
     // The slabs "over" each other from the front (premultiplied), at the quad's mip level.
+    // Albedo and surface attributes are composited with the same weights, then lit once.
     var c = vec4<f32>(0.0);
+    var g = vec4<f32>(0.0);
     for (var k = 0u; k < in.slabs; k++) {
         let uv = slab_uv(in, k);
+        let w = inside_image(uv) * (1.0 - c.a);
         let b = textureSampleLevel(colour, colour_sampler, uv, in.layer + k, in.depths.w);
-        c = c + b * inside_image(uv) * (1.0 - c.a);
+        g = g + textureSampleLevel(surface, colour_sampler, uv, in.layer + k, in.depths.w) * w;
+        c = c + b * w;
     }
-    return shade(in, c);
+    return shade(in, lit_texel(in, c, g));
 }
 
-// A quad's fragment of colour `c` (premultiplied): the hybrid's and the dither's masks, the
+// A quad's fragment of lit colour `c` (premultiplied): the hybrid's and the dither's masks, the
 // debug views, the haze, the aspect's alpha.
 fn shade(in: VsOut, c: vec4<f32>) -> vec4<f32> {
     // Position inside the quad in quad widths and its screen derivative (before any branch).

@@ -13,16 +13,11 @@ struct Environment {
     horizon: vec4<f32>,
     // xyz: sky colour at the zenith; w: the haze's falloff per metre of height (0: uniform).
     zenith: vec4<f32>,
-    // xyz: unit direction towards the sun; w: cosine of the disc's radius (> 1: no disc).
+    // x: cosine of the sun disc's radius (> 1: no disc); yzw unused. The sun itself (its
+    // direction and colour) is the frame's light, in the camera.
     sun: vec4<f32>,
-    // xyz: the sun's colour; w unused.
-    sun_colour: vec4<f32>,
     // xyz: the ground's first albedo, soil; w unused.
     albedo: vec4<f32>,
-    // xyz: sky irradiance on a surface facing up; w unused.
-    sky_light: vec4<f32>,
-    // xyz: ground-bounce irradiance on a surface facing down; w unused.
-    ground_light: vec4<f32>,
     // x, y: world x and z of sample (0, 0); z: metres between samples; w: 1 with a terrain.
     terrain: vec4<f32>,
     // x, y: samples along x and z.
@@ -72,10 +67,10 @@ fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
 fn sky(d: vec3<f32>) -> vec3<f32> {
     let up = clamp(d.y, 0.0, 1.0);
     var c = mix(env.horizon.rgb, env.zenith.rgb, sqrt(up));
-    let s = dot(d, env.sun.xyz);
-    if (env.sun.w <= 1.0) {
-        c = c + env.sun_colour.rgb * (0.25 * pow(max(s, 0.0), 256.0));
-        if (s >= env.sun.w) { c = env.sun_colour.rgb * 1.5; }
+    let s = dot(d, camera.sun.xyz);
+    if (env.sun.x <= 1.0) {
+        c = c + camera.sun_colour.rgb * (0.25 * pow(max(s, 0.0), 256.0));
+        if (s >= env.sun.x) { c = camera.sun_colour.rgb * 1.5; }
     }
     return c;
 }
@@ -196,12 +191,9 @@ fn ground_albedo(xz: vec2<f32>) -> vec3<f32> {
 }
 
 // The ground at `world` with unit normal `n` under the shared shading model
-// (forest_format::shading: in sun, no translucency).
+// (forest_format::shading: in sun, open sky, no translucency).
 fn ground_shade(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let ndl = dot(n, env.sun.xyz);
-    let hemi = 0.5 + 0.5 * n.y;
-    let ambient = env.sky_light.rgb * hemi + env.ground_light.rgb * (1.0 - hemi);
-    return ground_albedo(world.xz) * (ambient + env.sun_colour.rgb * max(ndl, 0.0));
+    return shade_light(ground_albedo(world.xz), n, 1.0, 1.0, 0.0);
 }
 
 // The terrain, shaded as the plane is at its interpolated normal, then hazed.

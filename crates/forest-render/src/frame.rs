@@ -21,15 +21,21 @@ pub struct FrameParams {
     pub viewport: (u32, u32),
     /// Refinement threshold ε: a quad is refined while a projected edge is longer (pixels).
     pub epsilon: f32,
+    /// The frame's light: sun (world direction, colour), sky, ground and exposure. It rides in
+    /// the camera uniform, so the camera stays the frame's only upload.
+    pub light: forest_format::shading::Lighting,
 }
 
 impl From<&Camera> for FrameParams {
+    /// The camera's matrices with the default light ([`forest_format::shading::Lighting`]'s
+    /// `Default`).
     fn from(c: &Camera) -> Self {
         Self {
             view: c.view(),
             proj: c.proj(),
             viewport: c.viewport,
             epsilon: c.epsilon,
+            light: Default::default(),
         }
     }
 }
@@ -60,6 +66,9 @@ impl FrameParams {
         if !self.eye().is_finite() || !self.forward().is_finite() {
             return bad("the view matrix has no eye position (not invertible)");
         }
+        self.light
+            .validate()
+            .map_err(|e| CameraError(format!("light: {e}")))?;
         Ok(())
     }
 
@@ -82,15 +91,18 @@ impl FrameParams {
         self.proj.y_axis.y.abs() * self.viewport.1 as f32 * 0.5
     }
 
-    /// The GPU form (every tree drawn as quads; renderers set `forms`, debug view and flags).
+    /// The GPU form with the frame's light (every tree drawn as quads; renderers set `forms`,
+    /// debug view and flags).
     pub fn to_gpu(&self) -> GpuCamera {
-        gpu_camera(
+        let mut g = gpu_camera(
             self.proj * self.view,
             self.eye(),
             self.forward(),
             self.viewport,
             self.epsilon,
-        )
+        );
+        g.set_light(&self.light);
+        g
     }
 }
 
@@ -109,6 +121,7 @@ pub(crate) fn gpu_camera(
         viewport: [viewport.0 as f32, viewport.1 as f32, 0.0, 0.0],
         planes: frustum_planes(m),
         forms: crate::forms::FORMS_QUADS,
+        ..Default::default()
     }
 }
 
@@ -146,6 +159,7 @@ pub(crate) fn nothing_visible() -> GpuCamera {
         viewport: [1.0, 1.0, 0.0, 0.0],
         planes: [[0.0, 0.0, 0.0, -3.0e38]; 6],
         forms: crate::forms::FORMS_QUADS,
+        ..Default::default()
     }
 }
 
@@ -266,6 +280,7 @@ mod tests {
             proj,
             viewport: (800, 600),
             epsilon: 4.0,
+            light: Default::default(),
         };
         assert!(f.validate().is_ok());
         assert!((f.forward() - c.forward()).length() < 1e-5);
@@ -310,5 +325,21 @@ mod tests {
         let mut f = FrameParams::from(&cam());
         f.epsilon = 0.0;
         assert!(f.validate().unwrap_err().0.contains("epsilon"));
+        let mut f = FrameParams::from(&cam());
+        f.light.exposure = -1.0;
+        assert!(f.validate().unwrap_err().0.contains("exposure"));
+    }
+
+    #[test]
+    fn the_light_rides_in_the_camera_uniform() {
+        let mut f = FrameParams::from(&cam());
+        f.light = forest_format::shading::Lighting::with_sun(90.0, 0.0);
+        f.light.exposure = 2.0;
+        let g = f.to_gpu();
+        assert!((Vec3::from_slice(&g.sun[..3]) - Vec3::X).length() < 1e-6);
+        assert_eq!(g.sun[3], 2.0);
+        assert_eq!(g.sky_light[..3], f.light.sky.to_array());
+        assert_eq!(g.ground_light[..3], f.light.ground.to_array());
+        assert_eq!(g.sun_colour[..3], f.light.sun.to_array());
     }
 }

@@ -3,7 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// The camera: the only data written to the GPU per frame (224 bytes).
+/// The camera and the frame's light: the only data written to the GPU per frame (288 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuCamera {
@@ -21,6 +21,25 @@ pub struct GpuCamera {
     /// Which form draws each tree (see [`crate::forms::quad_share`]): metres, focal pixels
     /// (times each tree's switch unit), band fraction, jitter fraction.
     pub forms: [f32; 4],
+    /// Unit direction towards the sun (world) and, in `w`, the exposure.
+    pub sun: [f32; 4],
+    /// Sun irradiance, linear RGB (`w` unused).
+    pub sun_colour: [f32; 4],
+    /// Sky irradiance on a surface facing up, linear RGB (`w` unused).
+    pub sky_light: [f32; 4],
+    /// Ground-bounce irradiance on a surface facing down, linear RGB (`w` unused).
+    pub ground_light: [f32; 4],
+}
+
+impl GpuCamera {
+    /// Write the frame's light into the camera.
+    pub fn set_light(&mut self, l: &forest_format::shading::Lighting) {
+        let d = l.sun_dir.normalize_or(glam::Vec3::Y);
+        self.sun = [d.x, d.y, d.z, l.exposure];
+        self.sun_colour = l.sun.extend(0.0).to_array();
+        self.sky_light = l.sky.extend(0.0).to_array();
+        self.ground_light = l.ground.extend(0.0).to_array();
+    }
 }
 
 /// A tree instance on the GPU (32 bytes).
@@ -232,17 +251,11 @@ pub struct GpuEnvironment {
     /// Sky colour at the zenith (linear RGB); `w`: the haze's falloff per metre of height
     /// (0: homogeneous).
     pub zenith: [f32; 4],
-    /// Unit direction towards the sun (world); `w`: cosine of the disc's angular radius (above
-    /// 1: no disc).
+    /// `x`: cosine of the sun disc's angular radius (above 1: no disc); `yzw` unused. The
+    /// sun's direction and colour are the frame's light, in [`GpuCamera`].
     pub sun: [f32; 4],
-    /// The sun's colour (linear RGB); `w` unused.
-    pub sun_colour: [f32; 4],
     /// The ground's first albedo, soil (linear RGB); `w` unused.
     pub albedo: [f32; 4],
-    /// Sky irradiance on a surface facing up (linear RGB); `w` unused.
-    pub sky_light: [f32; 4],
-    /// Ground-bounce irradiance on a surface facing down (linear RGB); `w` unused.
-    pub ground_light: [f32; 4],
     /// The terrain's grid: world x and z of sample (0, 0), metres between samples, and 1 when
     /// there is a terrain (0: flat ground only).
     pub terrain: [f32; 4],

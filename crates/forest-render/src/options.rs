@@ -50,7 +50,9 @@ pub struct RendererOptions {
     /// Explicit quad capacity (overrides the formula and is never grown; tests use small ones
     /// to force overflow).
     pub max_quads: Option<u32>,
-    /// Lighting for the ground (the atlases carry their own baked lighting).
+    /// The light frames start with (the sun, sky and exposure every method shades with):
+    /// `set_light` changes it for the next frames, and [`crate::FrameParams::light`] sets it
+    /// per frame. Nothing of it is baked.
     pub lighting: Lighting,
     /// Sky and ground, or transparent.
     pub background: Background,
@@ -411,7 +413,7 @@ pub const GROUND_MOSS: glam::Vec3 = glam::Vec3::new(0.075, 0.105, 0.04);
 /// Soil ([`GROUND_ALBEDO`]) lit by the shared shading model (facing up, in sun), linear RGB:
 /// the ground's colour where no moss grows, for hosts that draw their own ground.
 pub fn ground_colour(lighting: &Lighting) -> glam::Vec3 {
-    lighting.shade(GROUND_ALBEDO, glam::Vec3::Y, 1.0, 0.0)
+    lighting.shade(GROUND_ALBEDO, glam::Vec3::Y, 1.0, 1.0, 0.0)
 }
 
 /// One of 2²⁴ values in [0, 1) per integer lattice point: a 32-bit integer hash (after
@@ -455,14 +457,12 @@ pub fn ground_albedo(x: f32, z: f32) -> glam::Vec3 {
 /// The environment uniform: ground colour, sky, sun disc, haze and the terrain's grid (see
 /// `shaders/environment.wgsl`).
 pub fn environment_uniform(
-    lighting: &Lighting,
     atmosphere: &Atmosphere,
     terrain: &crate::terrain::TerrainGrid,
 ) -> GpuEnvironment {
     let g = GROUND_MOSS;
     let [hr, hg, hb] = atmosphere.horizon;
     let [zr, zg, zb] = atmosphere.zenith;
-    let s = lighting.sun_dir.normalize_or_zero();
     // A cosine above 1 draws no disc.
     let disc = if atmosphere.sun_disc {
         SUN_DISC_DEGREES.to_radians().cos()
@@ -473,11 +473,8 @@ pub fn environment_uniform(
         ground: [g.x, g.y, g.z, 0.0],
         horizon: [hr, hg, hb, atmosphere.haze_density()],
         zenith: [zr, zg, zb, atmosphere.haze_falloff()],
-        sun: [s.x, s.y, s.z, disc],
-        sun_colour: lighting.sun.extend(0.0).to_array(),
+        sun: [disc, 0.0, 0.0, 0.0],
         albedo: GROUND_ALBEDO.extend(0.0).to_array(),
-        sky_light: lighting.sky.extend(0.0).to_array(),
-        ground_light: lighting.ground.extend(0.0).to_array(),
         terrain: [
             terrain.origin[0],
             terrain.origin[1],

@@ -16,16 +16,28 @@ pub const PRESORT_TEXTURE_WIDTH: u32 = 4096;
 pub struct SpeciesData {
     /// The atlas.
     pub atlas: Atlas,
-    /// Its decoded colour layers.
+    /// Its decoded albedo and coverage layers.
     pub layers: Layers,
+    /// Its decoded surface-attribute layers (see [`forest_format::atlas`]).
+    pub surface: Layers,
 }
 
 impl SpeciesData {
     /// Load and decode an atlas folder.
     pub fn load(path: &std::path::Path) -> Result<Self, RenderError> {
         let atlas = Atlas::load(path)?;
+        Self::decode(atlas, path)
+    }
+
+    /// Decode a loaded atlas's images (`path` names its folder in errors).
+    pub fn decode(atlas: Atlas, path: &std::path::Path) -> Result<Self, RenderError> {
         let layers = atlas.decode_layers(path)?;
-        Ok(Self { atlas, layers })
+        let surface = atlas.decode_surface(path, &layers)?;
+        Ok(Self {
+            atlas,
+            layers,
+            surface,
+        })
     }
 }
 
@@ -157,8 +169,17 @@ pub fn gpu_instances(forest: &Forest) -> Vec<GpuInstance> {
         .collect()
 }
 
-/// Box-filter a premultiplied sRGB RGBA8 image to half size, in linear space.
-fn downsample(src: &[u8], side: usize, table: &[f32; 256]) -> Vec<u8> {
+/// Box-filter a premultiplied RGBA8 image to half size, in linear space: its RGB is sRGB-encoded
+/// when `table` decodes sRGB (and is encoded again), linear when `table` is `None`.
+fn downsample(src: &[u8], side: usize, table: Option<&[f32; 256]>) -> Vec<u8> {
+    let decode = |v: u8| table.map_or(f32::from(v) / 255.0, |t| t[v as usize]);
+    let encode = |v: f32| {
+        if table.is_some() {
+            srgb_encode(v)
+        } else {
+            v.clamp(0.0, 1.0)
+        }
+    };
     let half = side / 2;
     let mut out = vec![0u8; half * half * 4];
     for y in 0..half {
@@ -167,13 +188,13 @@ fn downsample(src: &[u8], side: usize, table: &[f32; 256]) -> Vec<u8> {
             for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 let i = ((2 * y + dy) * side + 2 * x + dx) * 4;
                 for c in 0..3 {
-                    acc[c] += table[src[i + c] as usize];
+                    acc[c] += decode(src[i + c]);
                 }
                 acc[3] += f32::from(src[i + 3]);
             }
             let o = (y * half + x) * 4;
             for c in 0..3 {
-                out[o + c] = (srgb_encode(acc[c] / 4.0) * 255.0).round() as u8;
+                out[o + c] = (encode(acc[c] / 4.0) * 255.0).round() as u8;
             }
             out[o + 3] = (acc[3] / 4.0).round() as u8;
         }
@@ -186,21 +207,25 @@ pub fn colour_mip_count(resolution: u32) -> u32 {
     resolution.trailing_zeros().saturating_sub(1).max(1)
 }
 
-/// Every layer's mip chain (layer-major), encoded as BC7 or kept as RGBA8; layers in parallel.
+/// Every layer's mip chain (layer-major), encoded as BC7 or kept as RGBA8; layers in parallel:
+/// the albedo layers (sRGB) or, with `surface`, the surface layers (linear).
 /// `progress(done, total)` is called as layers finish.
 fn colour_data(
     species: &[SpeciesData],
     resolution: u32,
     bc7: bool,
+    surface: bool,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Vec<u8> {
     use rayon::prelude::*;
-    let table = srgb_decode_table();
+    let srgb = srgb_decode_table();
+    let table = (!surface).then_some(&srgb);
     let mips = colour_mip_count(resolution);
     let settings = intel_tex_2::bc7::alpha_very_fast_settings();
     let layers: Vec<&[u8]> = species
         .iter()
-        .flat_map(|s| (0..s.layers.count).map(|l| s.layers.layer(l)))
+        .map(|s| if surface { &s.surface } else { &s.layers })
+        .flat_map(|l| (0..l.count).map(|k| l.layer(k)))
         .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
     let total = layers.len() as u64;
@@ -212,7 +237,7 @@ fn colour_data(
             let mut side = resolution as usize;
             for m in 0..mips {
                 if m > 0 {
-                    img = downsample(&img, side, &table);
+                    img = downsample(&img, side, table);
                     side /= 2;
                 }
                 if bc7 && side >= 4 {
@@ -241,8 +266,11 @@ fn colour_data(
 pub struct GpuScene {
     /// CPU copies of the tables.
     pub tables: SceneTables,
-    /// Colour layers of all species.
+    /// Colour layers (premultiplied albedo and coverage) of all species.
     pub colour: wgpu::Texture,
+    /// Surface layers of all species, the same layout as `colour` (premultiplied octahedral
+    /// normal, sky visibility, translucency; linear).
+    pub surface: wgpu::Texture,
     /// Node texture (`Rgba32Uint`, [`NODE_TEXTURE_WIDTH`] wide): the node's two words, its
     /// covered box, 0.
     pub nodes: wgpu::Texture,
@@ -321,6 +349,62 @@ fn u32_texture(
     ))
 }
 
+/// A texture array of every species' layers with their mip chains (`data` from
+/// [`colour_data`]): BC7 or RGBA8, sRGB or linear; one blank layer when there are none. Returns
+/// it and its bytes.
+fn layer_texture(
+    ctx: &GpuContext,
+    label: &str,
+    tables: &SceneTables,
+    bc7: bool,
+    srgb: bool,
+    data: Vec<u8>,
+) -> (wgpu::Texture, u64) {
+    let format = match (bc7, srgb) {
+        (true, true) => wgpu::TextureFormat::Bc7RgbaUnormSrgb,
+        (true, false) => wgpu::TextureFormat::Bc7RgbaUnorm,
+        (false, true) => wgpu::TextureFormat::Rgba8UnormSrgb,
+        (false, false) => wgpu::TextureFormat::Rgba8Unorm,
+    };
+    let res = tables.resolution.max(1);
+    let data = if tables.layers == 0 {
+        vec![
+            0u8;
+            if bc7 {
+                16
+            } else {
+                4 * res as usize * res as usize
+            }
+        ]
+    } else {
+        data
+    };
+    let texture = ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: res,
+                height: res,
+                depth_or_array_layers: tables.layers.max(1),
+            },
+            mip_level_count: if tables.layers == 0 {
+                1
+            } else {
+                colour_mip_count(res)
+            },
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &data,
+    );
+    (texture, data.len() as u64)
+}
+
 impl GpuScene {
     /// Upload species and a forest, colour in the automatic format.
     pub fn new(
@@ -363,49 +447,15 @@ impl GpuScene {
             });
         }
         let bc7 = ctx.use_bc7(colour_format) && tables.resolution >= 4;
-        let format = if bc7 {
-            wgpu::TextureFormat::Bc7RgbaUnormSrgb
-        } else {
-            wgpu::TextureFormat::Rgba8UnormSrgb
-        };
         let res = tables.resolution.max(1);
-        let data = colour_data(species, res, bc7, progress);
-        let layers = tables.layers.max(1);
-        let data = if tables.layers == 0 {
-            vec![
-                0u8;
-                if bc7 {
-                    16
-                } else {
-                    4 * res as usize * res as usize
-                }
-            ]
-        } else {
-            data
-        };
-        let colour = ctx.device.create_texture_with_data(
-            &ctx.queue,
-            &wgpu::TextureDescriptor {
-                label: Some("colour layers"),
-                size: wgpu::Extent3d {
-                    width: res,
-                    height: res,
-                    depth_or_array_layers: layers,
-                },
-                mip_level_count: if tables.layers == 0 {
-                    1
-                } else {
-                    colour_mip_count(res)
-                },
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            &data,
-        );
+        // Progress counts the albedo and the surface layers.
+        let total = 2 * u64::from(tables.layers);
+        let half = u64::from(tables.layers);
+        let data = colour_data(species, res, bc7, false, &|d, _| progress(d, total));
+        let surface_data = colour_data(species, res, bc7, true, &|d, _| progress(half + d, total));
+        let (colour, colour_bytes) = layer_texture(ctx, "colour layers", &tables, bc7, true, data);
+        let (surface, surface_bytes) =
+            layer_texture(ctx, "surface layers", &tables, bc7, false, surface_data);
         let node_texels: Vec<[u32; 4]> = tables
             .nodes
             .iter()
@@ -431,7 +481,8 @@ impl GpuScene {
             4,
             bytemuck::cast_slice(&tables.presort),
         )?;
-        let bytes = data.len() as u64
+        let bytes = colour_bytes
+            + surface_bytes
             + u64::from(nodes.height()) * u64::from(NODE_TEXTURE_WIDTH) * 16
             + u64::from(presort.height()) * u64::from(PRESORT_TEXTURE_WIDTH) * 4
             + (std::mem::size_of_val(tables.instances.as_slice())
@@ -451,6 +502,7 @@ impl GpuScene {
             terrain,
             tables,
             colour,
+            surface,
             nodes,
             presort,
             bytes,

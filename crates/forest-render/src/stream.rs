@@ -99,6 +99,7 @@ pub struct QuadStream {
     debug: DebugView,
     options: StreamOptions,
     forms: [f32; 4],
+    light: forest_format::shading::Lighting,
 }
 
 fn buffer(
@@ -170,7 +171,6 @@ impl QuadStream {
         let environment = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("environment"),
             contents: bytemuck::bytes_of(&environment_uniform(
-                &opts.lighting,
                 &opts.atmosphere,
                 &scene.terrain.grid,
             )),
@@ -228,6 +228,7 @@ impl QuadStream {
             debug: DebugView::Off,
             options: StreamOptions::default(),
             forms: crate::forms::FORMS_QUADS,
+            light: opts.lighting,
         })
     }
 
@@ -351,6 +352,10 @@ impl QuadStream {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
+        let surface_view = scene.surface.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("colour"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -377,6 +382,7 @@ impl QuadStream {
                         environment.as_entire_binding(),
                         scene.roots.as_entire_binding(),
                         state.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&surface_view),
                     ]),
                     vec![wgpu::BindGroupEntry {
                         binding: crate::terrain::HEIGHTS_BINDING,
@@ -586,6 +592,22 @@ impl QuadStream {
         self.forms = forms;
     }
 
+    /// The light of the frames written from the next [`Self::set_camera`] on (a
+    /// [`Self::prepare`] takes its frame's own light). Refused when a value is out of range.
+    pub fn set_light(
+        &mut self,
+        light: forest_format::shading::Lighting,
+    ) -> Result<(), RenderError> {
+        light.validate().map_err(RenderError::Parameter)?;
+        self.light = light;
+        Ok(())
+    }
+
+    /// The light frames are shaded with.
+    pub fn light(&self) -> forest_format::shading::Lighting {
+        self.light
+    }
+
     /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
     pub fn set_refine(&mut self, refine: bool) {
         self.iterations = if refine {
@@ -609,6 +631,7 @@ impl QuadStream {
     /// Write the frame's camera from the host's matrices: the one upload of a frame.
     pub fn prepare(&mut self, queue: &wgpu::Queue, frame: &FrameParams) -> Result<(), RenderError> {
         frame.validate()?;
+        self.light = frame.light;
         self.write_camera(queue, frame.to_gpu());
         Ok(())
     }
@@ -624,6 +647,7 @@ impl QuadStream {
         g.viewport[2] = self.debug as u32 as f32;
         g.viewport[3] = self.options.flags() as f32;
         g.forms = self.forms;
+        g.set_light(&self.light);
         crate::camera::upload(queue, &self.camera, &g, &mut self.writes);
         self.prepared = true;
     }

@@ -61,7 +61,8 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             count: None,
         },
-        buffer(7, S::FRAGMENT, uniform),
+        // The billboards' surface attributes (linear).
+        texture(7),
         // The environment: the terrain's grid is read by `vs_terrain`.
         buffer(8, S::VERTEX_FRAGMENT, uniform),
         buffer(9, S::VERTEX, read),

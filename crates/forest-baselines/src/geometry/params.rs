@@ -3,7 +3,6 @@
 
 use forest_bake::Mesh;
 use forest_bake::lod::BANDS;
-use forest_format::shading::Lighting;
 use forest_render::context::RenderError;
 use forest_render::stats::PassTimes;
 
@@ -13,20 +12,17 @@ use crate::gpu_types::GpuMethod;
 pub struct GeometrySpecies {
     /// The model.
     pub mesh: Mesh,
-    /// The lighting its atlas was baked with (so every method shades alike).
-    pub lighting: Lighting,
     /// The hybrid's switch unit of its atlas ([`forest_render::forms::switch_unit`]), so that
     /// both forms agree where each tree switches (any value when the hybrid is not used).
     pub switch_unit: f32,
 }
 
 impl GeometrySpecies {
-    /// The model `mesh` of the species baked into the atlas of `manifest`: its lighting and
-    /// hybrid switch come from the atlas, so the geometry shades and switches as its quads do.
+    /// The model `mesh` of the species baked into the atlas of `manifest`: its hybrid switch
+    /// comes from the atlas, so the geometry switches as its quads do.
     pub fn new(mesh: Mesh, manifest: &forest_format::AtlasManifest) -> Self {
         Self {
             mesh,
-            lighting: manifest.lighting,
             switch_unit: forest_render::forms::switch_unit(manifest),
         }
     }

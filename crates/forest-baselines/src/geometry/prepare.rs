@@ -1,10 +1,9 @@
-//! The CPU preparation of the geometry-based methods: reference vertices with traced sun
+//! The CPU preparation of the geometry-based methods: reference vertices with traced sky
 //! visibility, the LOD set, billboard images and material layers (the bake's tracer and
-//! simplifier do the work).
+//! simplifier do the work). Nothing here depends on the light: renderers light at run time.
 
 use forest_bake::RefVertex;
 use forest_bake::lod::LodParams;
-use forest_format::shading::Lighting;
 
 use super::params::{GeometrySpecies, SpeciesFigures};
 use super::textures::{layer_bytes, material_layer};
@@ -15,8 +14,8 @@ pub const BILLBOARD_RESOLUTION: u32 = 256;
 const BILLBOARD_SPP: u32 = 4;
 const NONE: u32 = u32::MAX;
 
-/// The CPU preparation of the species (reference vertices with traced sun visibility, LOD set,
-/// billboard images), reusable for any forest of these species.
+/// The CPU preparation of the species (reference vertices with traced sky visibility, LOD set,
+/// billboard images), reusable for any forest of these species and any light.
 #[derive(Clone)]
 pub struct PreparedGeometry {
     pub(super) vertices: Vec<RefVertex>,
@@ -24,21 +23,22 @@ pub struct PreparedGeometry {
     pub(super) materials: Vec<GpuGeoMaterial>,
     pub(super) layers: Vec<image::RgbaImage>,
     pub(super) billboard_layers: Vec<image::RgbaImage>,
+    pub(super) billboard_surface: Vec<image::RgbaImage>,
     pub(super) leaf_end: Vec<u32>,
     pub(super) leaf_centre: Vec<[f32; 4]>,
     /// Per-species figures.
     pub figures: Vec<SpeciesFigures>,
-    pub(super) lighting: Lighting,
 }
 
 impl PreparedGeometry {
-    /// Prepare every species (seconds per species: the sun-visibility and billboard rays).
+    /// Prepare every species (seconds per species: the sky-visibility and billboard rays).
     pub fn new(species: &[GeometrySpecies]) -> Self {
         let mut vertices: Vec<RefVertex> = Vec::new();
         let mut geo_species = Vec::new();
         let mut materials = Vec::new();
         let mut layers: Vec<image::RgbaImage> = Vec::new();
         let mut billboard_layers: Vec<image::RgbaImage> = Vec::new();
+        let mut billboard_surface: Vec<image::RgbaImage> = Vec::new();
         let mut leaf_end: Vec<u32> = Vec::new();
         let mut leaf_centre: Vec<[f32; 4]> = Vec::new();
         let mut figures = Vec::new();
@@ -64,13 +64,13 @@ impl PreparedGeometry {
                     pad: [0; 2],
                 });
             }
-            let reference = forest_bake::reference_vertices(&s.mesh, &s.lighting);
+            let reference = forest_bake::reference_vertices(&s.mesh);
             let leaf: Vec<bool> = reference
                 .chunks_exact(3)
                 .map(|t| s.mesh.materials[t[0].material as usize].alpha.is_some())
                 .collect();
             let set = forest_bake::lod::build_lods(&reference, &leaf, &LodParams::default());
-            let mean = forest_bake::lod::mean_leaf_colour(&s.mesh, &set.lod0, &s.lighting);
+            let mean = forest_bake::lod::mean_leaf_colour(&s.mesh, &set.lod0);
             let sphere = forest_bake::bounding_sphere(&s.mesh);
             let first = vertices.len() as u32;
             let counts = [
@@ -96,12 +96,12 @@ impl PreparedGeometry {
             });
             leaf_end.extend(&set.leaf_end);
             leaf_centre.extend(set.leaf_centre.iter().map(|c| c.extend(0.0).to_array()));
-            billboard_layers.extend(forest_bake::lod::billboard_images(
-                &s.mesh,
-                &s.lighting,
-                BILLBOARD_RESOLUTION,
-                BILLBOARD_SPP,
-            ));
+            for b in
+                forest_bake::lod::billboard_images(&s.mesh, BILLBOARD_RESOLUTION, BILLBOARD_SPP)
+            {
+                billboard_layers.push(b.albedo);
+                billboard_surface.push(b.surface);
+            }
             for v in set.lod0.iter().chain(&set.lods[0]).chain(&set.lods[1]) {
                 vertices.push(RefVertex {
                     material: v.material + material_base,
@@ -120,33 +120,30 @@ impl PreparedGeometry {
                     + std::mem::size_of_val(&leaf_centre[leaves_base..]))
                     as u64
                     + layer_bytes(&layers[layers_base..])
-                    + layer_bytes(&billboard_layers[billboards_base..]),
+                    + 2 * layer_bytes(&billboard_layers[billboards_base..]),
             });
         }
-        let lighting = species
-            .first()
-            .map(|s| s.lighting)
-            .unwrap_or(Lighting::with_sun(30.0, 55.0));
         Self {
             vertices,
             geo_species,
             materials,
             layers,
             billboard_layers,
+            billboard_surface,
             leaf_end,
             leaf_centre,
             figures,
-            lighting,
         }
     }
 
-    /// A copy with every vertex's traced sun visibility replaced by `f(visibility)`: for
-    /// measuring what self-shadowing contributes (tests, experiments).
-    pub fn map_sun_visibility(&self, f: impl Fn(f32) -> f32) -> Self {
+    /// A copy with every vertex's traced sky visibility (both sides) replaced by
+    /// `f(visibility)`: for measuring what the occlusion contributes (tests, experiments).
+    pub fn map_sky_visibility(&self, f: impl Fn(f32) -> f32) -> Self {
         let mut out = self.clone();
-        out.vertices
-            .iter_mut()
-            .for_each(|v| v.sun_visibility = f(v.sun_visibility));
+        out.vertices.iter_mut().for_each(|v| {
+            v.sky_front = f(v.sky_front);
+            v.sky_back = f(v.sky_back);
+        });
         out
     }
 

@@ -20,7 +20,6 @@ use super::layout::{compute_entries, draw_entries};
 use super::params::{GeometryStats, MeshMethod, SpeciesFigures};
 use super::prepare::{BILLBOARD_RESOLUTION, PreparedGeometry};
 use super::textures::{MATERIAL_TEXTURE_SIZE, layered_texture};
-use crate::gpu_types::GpuLight;
 
 /// Workgroup size of `geo_reset` (one invocation per segment); the other per-tree entry
 /// points use the runtime's `WG` (a test checks both against the WGSL).
@@ -32,6 +31,7 @@ pub struct GeometryRenderer {
     method_buf: wgpu::Buffer,
     method: MeshMethod,
     forms: [f32; 4],
+    light: forest_format::shading::Lighting,
     writes: (u64, u64),
     ring: forest_render::stats::StatsRing,
     reset: wgpu::ComputePipeline,
@@ -98,12 +98,11 @@ impl GeometryRenderer {
             materials,
             layers,
             billboard_layers,
+            billboard_surface,
             leaf_end,
             leaf_centre,
             figures,
-            lighting: l,
         } = prepared;
-        let l = *l;
         opts.atmosphere.validate().map_err(RenderError::Parameter)?;
         if geo_species.len() != forest.species.len() {
             return Err(RenderError::SpeciesCount {
@@ -123,12 +122,6 @@ impl GeometryRenderer {
             });
         }
         let device = &ctx.device;
-        let light = GpuLight {
-            sun_dir: l.sun_dir.extend(0.0).to_array(),
-            sun: l.sun.extend(0.0).to_array(),
-            sky: l.sky.extend(0.0).to_array(),
-            ground: l.ground.extend(0.0).to_array(),
-        };
         let instances = forest_render::scene::gpu_instances(forest);
         let cap = forest_render::capacity::GeometryCapacity::new(
             instances.len() as u32,
@@ -187,7 +180,6 @@ impl GeometryRenderer {
             bytemuck::cast_slice(leaf_centre),
             U::STORAGE,
         );
-        let light_buf = init("geometry light", bytemuck::bytes_of(&light), U::UNIFORM);
         let consts = init(
             "geometry constants",
             bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
@@ -203,11 +195,28 @@ impl GeometryRenderer {
             U::STORAGE | U::INDIRECT | U::COPY_SRC,
         );
 
-        let (material_view, material_bytes) =
-            layered_texture(ctx, "material textures", MATERIAL_TEXTURE_SIZE, layers);
-        let (billboard_view, billboard_bytes) =
-            layered_texture(ctx, "billboards", BILLBOARD_RESOLUTION, billboard_layers);
-        gpu_bytes.set(gpu_bytes.get() + material_bytes + billboard_bytes);
+        let (material_view, material_bytes) = layered_texture(
+            ctx,
+            "material textures",
+            MATERIAL_TEXTURE_SIZE,
+            layers,
+            false,
+        );
+        let (billboard_view, billboard_bytes) = layered_texture(
+            ctx,
+            "billboards",
+            BILLBOARD_RESOLUTION,
+            billboard_layers,
+            false,
+        );
+        let (billboard_surface_view, billboard_surface_bytes) = layered_texture(
+            ctx,
+            "billboard surfaces",
+            BILLBOARD_RESOLUTION,
+            billboard_surface,
+            true,
+        );
+        gpu_bytes.set(gpu_bytes.get() + material_bytes + billboard_bytes + billboard_surface_bytes);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("material"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -326,7 +335,6 @@ impl GeometryRenderer {
         let environment_buf = init(
             "geometry environment",
             bytemuck::bytes_of(&forest_render::options::environment_uniform(
-                &l,
                 &opts.atmosphere,
                 &terrain.grid,
             )),
@@ -340,7 +348,10 @@ impl GeometryRenderer {
             (4, material_buf.as_entire_binding()),
             (5, wgpu::BindingResource::TextureView(&material_view)),
             (6, wgpu::BindingResource::Sampler(&sampler)),
-            (7, light_buf.as_entire_binding()),
+            (
+                7,
+                wgpu::BindingResource::TextureView(&billboard_surface_view),
+            ),
             (8, environment_buf.as_entire_binding()),
             (9, species_buf.as_entire_binding()),
             (10, method_buf.as_entire_binding()),
@@ -385,6 +396,7 @@ impl GeometryRenderer {
             method_buf,
             method,
             forms: forest_render::forms::FORMS_GEOMETRY,
+            light: opts.lighting,
             writes: (0, 0),
             ring,
             reset: cpl("geo_reset"),
@@ -498,9 +510,21 @@ impl GeometryRenderer {
         Ok(())
     }
 
-    /// Write a camera uniform with the renderer's `forms`.
+    /// The light of the frames written from the next [`Self::set_camera`] on (a
+    /// [`Self::prepare`] takes its frame's own light). Refused when a value is out of range.
+    pub fn set_light(
+        &mut self,
+        light: forest_format::shading::Lighting,
+    ) -> Result<(), RenderError> {
+        light.validate().map_err(RenderError::Parameter)?;
+        self.light = light;
+        Ok(())
+    }
+
+    /// Write a camera uniform with the renderer's `forms` and light.
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
         g.forms = self.forms;
+        g.set_light(&self.light);
         forest_render::camera::upload(queue, &self.camera, &g, &mut self.writes);
     }
 
@@ -512,6 +536,7 @@ impl GeometryRenderer {
         frame: &forest_render::FrameParams,
     ) -> Result<(), RenderError> {
         frame.validate()?;
+        self.light = frame.light;
         self.write_camera(queue, frame.to_gpu());
         Ok(())
     }

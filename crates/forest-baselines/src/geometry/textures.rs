@@ -61,6 +61,28 @@ pub(super) fn material_layer(
 /// Alpha is rescaled per level so that the share of texels passing the 0.5 alpha test stays
 /// that of level 0 (Castaño's coverage-preserving mips): plain averaging erodes alpha-tested
 /// leaves into nothing at a distance.
+/// Every mip level of linear data down to 1×1, each the box filter of the one above (bytes and
+/// level count, as [`mip_chain`]).
+pub(super) fn box_mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
+    let mut data = img.as_raw().clone();
+    let mut level = img.clone();
+    let mut mips = 1;
+    while level.width() > 1 && level.height() > 1 {
+        let (w, h) = (level.width() / 2, level.height() / 2);
+        level = image::RgbaImage::from_fn(w, h, |x, y| {
+            let mut acc = [0u32; 4];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let p = level.get_pixel(2 * x + dx, 2 * y + dy);
+                (0..4).for_each(|c| acc[c] += u32::from(p[c]));
+            }
+            image::Rgba(acc.map(|a| ((a + 2) / 4) as u8))
+        });
+        data.extend_from_slice(level.as_raw());
+        mips += 1;
+    }
+    (data, mips)
+}
+
 pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     use forest_format::shading::{srgb_decode_table, srgb_encode};
     let coverage = |m: &image::RgbaImage, scale: f32| {
@@ -146,11 +168,15 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
 const ALPHA_TEST_BYTE: u8 = 128;
 
 /// An sRGB RGBA8 2D-array texture with mips from square layers of side `size`.
+/// An array of `layers` with their mip chains: sRGB colour with coverage-preserving mips
+/// ([`mip_chain`]), or with `linear` plain box-filtered linear data (the billboards' surface
+/// attributes, whose blank texels were dilated).
 pub(super) fn layered_texture(
     ctx: &GpuContext,
     label: &str,
     size: u32,
     layers: &[image::RgbaImage],
+    linear: bool,
 ) -> (wgpu::TextureView, u64) {
     let white = [image::RgbaImage::from_pixel(
         size,
@@ -165,7 +191,11 @@ pub(super) fn layered_texture(
     let mut data = Vec::new();
     let mut mips = 1;
     for img in layers {
-        let (d, m) = mip_chain(img);
+        let (d, m) = if linear {
+            box_mip_chain(img)
+        } else {
+            mip_chain(img)
+        };
         data.extend(d);
         mips = m;
     }
@@ -181,7 +211,11 @@ pub(super) fn layered_texture(
             mip_level_count: mips,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            format: if linear {
+                wgpu::TextureFormat::Rgba8Unorm
+            } else {
+                wgpu::TextureFormat::Rgba8UnormSrgb
+            },
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         },

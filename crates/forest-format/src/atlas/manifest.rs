@@ -8,7 +8,6 @@ use serde::{Deserialize, Serialize};
 use crate::directions;
 use crate::error::FormatError;
 use crate::node::{MAX_NODES, QuadNode};
-use crate::shading::Lighting;
 use crate::slab::{DirectionFrame, Sphere};
 
 use super::*;
@@ -45,8 +44,6 @@ pub struct AtlasManifest {
     pub source: SourceInfo,
     /// Bake parameters.
     pub params: BakeParams,
-    /// The lighting baked into the colours.
-    pub lighting: Lighting,
     /// The sphere every slab image frames (object space, metres).
     pub bounding_sphere: Sphere,
     /// Sampling directions with their image frames (`params.directions` of them).
@@ -112,8 +109,8 @@ impl AtlasManifest {
             .unwrap_or(self.bounding_sphere.center.y + self.bounding_sphere.radius)
     }
 
-    /// Bytes the runtime puts in GPU textures for this atlas: the colour layers as BC7 (16
-    /// bytes per 4×4 block) with mips down to 4×4, plus the node texture (8 bytes per texel,
+    /// Bytes the runtime puts in GPU textures for this atlas: the colour and surface layers
+    /// as BC7 each (16 bytes per 4×4 block) with mips down to 4×4, plus the node texture (8 bytes per texel,
     /// [`NODE_TEXTURE_WIDTH`] wide, rows rounded up).
     pub fn gpu_bytes(&self) -> u64 {
         let mut per_layer = 0u64;
@@ -130,7 +127,7 @@ impl AtlasManifest {
             .node_count
             .div_ceil(u64::from(NODE_TEXTURE_WIDTH))
             .max(1);
-        per_layer * u64::from(self.params.layers()) + rows * u64::from(NODE_TEXTURE_WIDTH) * 8
+        2 * per_layer * u64::from(self.params.layers()) + rows * u64::from(NODE_TEXTURE_WIDTH) * 8
     }
 
     /// Sampling directions as vectors.
@@ -220,17 +217,6 @@ impl AtlasManifest {
                 self.node_count
             ));
         }
-        let lighting_ok = [
-            self.lighting.sun_dir,
-            self.lighting.sun,
-            self.lighting.sky,
-            self.lighting.ground,
-        ]
-        .iter()
-        .all(|v| v.is_finite());
-        if !lighting_ok {
-            return bad("lighting has a non-finite value".into());
-        }
         if let Some(h) = &self.hybrid_switch {
             let p = h.finest_quad_pixels;
             if !(HybridSwitch::MIN_PIXELS..=HybridSwitch::MAX_PIXELS).contains(&p) {
@@ -277,7 +263,6 @@ pub fn manifest_for(
         format: ATLAS_FORMAT.into(),
         version: ATLAS_VERSION,
         source,
-        lighting: params.lighting(),
         levels: params.levels(),
         bounding_sphere,
         direction_triangles: upper,

@@ -3,9 +3,13 @@
 //! - `manifest.json`: format name and version, every bake parameter, the bounding sphere, the
 //!   sampling directions with their frames and triangulation, per-level node counts;
 //! - `colour.jpg` (or `colour.png` when baked lossless): every slab image's premultiplied,
-//!   sRGB-encoded RGB, tiled into one mosaic (layer `L = direction·slabs + slab` at column
+//!   sRGB-encoded albedo (no light: light is applied at run time), tiled into one mosaic (layer `L = direction·slabs + slab` at column
 //!   `L mod mosaic_columns`, row `L div mosaic_columns`);
 //! - `alpha.png`: the coverage (alpha) mosaic, 8-bit, lossless;
+//! - `surface.png`: what the run-time light needs besides the albedo, per slab pixel as RGBA8,
+//!   linear and premultiplied by coverage like the colour: the octahedral code of the normal
+//!   facing the sampling ray (object space, [`crate::shading::oct_encode`]) in R and G, the sky
+//!   visibility in B and the translucency in A. The same tiling, lossless;
 //! - `nodes.bin`: the quad hierarchies of all layers (see [`crate::nodes_codec`]).
 //!
 //! [`Atlas::save`] writes to a temporary folder and renames it into place, so a reader never
@@ -28,8 +32,12 @@ use crate::shading::srgb_encode;
 
 /// The `format` field of every atlas manifest.
 pub const ATLAS_FORMAT: &str = "forest-atlas";
-/// The atlas format version this crate reads and writes.
-pub const ATLAS_VERSION: u32 = 2;
+/// The atlas format version this crate reads and writes. Version 3 stores albedo and surface
+/// attributes for run-time light; versions 1 and 2 had one sun baked into the colour and are
+/// refused with a message to bake again.
+pub const ATLAS_VERSION: u32 = 3;
+/// Surface-attribute mosaic file name.
+pub const SURFACE_FILE: &str = "surface.png";
 /// Manifest file name inside an atlas folder.
 pub const MANIFEST_FILE: &str = "manifest.json";
 /// Alpha mosaic file name.
@@ -51,21 +59,29 @@ pub struct Atlas {
     pub colour_file: Vec<u8>,
     /// The alpha mosaic file's bytes (8-bit grey PNG).
     pub alpha_file: Vec<u8>,
+    /// The surface mosaic file's bytes (RGBA8 PNG, see the module documentation).
+    pub surface_file: Vec<u8>,
     /// All nodes, level by level; the roots are the first ones, in layer order.
     pub nodes: Vec<QuadNode>,
 }
 
 impl Atlas {
-    /// Encode decoded layers and nodes into an atlas. `layers` must hold
-    /// `manifest.params.layers()` layers of `resolution²` pixels.
+    /// Encode decoded layers and nodes into an atlas. `layers` (albedo and coverage) and
+    /// `surface` (premultiplied surface attributes) must each hold `manifest.params.layers()`
+    /// layers of `resolution²` pixels.
     pub fn from_layers(
         manifest: AtlasManifest,
         layers: &Layers,
+        surface: &Layers,
         nodes: Vec<QuadNode>,
     ) -> Result<Self, FormatError> {
         let p = &manifest.params;
         assert_eq!(layers.count, p.layers(), "one layer per direction and slab");
         assert_eq!(layers.resolution, p.resolution);
+        assert_eq!(
+            (surface.count, surface.resolution),
+            (layers.count, layers.resolution)
+        );
         let cols = p.mosaic_columns();
         let (w, h, mut rgb) = layers.mosaic(cols, &[0, 1, 2]);
         let (_, _, alpha) = layers.mosaic(cols, &[3]);
@@ -90,11 +106,79 @@ impl Atlas {
             }
         };
         let alpha_file = encode_alpha_png(w, h, &alpha);
+        let (_, _, surf) = surface.mosaic(cols, &[0, 1, 2, 3]);
+        let surface_file = encode_png(w, h, &surf, image::ExtendedColorType::Rgba8);
         Ok(Self {
             manifest,
             colour_file,
             alpha_file,
+            surface_file,
             nodes,
+        })
+    }
+
+    /// Decode the surface mosaic into layers (RGBA8, premultiplied: each channel is clamped
+    /// to the pixel's coverage from the alpha mosaic, `alpha`'s layers as
+    /// [`Self::decode_layers`] returns them).
+    pub fn decode_surface(&self, path: &Path, alpha: &Layers) -> Result<Layers, FormatError> {
+        let p = &self.manifest.params;
+        let file = path.join(SURFACE_FILE);
+        let (cols, rows) = (p.mosaic_columns(), p.mosaic_rows());
+        let (w, h) = (cols * p.resolution, rows * p.resolution);
+        let dims = crate::bounded::image_dimensions(
+            &self.surface_file,
+            Some(image::ImageFormat::Png),
+            &file,
+        )?;
+        if dims != (w, h) {
+            return Err(FormatError::invalid(
+                &file,
+                format!(
+                    "mosaic is {}×{} pixels, expected {w}×{h} ({cols}×{rows} tiles of {})",
+                    dims.0, dims.1, p.resolution
+                ),
+            ));
+        }
+        let img =
+            crate::bounded::decode_image(&self.surface_file, Some(image::ImageFormat::Png), &file)?;
+        let img = match img {
+            image::DynamicImage::ImageRgba8(i) => i,
+            other => {
+                return Err(FormatError::invalid(
+                    &file,
+                    format!("surface mosaic is {:?}, expected 8-bit RGBA", other.color()),
+                ));
+            }
+        };
+        if img.dimensions() != (w, h) {
+            return Err(FormatError::invalid(
+                &file,
+                format!(
+                    "decoded to {}×{} pixels, expected {w}×{h}",
+                    img.width(),
+                    img.height()
+                ),
+            ));
+        }
+        let r = p.resolution as usize;
+        let mut rgba = vec![0u8; p.layers() as usize * r * r * 4];
+        for l in 0..p.layers() {
+            let (tx, ty) = ((l % cols) * p.resolution, (l / cols) * p.resolution);
+            let base = l as usize * r * r * 4;
+            let cover = alpha.layer(l);
+            for y in 0..r {
+                for x in 0..r {
+                    let c = img.get_pixel(tx + x as u32, ty + y as u32).0;
+                    let d = base + (y * r + x) * 4;
+                    let a = cover[(y * r + x) * 4 + 3];
+                    rgba[d..d + 4].copy_from_slice(&c.map(|v| v.min(a)));
+                }
+            }
+        }
+        Ok(Layers {
+            resolution: p.resolution,
+            count: p.layers(),
+            rgba,
         })
     }
 
@@ -219,10 +303,11 @@ impl Atlas {
             std::fs::create_dir_all(&tmp).map_err(|e| FormatError::io(&tmp, e))?;
             let manifest =
                 serde_json::to_vec_pretty(&self.manifest).expect("the manifest serialises to JSON");
-            let files: [(&str, &[u8]); 4] = [
+            let files: [(&str, &[u8]); 5] = [
                 (MANIFEST_FILE, &manifest),
                 (self.manifest.params.colour.file_name(), &self.colour_file),
                 (ALPHA_FILE, &self.alpha_file),
+                (SURFACE_FILE, &self.surface_file),
                 (
                     NODES_FILE,
                     &nodes_codec::encode(&self.nodes, self.root_count()),
@@ -292,6 +377,7 @@ impl Atlas {
         let manifest = parse_manifest(&mpath, &read(MANIFEST_FILE)?)?;
         let colour_file = read(manifest.params.colour.file_name())?;
         let alpha_file = read(ALPHA_FILE)?;
+        let surface_file = read(SURFACE_FILE)?;
         let npath = path.join(NODES_FILE);
         let node_bytes = read(NODES_FILE)?;
         // The header's count is checked against the manifest's before anything is inflated.
@@ -346,10 +432,12 @@ impl Atlas {
             manifest,
             colour_file,
             alpha_file,
+            surface_file,
             nodes,
         };
         // Decoding checks the image sizes too.
-        atlas.decode_layers(path)?;
+        let layers = atlas.decode_layers(path)?;
+        atlas.decode_surface(path, &layers)?;
         Ok(atlas)
     }
 }
@@ -371,6 +459,35 @@ fn check_folder(path: &Path) -> Result<(), FormatError> {
 
 /// Parse and check the manifest read from `mpath` (which errors name).
 fn parse_manifest(mpath: &Path, bytes: &[u8]) -> Result<AtlasManifest, FormatError> {
+    // The version first: an older manifest has other fields, and the error must say why.
+    #[derive(serde::Deserialize)]
+    struct Probe {
+        format: Option<String>,
+        version: Option<u32>,
+    }
+    if let Ok(Probe {
+        format: Some(f),
+        version: Some(v),
+    }) = serde_json::from_slice::<Probe>(bytes)
+        && f == ATLAS_FORMAT
+        && v != ATLAS_VERSION
+    {
+        return Err(FormatError::Version {
+            path: mpath.to_path_buf(),
+            what: if v < ATLAS_VERSION {
+                format!(
+                    "atlas version {v} has one sun baked into its colours; this program lights \
+                     trees at run time from version {ATLAS_VERSION} on: bake the model again \
+                     with `forest bake` (the sun is now `forest render --sun AZ,EL`)"
+                )
+            } else {
+                format!(
+                    "atlas version {v} is newer than this program reads ({ATLAS_VERSION}): \
+                     update forest or bake the model again"
+                )
+            },
+        });
+    }
     let manifest: AtlasManifest =
         serde_json::from_slice(bytes).map_err(|source| FormatError::Json {
             path: mpath.to_path_buf(),

@@ -4,7 +4,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::FormatError;
 use crate::node::level_count;
-use crate::shading::Lighting;
 
 use super::*;
 
@@ -74,10 +73,6 @@ pub struct BakeParams {
     pub min_quad: u32,
     /// Jittered samples per pixel (1..=256; default 4).
     pub spp: u32,
-    /// Sun azimuth in degrees from +Z towards +X.
-    pub sun_azimuth_deg: f32,
-    /// Sun elevation in degrees above the horizon (0..=90).
-    pub sun_elevation_deg: f32,
     /// How the colour mosaic is stored.
     pub colour: ColourEncoding,
 }
@@ -92,8 +87,6 @@ impl Default for BakeParams {
             resolution: 512,
             min_quad: 4,
             spp: 4,
-            sun_azimuth_deg: 30.0,
-            sun_elevation_deg: 55.0,
             colour: ColourEncoding::Jpeg { quality: 80 },
         }
     }
@@ -171,15 +164,6 @@ impl BakeParams {
         if !(1..=256).contains(&self.spp) {
             return p(format!("spp = {}: must be 1 to 256", self.spp));
         }
-        if !self.sun_azimuth_deg.is_finite()
-            || !self.sun_elevation_deg.is_finite()
-            || !(0.0..=90.0).contains(&self.sun_elevation_deg)
-        {
-            return p(format!(
-                "sun = {},{}: azimuth must be finite and elevation 0 to 90 degrees",
-                self.sun_azimuth_deg, self.sun_elevation_deg
-            ));
-        }
         if let ColourEncoding::Jpeg { quality } = self.colour
             && !(1..=100).contains(&quality)
         {
@@ -194,10 +178,5 @@ impl BakeParams {
             ));
         }
         Ok(())
-    }
-
-    /// The lighting of this bake.
-    pub fn lighting(&self) -> Lighting {
-        Lighting::with_sun(self.sun_azimuth_deg, self.sun_elevation_deg)
     }
 }

@@ -30,6 +30,17 @@ fn synthetic(colour: ColourEncoding) -> (Atlas, Layers) {
         count: n,
         rgba,
     };
+    // Premultiplied surface attributes: every channel at most the coverage.
+    let surface = Layers {
+        resolution: 8,
+        count: n,
+        rgba: layers
+            .rgba
+            .chunks_exact(4)
+            .enumerate()
+            .flat_map(|(i, p)| [(i % 7) as u8 * 30, 128, 200, 90].map(|c| c.min(p[3])))
+            .collect(),
+    };
     let nodes: Vec<QuadNode> = (0..n)
         .map(|l| QuadNode::new(0, 0, [l as u8, 10, 20, 30]))
         .collect();
@@ -51,7 +62,7 @@ fn synthetic(colour: ColourEncoding) -> (Atlas, Layers) {
         vec![u64::from(n), 0],
     );
     (
-        Atlas::from_layers(manifest, &layers, nodes).unwrap(),
+        Atlas::from_layers(manifest, &layers, &surface, nodes).unwrap(),
         layers,
     )
 }
@@ -77,6 +88,15 @@ fn save_then_load_round_trips_and_replaces_atomically() {
         .map(|(a, b)| a.abs_diff(*b))
         .max();
     assert_eq!(worst.map(|w| w <= 1), Some(true), "{worst:?}");
+    // The surface mosaic is lossless: exactly the premultiplied attributes.
+    let surface = back.decode_surface(&path, &decoded).unwrap();
+    let expected: Vec<u8> = layers
+        .rgba
+        .chunks_exact(4)
+        .enumerate()
+        .flat_map(|(i, p)| [(i % 7) as u8 * 30, 128, 200, 90].map(|c| c.min(p[3])))
+        .collect();
+    assert_eq!(surface.rgba, expected);
     atlas.save(&path).unwrap();
     let names: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
@@ -95,8 +115,25 @@ fn the_loader_names_what_is_wrong() {
     reset();
     let manifest = path.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("\"version\": 2", "\"version\": 7")).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 3", "\"version\": 7")).unwrap();
     assert!(err(&path).contains("atlas version 7"), "{}", err(&path));
+    // An atlas with baked light (version 2: a `lighting` field, the sun in its parameters) is
+    // refused for what it is, not for its unknown fields.
+    let old = text.replace("\"version\": 3", "\"version\": 2").replacen(
+        "\"params\": {",
+        "\"lighting\": {}, \"params\": {\"sun_azimuth_deg\": 30.0,",
+        1,
+    );
+    std::fs::write(&manifest, old).unwrap();
+    let e = err(&path);
+    assert!(
+        e.contains("atlas version 2") && e.contains("bake the model again"),
+        "{e}"
+    );
+    assert!(e.contains("--sun"), "{e}");
+    reset();
+    std::fs::remove_file(path.join(SURFACE_FILE)).unwrap();
+    assert!(err(&path).contains(SURFACE_FILE), "{}", err(&path));
     reset();
     std::fs::write(&manifest, &text[..text.len() / 2]).unwrap();
     assert!(
@@ -181,7 +218,7 @@ fn the_manifest_loads_alone_and_is_checked_as_in_a_full_load() {
     assert!(Atlas::load(&path).is_err());
     let manifest = path.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("\"version\": 2", "\"version\": 7")).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 3", "\"version\": 7")).unwrap();
     let e = Atlas::load_manifest(&path).unwrap_err().to_string();
     assert!(e.contains("atlas version 7"), "{e}");
     let e = Atlas::load_manifest(&dir.path().join("none.atlas"))

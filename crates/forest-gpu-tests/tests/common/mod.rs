@@ -47,10 +47,7 @@ pub fn species() -> Vec<SpeciesData> {
 }
 
 fn species_data(a: &Atlas) -> SpeciesData {
-    SpeciesData {
-        layers: a.decode_layers(Path::new("test")).unwrap(),
-        atlas: a.clone(),
-    }
+    SpeciesData::decode(a.clone(), Path::new("test")).unwrap()
 }
 
 /// Bush and pine baked with `params` (not cached).

@@ -66,13 +66,15 @@ pub fn projection(size: (u32, u32)) -> Mat4 {
     glam::camera::rh::proj::directx::perspective_infinite_reverse(60f32.to_radians(), aspect, 0.1)
 }
 
-/// The frame parameters of a camera at `eye` looking at `target`.
+/// The frame parameters of a camera at `eye` looking at `target`, under the default sun (the
+/// host's own light would go in `light`: the forest is lit at run time).
 pub fn frame(eye: Vec3, target: Vec3, size: (u32, u32), epsilon: f32) -> FrameParams {
     FrameParams {
         view: glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y),
         proj: projection(size),
         viewport: size,
         epsilon,
+        light: Default::default(),
     }
 }
 
@@ -118,7 +120,7 @@ impl Host {
         let ground_colour = ground_colour(&opts.lighting).extend(5000.0).to_array();
         let moss_colour = opts
             .lighting
-            .shade(GROUND_MOSS, Vec3::Y, 1.0, 0.0)
+            .shade(GROUND_MOSS, Vec3::Y, 1.0, 1.0, 0.0)
             .extend(0.0)
             .to_array();
         let forest = QuadStream::new(device, scene, &opts)?;

@@ -24,7 +24,8 @@ pub fn vertex_storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
-/// environment, layer roots, the frame's state (where the plain quads start), and the
+/// environment, layer roots, the frame's state (where the plain quads start), the surface
+/// layers, and the
 /// terrain's heights at [`crate::terrain::HEIGHTS_BINDING`].
 pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
@@ -74,6 +75,16 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         uniform(8),
         storage(9),
         storage(10),
+        wgpu::BindGroupLayoutEntry {
+            binding: 11,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        },
         crate::terrain::heights_entry(),
     ]
 }

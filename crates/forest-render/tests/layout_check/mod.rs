@@ -58,6 +58,10 @@ pub fn shared() -> Vec<Expect> {
                 ("viewport", offset_of!(GpuCamera, viewport)),
                 ("planes", offset_of!(GpuCamera, planes)),
                 ("forms", offset_of!(GpuCamera, forms)),
+                ("sun", offset_of!(GpuCamera, sun)),
+                ("sun_colour", offset_of!(GpuCamera, sun_colour)),
+                ("sky_light", offset_of!(GpuCamera, sky_light)),
+                ("ground_light", offset_of!(GpuCamera, ground_light)),
             ],
         ),
         (
