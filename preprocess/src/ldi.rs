@@ -105,7 +105,7 @@ pub fn trace_layers(
     let table = srgb_decode_table();
     let diameter = 2.0 * sphere.radius;
     // One task per (direction, row); each returns `slabs` rows of colour, surface and depth.
-    let rows: Vec<(Vec<[u8; 4]>, Vec<[u8; 4]>, Vec<f32>)> = (0..frames.len() * r)
+    let rows: Vec<SlabRows> = (0..frames.len() * r)
         .into_par_iter()
         .map(|task| {
             let (di, y) = (task / r, task % r);
@@ -196,6 +196,9 @@ pub fn trace_layers(
     }
     out
 }
+
+/// One task's rows, `slabs` of each: colour, surface attributes, depth.
+type SlabRows = (Vec<[u8; 4]>, Vec<[u8; 4]>, Vec<f32>);
 
 /// One slab pixel's sums over its samples' hits.
 #[derive(Clone, Copy, Default)]

@@ -127,7 +127,7 @@ fn texel_normals_of_tilted_cards_match_the_geometry() {
         center: Vec3::ZERO,
         radius: 1.5,
     };
-    for view in [Vec3::Y, Vec3::Z, Vec3::new(0.3, 0.5, -0.8).normalize()] {
+    for view in [Vec3::Y, Vec3::Z, Vec3::new(0.3, 0.8, 0.5).normalize()] {
         let frames = [DirectionFrame::new(view)];
         let setup = ldi::SlabSetup {
             sphere,
@@ -244,7 +244,7 @@ fn the_same_input_gives_a_byte_identical_atlas() {
         listing.sort();
         files.push(listing);
     }
-    assert_eq!(files[0].len(), 4);
+    assert_eq!(files[0].len(), 5);
     assert_eq!(files[0], files[1]);
 }
 

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use forest_format::atlas::{ALPHA_FILE, Atlas, MANIFEST_FILE, NODES_FILE};
+use forest_format::atlas::{ALPHA_FILE, Atlas, MANIFEST_FILE, NODES_FILE, SURFACE_FILE};
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
 
@@ -62,7 +62,7 @@ pub const TARGETS: &[Target] = &[
         name: "atlas",
         run: atlas,
         bound: IMAGE_BOUND,
-        covers: "atlas folder: manifest, colour and alpha mosaics, nodes (`Atlas::load`)",
+        covers: "atlas folder: manifest, colour, alpha and surface mosaics, nodes (`Atlas::load`)",
     },
     Target {
         name: "obj",
@@ -111,14 +111,15 @@ fn nodes(data: &[u8]) -> bool {
     forest_format::nodes_codec::decode(data).is_ok()
 }
 
-/// Files: manifest, colour mosaic, alpha mosaic, nodes.
+/// Files: manifest, colour mosaic, alpha mosaic, nodes, surface mosaic.
 fn atlas(data: &[u8]) -> bool {
-    let files = crate::split_files(data, 4);
+    let files = crate::split_files(data, 5);
     let read = |name: &str| -> Result<Vec<u8>, forest_format::FormatError> {
         Ok(match name {
             MANIFEST_FILE => files[0],
             ALPHA_FILE => files[2],
             NODES_FILE => files[3],
+            SURFACE_FILE => files[4],
             _ => files[1],
         }
         .to_vec())

@@ -1,5 +1,6 @@
 //! Viewed exactly along a sampling direction from far away (nearly orthographic), with a tiny
-//! ε, the quad stream reproduces the bake's own slab images (front slab over back slab).
+//! ε, the quad stream reproduces the bake's own slab images (front slab over back slab), each
+//! texel lit on the CPU by the shading model under the stream's light.
 
 mod common;
 
@@ -28,6 +29,27 @@ fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
     let sphere = atlas.manifest.bounding_sphere;
     let table = srgb_decode_table();
     let layers = &species[0].layers;
+    let surface = &species[0].surface;
+    let light = forest_format::shading::Lighting::default();
+    // Texel `i` of layer `l` lit under `light` in the direction's frame `f`: premultiplied,
+    // linear RGB and alpha.
+    let lit = |l: u32, i: usize, f: &forest_format::slab::DirectionFrame| {
+        let (c, g) = (layers.layer(l), surface.layer(l));
+        let a = f32::from(c[i + 3]) / 255.0;
+        if a == 0.0 {
+            return [0.0; 4];
+        }
+        let g = [0, 1, 2, 3].map(|k| f32::from(g[i + k]) / 255.0 / a);
+        let local = forest_format::shading::hemi_oct_decode(glam::Vec2::new(g[0], g[1]));
+        let n = (f.right * local.x + f.up * local.y + f.dir * local.z).normalize();
+        let albedo = glam::Vec3::new(
+            table[c[i] as usize],
+            table[c[i + 1] as usize],
+            table[c[i + 2] as usize],
+        ) / a;
+        let r = light.shade(albedo, n, 1.0, g[2].min(1.0), g[3].min(1.0)) * a;
+        [r.x, r.y, r.z, a]
+    };
     let mut checked = 0;
     for (d, frame) in atlas.manifest.directions.iter().enumerate() {
         if frame.dir.y.abs() > 0.99 {
@@ -39,17 +61,17 @@ fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
         assert_eq!(ctx.take_errors(), Vec::<String>::new());
         // Expected: front slab over back slab, in linear premultiplied space.
         let slabs = atlas.manifest.params.slabs;
-        let front = layers.layer(d as u32 * slabs);
-        let back = layers.layer(d as u32 * slabs + 1);
         let expected = image::RgbaImage::from_fn(res, res, |x, y| {
             let i = ((y * res + x) * 4) as usize;
-            let fa = f32::from(front[i + 3]) / 255.0;
+            let front = lit(d as u32 * slabs, i, frame);
+            let back = lit(d as u32 * slabs + 1, i, frame);
+            let fa = front[3];
             let mut px = [0u8; 4];
             for c in 0..3 {
-                let v = table[front[i + c] as usize] + table[back[i + c] as usize] * (1.0 - fa);
+                let v = front[c] + back[c] * (1.0 - fa);
                 px[c] = (srgb_encode(v) * 255.0).round() as u8;
             }
-            let a = fa + f32::from(back[i + 3]) / 255.0 * (1.0 - fa);
+            let a = fa + back[3] * (1.0 - fa);
             px[3] = (a * 255.0).round() as u8;
             image::Rgba(px)
         });

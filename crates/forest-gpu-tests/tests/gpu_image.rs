@@ -94,8 +94,11 @@ fn a_frame_writes_only_the_camera() {
     }
     assert_eq!(
         stream.uploads(),
-        (3, 3 * 224),
-        "one 224-byte camera write per frame"
+        (
+            3,
+            3 * std::mem::size_of::<forest_render::gpu_types::GpuCamera>() as u64
+        ),
+        "one 288-byte camera write (the camera and its light) per frame"
     );
     assert_ne!(
         streams[0], streams[1],

@@ -278,6 +278,7 @@ fn main() {
                 &read(colour.file_name()),
                 &read(forest_format::atlas::ALPHA_FILE),
                 &read(forest_format::atlas::NODES_FILE),
+                &read(forest_format::atlas::SURFACE_FILE),
             ]),
         );
     }
