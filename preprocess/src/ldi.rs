@@ -37,7 +37,7 @@ pub struct SlabImages {
 }
 
 /// A 32-bit integer hash (lowbias32) for deterministic sample jitter.
-fn hash(mut x: u32) -> u32 {
+pub(crate) fn hash(mut x: u32) -> u32 {
     x ^= x >> 16;
     x = x.wrapping_mul(0x7feb_352d);
     x ^= x >> 15;
@@ -46,7 +46,8 @@ fn hash(mut x: u32) -> u32 {
     x
 }
 
-fn unit(x: u32) -> f32 {
+/// The top 24 bits of a hash as a number in `[0, 1)`.
+pub(crate) fn unit(x: u32) -> f32 {
     (x >> 8) as f32 / (1u32 << 24) as f32
 }
 

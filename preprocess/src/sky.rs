@@ -12,6 +12,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use crate::ldi::{hash, unit};
 use crate::trace::Scene;
 
 /// Points per side of the stratification grid: `SIDE²` rays per triangle side.
@@ -19,20 +20,6 @@ pub const SIDE: u32 = 4;
 
 /// Sky visibility of each triangle's corners, `[front, back]` sides, each in `[0, 1]`.
 pub type TriangleSky = [[f32; 3]; 2];
-
-/// A 32-bit integer hash (lowbias32), for the stratified jitter.
-fn hash(mut x: u32) -> u32 {
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb_352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846c_a68b);
-    x ^= x >> 16;
-    x
-}
-
-fn unit(x: u32) -> f32 {
-    (x >> 8) as f32 / (1u32 << 24) as f32
-}
 
 /// A cosine-weighted direction about unit `n` for `u ∈ [0,1)²` (Malley's method).
 pub fn cosine_direction(n: Vec3, u: Vec2) -> Vec3 {

@@ -71,14 +71,6 @@ impl Lighting {
         }
     }
 
-    /// The same sky with the sun moved to `azimuth_deg`, `elevation_deg`.
-    pub fn sun_at(self, azimuth_deg: f32, elevation_deg: f32) -> Self {
-        Self {
-            sun_dir: sun_direction(azimuth_deg, elevation_deg),
-            ..self
-        }
-    }
-
     /// Check every value: a unit-length sun direction (within 1e-3), finite non-negative
     /// colours and a finite positive exposure. The error names the bad one.
     pub fn validate(&self) -> Result<(), String> {

@@ -12,6 +12,18 @@ use glam::Vec3;
 
 const SIZE: u32 = 128;
 
+/// Both forms' options: a `SIZE`² view refined down to ε = 1 over a transparent background,
+/// under `light`.
+fn options(light: Lighting) -> RendererOptions {
+    RendererOptions {
+        viewport: (SIZE, SIZE),
+        min_epsilon: 1.0,
+        background: Background::Transparent,
+        lighting: light,
+        ..Default::default()
+    }
+}
+
 /// Mean luminance of the covered pixels on each side of the tree's centre along world +X:
 /// (the +X half, the −X half).
 fn halves(img: &image::RgbaImage, cam: &Camera, centre: Vec3) -> (f32, f32) {
@@ -57,13 +69,7 @@ fn rotated_instances_are_lit_from_the_one_sun() {
             1.0,
         );
         let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-        let opts = RendererOptions {
-            viewport: (SIZE, SIZE),
-            min_epsilon: 1.0,
-            background: Background::Transparent,
-            lighting: sun,
-            ..Default::default()
-        };
+        let opts = options(sun);
         let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
         let target = Target::new(&ctx, SIZE, SIZE);
         stream.render_fitted(&ctx, &cam, &target).unwrap();
@@ -114,13 +120,9 @@ fn a_low_sun_matches_the_reference_and_baked_light_does_not() {
     );
     let render_quads = |light: Lighting| {
         let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
-        let opts = RendererOptions {
-            viewport: (SIZE, SIZE),
-            min_epsilon: 1.0,
-            background: Background::Transparent,
-            ..Default::default()
-        };
-        let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
+        // The stream's own light is the default: the frame's replaces it.
+        let mut stream =
+            QuadStream::new(&ctx.device, scene, &options(Lighting::default())).unwrap();
         // Through the host API: the frame carries its light.
         let mut frame = forest_render::FrameParams::from(&cam);
         frame.light = light;
@@ -139,9 +141,7 @@ fn a_low_sun_matches_the_reference_and_baked_light_does_not() {
         &forest,
         &RendererOptions {
             format: TARGET_FORMAT,
-            background: Background::Transparent,
-            lighting: low,
-            ..Default::default()
+            ..options(low)
         },
     )
     .unwrap();

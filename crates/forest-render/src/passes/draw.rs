@@ -40,6 +40,17 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         },
         count: None,
     };
+    // The colour (6) and surface (11) layers, sampled filtered by the fragment stage.
+    let layer_array = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        },
+        count: None,
+    };
     vec![
         uniform(0),
         storage(1),
@@ -56,16 +67,7 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             },
             count: None,
         },
-        wgpu::BindGroupLayoutEntry {
-            binding: 6,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2Array,
-                multisampled: false,
-            },
-            count: None,
-        },
+        layer_array(6),
         wgpu::BindGroupLayoutEntry {
             binding: 7,
             visibility: wgpu::ShaderStages::FRAGMENT,
@@ -75,16 +77,7 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         uniform(8),
         storage(9),
         storage(10),
-        wgpu::BindGroupLayoutEntry {
-            binding: 11,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2Array,
-                multisampled: false,
-            },
-            count: None,
-        },
+        layer_array(11),
         crate::terrain::heights_entry(),
     ]
 }
