@@ -30,6 +30,12 @@ $forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${spec
 # The hybrid: the trees within a few crown radii as full geometry, the rest as the quad stream.
 $forest render out/forest-100k.forest -o out/render/forest.png --view inside --view hill --view birds-eye \
   --size 800x600 --method hybrid --models "$(IFS=,; echo "${models[*]}")"
+# The same forest at two times of day: a low morning sun and noon.
+for t in 7.5 12; do
+  $forest render out/forest-100k.forest -o "out/render/forest-$t.png" --view hill --time "$t" \
+    --size 800x600 --method hybrid --models "$(IFS=,; echo "${models[*]}")"
+done
 echo
-echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png"
+echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png,"
+echo "  at 7:30 and noon: out/render/forest-7.5.png, out/render/forest-12.png"
 echo "Atlases: out/atlases/, contact sheets: out/contact/"

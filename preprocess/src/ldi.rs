@@ -51,6 +51,17 @@ pub(crate) fn unit(x: u32) -> f32 {
     (x >> 8) as f32 / (1u32 << 24) as f32
 }
 
+/// Barycentric weights of point `s` of `side²` stratified, jittered points on triangle `tri`
+/// (`salt` separates the users' jitter): stratum `(s mod side, s div side)` of the unit square,
+/// warped onto the triangle by `(1 − √u, √u(1 − v), √u·v)`, uniform by area.
+pub(crate) fn stratified_barycentric(tri: u32, s: u32, side: u32, salt: u32) -> [f32; 3] {
+    let h = hash(tri ^ hash(s ^ salt));
+    let u = ((s % side) as f32 + unit(h)) / side as f32;
+    let v = ((s / side) as f32 + unit(hash(h))) / side as f32;
+    let r = u.sqrt();
+    [1.0 - r, r * (1.0 - v), r * v]
+}
+
 /// Sample offset `k` of `spp` within pixel `seed`: stratified on an `n × n` grid when `spp`
 /// is a square, else uniformly jittered; each in `[0,1)²`.
 pub fn sample_offset(seed: u32, k: u32, spp: u32) -> Vec2 {

@@ -13,7 +13,9 @@ pub mod gltf_mesh;
 pub mod ldi;
 pub mod lod;
 pub mod mesh;
+pub mod opacity;
 pub mod quadtree;
+pub mod shadowing;
 pub mod sky;
 pub mod texture;
 pub mod trace;
@@ -225,7 +227,8 @@ pub fn bake_mesh(
         count: params.layers(),
         rgba: images.surface.clone(),
     };
-    let atlas = Atlas::from_layers(manifest, &layers, &surface, nodes)?;
+    let volume = opacity::opacity_volume(mesh, &sphere, forest_format::opacity::VOLUME_RESOLUTION);
+    let atlas = Atlas::from_layers(manifest, &layers, &surface, &volume, nodes)?;
     Ok(BakeOutput {
         atlas,
         images,

@@ -400,6 +400,14 @@ impl Mesh {
         })
     }
 
+    /// Whether barycentric point `b` of triangle `t` is solid: not a hole of an alpha-tested
+    /// material (alpha below [`ALPHA_CUTOFF`]).
+    pub fn solid_at(&self, t: &Tri, b: [f32; 3]) -> bool {
+        self.materials[t.material as usize].alpha.is_none()
+            || self.alpha(t.material, t.uv[0] * b[0] + t.uv[1] * b[1] + t.uv[2] * b[2])
+                >= ALPHA_CUTOFF
+    }
+
     /// Alpha of material `m` at `uv` (1 for materials without alpha).
     pub fn alpha(&self, m: u32, uv: Vec2) -> f32 {
         match self.materials[m as usize].alpha {

@@ -244,7 +244,7 @@ fn the_same_input_gives_a_byte_identical_atlas() {
         listing.sort();
         files.push(listing);
     }
-    assert_eq!(files[0].len(), 5);
+    assert_eq!(files[0].len(), 6);
     assert_eq!(files[0], files[1]);
 }
 

@@ -5,7 +5,9 @@
 // Meshes are shaded with the project's one shading model (shade_light, forest_format::shading)
 // in world space under the frame's light (the camera uniform's): an instance's rotation turns
 // its normals, not the sun. Sky visibility is per vertex and per side, traced by the bake's
-// ray tracer (the values the slab images are baked with). Under stochastic simplification a
+// ray tracer (the values the slab images are baked with). Sun visibility comes from marching
+// the species' opacity volume towards the frame's sun (sun_transmittance): per vertex for
+// meshes, per fragment for billboards. Under stochastic simplification a
 // leaf vertex is moved towards its leaf's centre by the fade × area factor and the leaf's
 // albedo pulled towards the species' mean by √λ; at λ = 1 nothing is touched, so the image is
 // exactly the full geometry's.
@@ -25,6 +27,9 @@
 @group(0) @binding(10) var<uniform> method: Method;
 @group(0) @binding(11) var<storage, read> leaf_centre: array<vec4<f32>>;
 @group(0) @binding(12) var billboards: texture_2d_array<f32>;
+// Every species' opacity volume, stacked (forest_render::opacity), and its clamping sampler.
+@group(0) @binding(14) var opacity: texture_3d<f32>;
+@group(0) @binding(15) var opacity_sampler: sampler;
 
 struct GeoOut {
     @builtin(position) clip: vec4<f32>,
@@ -42,6 +47,8 @@ struct GeoOut {
     @location(6) @interpolate(flat) form: vec2<u32>,
     // The surface point (world, metres), for the haze.
     @location(7) world: vec3<f32>,
+    // Transmittance towards the sun through the tree's own crown (its opacity volume).
+    @location(8) sun_vis: f32,
 }
 
 // The instance and its quad share (0 outside the hybrid's transition band).
@@ -87,6 +94,9 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     out.material = v.material;
     out.contrast = contrast;
     out.form = geo_form(id, inst);
+    let sp = geo_species[inst.species];
+    out.sun_vis = sun_transmittance(opacity, opacity_sampler, inst.species, sp.sphere,
+                                    sp.opacity_depth, p, to_object_dir(inst, camera.sun.xyz));
     return out;
 }
 
@@ -110,7 +120,7 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
         n = -n;
         sky = in.sky.y;
     }
-    let c = shade_light(albedo, n, 1.0, sky, m.kd.a);
+    let c = shade_light(albedo, n, in.sun_vis, sky, m.kd.a);
     return hazed(vec4<f32>(c, 1.0), in.world);
 }
 
@@ -124,6 +134,14 @@ struct BillboardOut {
     @location(4) @interpolate(flat) right: vec3<f32>,
     @location(5) @interpolate(flat) up: vec3<f32>,
     @location(6) @interpolate(flat) back: vec3<f32>,
+    // The point in object space (on the plane through the tree's centre), where the march
+    // towards the sun starts.
+    @location(7) obj: vec3<f32>,
+    // The species' bounding sphere; its index.
+    @location(8) @interpolate(flat) sphere: vec4<f32>,
+    @location(9) @interpolate(flat) species: u32,
+    // xyz: the sun's direction in object space; w: the species' opacity depth.
+    @location(10) @interpolate(flat) sun_obj: vec4<f32>,
 }
 
 // A camera-facing quad over the tree's bounding sphere showing the billboard image whose
@@ -157,6 +175,10 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.right = right;
     out.up = up;
     out.back = -f;
+    out.obj = to_object_point(inst, out.world);
+    out.sphere = sp.sphere;
+    out.species = inst.species;
+    out.sun_obj = vec4<f32>(to_object_dir(inst, camera.sun.xyz), sp.opacity_depth);
     return out;
 }
 
@@ -168,5 +190,8 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     if (t.a < 0.5) { discard; }
     let local = hemi_oct_decode(g.xy);
     let n = normalize(local.x * in.right + local.y * in.up + local.z * in.back);
-    return hazed(vec4<f32>(shade_light(t.rgb, n, 1.0, g.z, g.w), 1.0), in.world);
+    // The billboard lies on the plane through the tree's centre: march from there.
+    let v = sun_transmittance(opacity, opacity_sampler, in.species, in.sphere, in.sun_obj.w,
+                              in.obj, in.sun_obj.xyz);
+    return hazed(vec4<f32>(shade_light(t.rgb, n, v, g.z, g.w), 1.0), in.world);
 }

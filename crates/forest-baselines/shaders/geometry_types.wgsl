@@ -44,6 +44,11 @@ struct GeoSpecies {
     // The hybrid's switch unit (forest_render::forms::switch_unit): metres of switch distance
     // per focal pixel at scale 1.
     switch_unit: f32,
+    // Optical depth per voxel length of the opacity-volume code 1.0 (0: no self-shadowing).
+    opacity_depth: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // The method and its parameters (forest_render::geometry::MeshMethod).

@@ -26,6 +26,11 @@ pub struct GpuGeoSpecies {
     pub mean_leaf: [f32; 3],
     /// The hybrid's switch unit ([`forest_render::forms::switch_unit`]).
     pub switch_unit: f32,
+    /// Optical depth per voxel length of the species' opacity-volume code 255 (0: no
+    /// self-shadowing; see [`forest_format::opacity`]).
+    pub opacity_depth: f32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 3],
 }
 
 /// The geometry method and its parameters (48 bytes; `Method` in

@@ -122,6 +122,19 @@ impl ForestRenderer {
         self.stream.options_built().background
     }
 
+    /// Light every method's next frames with `light` (the quad stream's and the geometry
+    /// renderer's, so that the hybrid's two forms agree); the error names a bad value.
+    pub fn set_light(
+        &mut self,
+        light: forest_format::shading::Lighting,
+    ) -> Result<(), RenderError> {
+        self.stream.set_light(light)?;
+        if let Some(g) = &mut self.geometry {
+            g.set_light(light)?;
+        }
+        Ok(())
+    }
+
     /// Switch the method; the geometry-based ones and the hybrid need the geometry renderer.
     pub fn set_method(&mut self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
         let missing = RenderError::MissingData {

@@ -44,6 +44,10 @@ fn geometry_structs_match_the_host() {
                 ("r", offset_of!(GpuGeoSpecies, r)),
                 ("mean_leaf", offset_of!(GpuGeoSpecies, mean_leaf)),
                 ("switch_unit", offset_of!(GpuGeoSpecies, switch_unit)),
+                ("opacity_depth", offset_of!(GpuGeoSpecies, opacity_depth)),
+                ("pad0", offset_of!(GpuGeoSpecies, pad)),
+                ("pad1", offset_of!(GpuGeoSpecies, pad) + 4),
+                ("pad2", offset_of!(GpuGeoSpecies, pad) + 8),
             ],
         ),
         (

@@ -75,6 +75,10 @@ pub struct LightArgs {
     /// 0 to 90 above the horizon).
     #[arg(long, default_value = "30,55", value_parser = parse_sun, allow_hyphen_values = true)]
     pub sun: (f32, f32),
+    /// Daylight at this local solar hour instead of --sun: 6 (sunrise, east) to 18 (sunset,
+    /// west), 65° at noon; the sun reddens and the sky dims and warms as it sinks.
+    #[arg(long, conflicts_with = "sun", allow_negative_numbers = true)]
+    pub time: Option<f32>,
     /// Exposure: every radiance is scaled by it (above 0).
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub exposure: f32,
@@ -87,9 +91,16 @@ impl LightArgs {
         if !(0.0..=90.0).contains(&el) {
             anyhow::bail!("--sun {az},{el}: the elevation must be 0 to 90 degrees");
         }
+        let base = match self.time {
+            Some(h) if !(6.0..=18.0).contains(&h) => {
+                anyhow::bail!("--time {h}: the hour must be 6 (sunrise) to 18 (sunset)")
+            }
+            Some(h) => forest_format::shading::Lighting::at_hour(h, crate::window::NOON_ELEVATION),
+            None => forest_format::shading::Lighting::with_sun(az, el),
+        };
         let l = forest_format::shading::Lighting {
             exposure: self.exposure,
-            ..forest_format::shading::Lighting::with_sun(az, el)
+            ..base
         };
         l.validate()
             .map_err(|e| anyhow::anyhow!("--exposure {}: {e}", self.exposure))?;

@@ -22,6 +22,7 @@ pub mod forest;
 pub mod generate;
 pub mod node;
 pub mod nodes_codec;
+pub mod opacity;
 pub mod shading;
 pub mod slab;
 pub mod terrain;

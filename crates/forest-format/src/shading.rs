@@ -59,6 +59,38 @@ impl Default for Lighting {
 }
 
 impl Lighting {
+    /// Daylight with the sun at the given azimuth and elevation (degrees; elevation clamped
+    /// to [0.5°, 90°]): the sun reddens and dims through the air mass it crosses
+    /// (Kasten–Young's air mass, per-channel extinction), the sky dims and warms as the sun
+    /// sinks, and the ground bounce follows both. Close to [`Lighting::with_sun`] at 55°.
+    pub fn daylight(azimuth_deg: f32, elevation_deg: f32) -> Self {
+        let el = elevation_deg.clamp(0.5, 90.0);
+        let s = el.to_radians().sin();
+        let air_mass = 1.0 / (s + 0.505_72 * (el + 6.079_95).powf(-1.6364));
+        let extinction = Vec3::new(0.06, 0.12, 0.27);
+        let sun = Vec3::splat(1.08) * (-extinction * air_mass).exp();
+        let h = s.sqrt();
+        let sky = Vec3::new(0.40, 0.34, 0.30).lerp(Vec3::new(0.32, 0.38, 0.48), h)
+            * ((0.25 + 0.75 * h) / (0.25 + 0.75 * 0.905));
+        let ground = (sun * s + sky) * Vec3::new(0.062, 0.056, 0.044);
+        Self {
+            sun_dir: sun_direction(azimuth_deg, el),
+            sun,
+            sky,
+            ground,
+            exposure: 1.0,
+        }
+    }
+
+    /// [`Lighting::daylight`] at a local solar hour in [6, 18] (clamped): the sun rises at 6
+    /// in the east (azimuth 90°), culminates at 12 in the south (180°) at `max_elevation_deg`,
+    /// and sets at 18 in the west (270°).
+    pub fn at_hour(hour: f32, max_elevation_deg: f32) -> Self {
+        let t = ((hour.clamp(6.0, 18.0) - 6.0) / 12.0).clamp(0.0, 1.0);
+        let el = max_elevation_deg * (std::f32::consts::PI * t).sin();
+        Self::daylight(90.0 + 180.0 * t, el)
+    }
+
     /// The default sun colour, sky and ground with the sun at the given azimuth (degrees from
     /// +Z towards +X) and elevation (degrees above the horizon).
     pub fn with_sun(azimuth_deg: f32, elevation_deg: f32) -> Self {
@@ -195,6 +227,38 @@ pub fn srgb_decode_table() -> [f32; 256] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn daylight_reddens_and_dims_as_the_sun_sinks() {
+        let noon = Lighting::daylight(180.0, 60.0);
+        let low = Lighting::daylight(250.0, 8.0);
+        assert!(noon.validate().is_ok() && low.validate().is_ok());
+        // Near the default light at 55°.
+        let d = Lighting::daylight(30.0, 55.0);
+        assert!(
+            (d.sun - Lighting::default().sun).abs().max_element() < 0.08,
+            "{}",
+            d.sun
+        );
+        assert!(
+            (d.sky - Lighting::default().sky).abs().max_element() < 0.02,
+            "{}",
+            d.sky
+        );
+        // Low sun: dimmer, and red over blue far more than at noon.
+        assert!(low.sun.length() < noon.sun.length());
+        assert!(low.sun.x / low.sun.z > 2.0 * noon.sun.x / noon.sun.z);
+        assert!(low.sky.length() < noon.sky.length());
+        // The hours: sunrise east, noon south at the given height, sunset west.
+        let rise = Lighting::at_hour(6.0, 65.0).sun_dir;
+        assert!(rise.x > 0.99 && rise.y > 0.0 && rise.y < 0.01, "{rise}");
+        let n = Lighting::at_hour(12.0, 65.0).sun_dir;
+        assert!(
+            (n.y - 65f32.to_radians().sin()).abs() < 1e-4 && n.z < 0.0,
+            "{n}"
+        );
+        assert!(Lighting::at_hour(18.0, 65.0).sun_dir.x < -0.99);
+    }
 
     #[test]
     fn srgb_round_trips_all_bytes() {

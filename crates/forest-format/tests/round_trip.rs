@@ -114,7 +114,10 @@ fn atlas_round_trip(params: BakeParams, pixels: &[(u8, [u8; 3])], nodes: Vec<Qua
             .collect(),
         ..layers.clone()
     };
-    let atlas = Atlas::from_layers(manifest, &layers, &surface, nodes).unwrap();
+    let r = forest_format::opacity::VOLUME_RESOLUTION;
+    let depths: Vec<f32> = (0..r.pow(3)).map(|i| (i % 11) as f32 * 0.07).collect();
+    let volume = forest_format::opacity::OpacityVolume::from_depths(r, &depths);
+    let atlas = Atlas::from_layers(manifest, &layers, &surface, &volume, nodes).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("r.atlas");
     atlas.save(&path).unwrap();
@@ -136,6 +139,9 @@ fn atlas_round_trip(params: BakeParams, pixels: &[(u8, [u8; 3])], nodes: Vec<Qua
     }
     // The surface mosaic is lossless.
     assert_eq!(back.decode_surface(&path, &decoded).unwrap(), surface);
+    // So is the opacity volume, and its coding is in the manifest.
+    assert_eq!(back.decode_opacity(&path).unwrap(), volume);
+    assert_eq!(back.manifest.opacity.max_depth, volume.max_depth);
 }
 
 fn atlas_params() -> impl Strategy<Value = BakeParams> {

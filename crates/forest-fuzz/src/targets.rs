@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use forest_format::atlas::{ALPHA_FILE, Atlas, MANIFEST_FILE, NODES_FILE, SURFACE_FILE};
+use forest_format::atlas::{
+    ALPHA_FILE, Atlas, MANIFEST_FILE, NODES_FILE, OPACITY_FILE, SURFACE_FILE,
+};
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
 
@@ -111,15 +113,16 @@ fn nodes(data: &[u8]) -> bool {
     forest_format::nodes_codec::decode(data).is_ok()
 }
 
-/// Files: manifest, colour mosaic, alpha mosaic, nodes, surface mosaic.
+/// Files: manifest, colour mosaic, alpha mosaic, nodes, surface mosaic, opacity volume.
 fn atlas(data: &[u8]) -> bool {
-    let files = crate::split_files(data, 5);
+    let files = crate::split_files(data, 6);
     let read = |name: &str| -> Result<Vec<u8>, forest_format::FormatError> {
         Ok(match name {
             MANIFEST_FILE => files[0],
             ALPHA_FILE => files[2],
             NODES_FILE => files[3],
             SURFACE_FILE => files[4],
+            OPACITY_FILE => files[5],
             _ => files[1],
         }
         .to_vec())

@@ -1,6 +1,8 @@
 //! Viewed exactly along a sampling direction from far away (nearly orthographic), with a tiny
 //! ε, the quad stream reproduces the bake's own slab images (front slab over back slab), each
-//! texel lit on the CPU by the shading model under the stream's light.
+//! texel lit on the CPU by the shading model under the stream's light. The opacity volume is
+//! left empty here (no self-shadowing): the slab texels do not record where along the ray
+//! they lie, and the march is checked on its own (tests/opacity.rs, tests/lighting.rs).
 
 mod common;
 
@@ -12,7 +14,10 @@ use forest_render::{GpuScene, QuadStream};
 #[test]
 fn a_tree_seen_along_a_sampling_direction_matches_its_slab_images() {
     let ctx = common::ctx();
-    let species = common::species();
+    let mut species = common::species();
+    for s in &mut species {
+        s.opacity = forest_format::opacity::OpacityVolume::empty(s.opacity.resolution);
+    }
     let atlas = &species[0].atlas; // bush, 64 px, 5 directions, 2 slabs
     let forest = common::one_tree(0, 0.0);
     let res = atlas.manifest.params.resolution;

@@ -52,8 +52,6 @@ fn halves(img: &image::RgbaImage, cam: &Camera, centre: Vec3) -> (f32, f32) {
 /// rotation, the half of its crown towards the sun is the brighter, for the quad stream and
 /// for full geometry (its rotation turns the normals, not the sun).
 #[test]
-#[ignore = "needs self-shadowing under the run-time sun, not built yet: without it each leaf is \
-            lit by its own normal alone, and the two halves differ by 2 % (quads, 0°)"]
 fn rotated_instances_are_lit_from_the_one_sun() {
     let ctx = common::ctx();
     let sun = Lighting::with_sun(90.0, 20.0);

@@ -40,6 +40,49 @@ fn shade_light(a: vec3<f32>, n: vec3<f32>, v: f32, s: f32, tau: f32) -> vec3<f32
     return a * (ambient + camera.sun_colour.rgb * (v * direct)) * camera.sun.w;
 }
 
+// The march towards the sun through a tree's opacity volume (mirrors
+// forest_format::opacity: VOLUME_RESOLUTION, MARCH_STEPS, START_VOXELS).
+const OPACITY_RES: f32 = 32.0;
+const OPACITY_STEPS: u32 = 16u;
+const OPACITY_START: f32 = 0.5;
+
+// Distance along unit `d` from `u` to where the ray leaves [0, 1]³ (opacity::cube_exit).
+fn cube_exit(u: vec3<f32>, d: vec3<f32>) -> f32 {
+    var t = 3.0e38;
+    for (var i = 0u; i < 3u; i++) {
+        if (d[i] > 1e-8) {
+            t = min(t, (1.0 - u[i]) / d[i]);
+        } else if (d[i] < -1e-8) {
+            t = min(t, -u[i] / d[i]);
+        }
+    }
+    return max(t, 0.0);
+}
+
+// Transmittance towards the sun from object-space point `p` of a tree of species `k`
+// (mirrors forest_format::opacity::OpacityVolume::transmittance): `vol` holds every species'
+// volume stacked along z (species k at slices k·R ..), `sphere` is the species' bounding
+// sphere, `max_depth` its volume's coding, `sun` the unit direction towards the sun in object
+// space. Sampled at level 0, so any stage may call it.
+fn sun_transmittance(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
+                     max_depth: f32, p: vec3<f32>, sun: vec3<f32>) -> f32 {
+    if (max_depth <= 0.0) { return 1.0; }
+    let u = (p - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
+    let exit = cube_exit(u, sun);
+    let start = OPACITY_START / OPACITY_RES;
+    if (exit <= start) { return 1.0; }
+    let dt = (exit - start) / f32(OPACITY_STEPS);
+    let slices = f32(textureDimensions(vol).z);
+    var sum = 0.0;
+    for (var i = 0u; i < OPACITY_STEPS; i++) {
+        let x = u + sun * (start + (f32(i) + 0.5) * dt);
+        let z = (f32(k) * OPACITY_RES + clamp(x.z * OPACITY_RES, 0.5, OPACITY_RES - 0.5)) / slices;
+        let s = textureSampleLevel(vol, samp, vec3<f32>(x.xy, z), 0.0).r;
+        sum = sum + s * s;
+    }
+    return exp(-sum * max_depth * dt * OPACITY_RES);
+}
+
 // Object direction -> world direction (the instance's rotation about +Y).
 fn to_world_dir(inst: Instance, d: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(inst.cos_rot * d.x + inst.sin_rot * d.z, d.y,
@@ -83,7 +126,8 @@ struct Species {
     // The hybrid's switch unit: metres of switch distance per focal pixel at scale 1
     // (forms::switch_unit).
     switch_unit: f32,
-    pad: u32,
+    // Optical depth per voxel length of the species' opacity-volume code 1.0 (0: none).
+    opacity_depth: f32,
 }
 
 // One direction frame: dir, right, up (xyz of each), object space.
@@ -233,6 +277,11 @@ fn to_world(inst: Instance, p: vec3<f32>) -> vec3<f32> {
     let s = p * inst.scale;
     return vec3<f32>(inst.cos_rot * s.x + inst.sin_rot * s.z, s.y,
                      -inst.sin_rot * s.x + inst.cos_rot * s.z) + inst.position;
+}
+
+// World point -> object point (the inverse of to_world).
+fn to_object_point(inst: Instance, w: vec3<f32>) -> vec3<f32> {
+    return to_object_dir(inst, w - inst.position) / inst.scale;
 }
 
 // World direction -> object direction (inverse rotation; scale does not change directions).

@@ -90,8 +90,9 @@ pub struct GpuSpecies {
     /// The hybrid's switch unit ([`crate::forms::switch_unit`], metres per focal pixel at
     /// scale 1).
     pub switch_unit: f32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
+    /// Optical depth per voxel length of the species' opacity-volume code 255
+    /// ([`forest_format::atlas::OpacityInfo::max_depth`]; 0: no self-shadowing).
+    pub opacity_depth: f32,
 }
 
 /// A sampling direction's frame (48 bytes; `w` unused).

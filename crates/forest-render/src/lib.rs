@@ -16,6 +16,7 @@ pub mod error;
 pub mod forms;
 pub mod frame;
 pub mod gpu_types;
+pub mod opacity;
 pub mod options;
 pub mod passes;
 pub mod reference;

@@ -20,6 +20,8 @@ pub struct SpeciesData {
     pub layers: Layers,
     /// Its decoded surface-attribute layers (see [`forest_format::atlas`]).
     pub surface: Layers,
+    /// Its decoded opacity volume (see [`forest_format::opacity`]).
+    pub opacity: forest_format::opacity::OpacityVolume,
 }
 
 impl SpeciesData {
@@ -33,10 +35,12 @@ impl SpeciesData {
     pub fn decode(atlas: Atlas, path: &std::path::Path) -> Result<Self, RenderError> {
         let layers = atlas.decode_layers(path)?;
         let surface = atlas.decode_surface(path, &layers)?;
+        let opacity = atlas.decode_opacity(path)?;
         Ok(Self {
             atlas,
             layers,
             surface,
+            opacity,
         })
     }
 }
@@ -112,7 +116,7 @@ impl SceneTables {
                 lower_tri_count: m.lower_triangles.len() as u32,
                 resolution: m.params.resolution,
                 switch_unit: crate::forms::switch_unit(m),
-                pad: 0,
+                opacity_depth: m.opacity.max_depth,
             });
             t.frames.extend(m.directions.iter().map(|f| GpuFrame {
                 dir: f.dir.extend(0.0).to_array(),
@@ -271,6 +275,8 @@ pub struct GpuScene {
     /// Surface layers of all species, the same layout as `colour` (premultiplied octahedral
     /// normal, sky visibility, translucency; linear).
     pub surface: wgpu::Texture,
+    /// Opacity volumes of all species, stacked ([`crate::opacity`]).
+    pub opacity: wgpu::Texture,
     /// Node texture (`Rgba32Uint`, [`NODE_TEXTURE_WIDTH`] wide): the node's two words, its
     /// covered box, 0.
     pub nodes: wgpu::Texture,
@@ -481,8 +487,12 @@ impl GpuScene {
             4,
             bytemuck::cast_slice(&tables.presort),
         )?;
+        let volumes: Vec<_> = species.iter().map(|s| &s.opacity).collect();
+        let (opacity, opacity_bytes) =
+            crate::opacity::opacity_texture(&ctx.device, &ctx.queue, &volumes)?;
         let bytes = colour_bytes
             + surface_bytes
+            + opacity_bytes
             + u64::from(nodes.height()) * u64::from(NODE_TEXTURE_WIDTH) * 16
             + u64::from(presort.height()) * u64::from(PRESORT_TEXTURE_WIDTH) * 4
             + (std::mem::size_of_val(tables.instances.as_slice())
@@ -503,6 +513,7 @@ impl GpuScene {
             tables,
             colour,
             surface,
+            opacity,
             nodes,
             presort,
             bytes,

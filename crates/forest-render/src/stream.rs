@@ -356,6 +356,7 @@ impl QuadStream {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
+        let opacity_view = scene.opacity.create_view(&Default::default());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("colour"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -384,10 +385,16 @@ impl QuadStream {
                         state.as_entire_binding(),
                         wgpu::BindingResource::TextureView(&surface_view),
                     ]),
-                    vec![wgpu::BindGroupEntry {
-                        binding: crate::terrain::HEIGHTS_BINDING,
-                        resource: scene.terrain.heights.as_entire_binding(),
-                    }],
+                    vec![
+                        wgpu::BindGroupEntry {
+                            binding: crate::terrain::HEIGHTS_BINDING,
+                            resource: scene.terrain.heights.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: crate::passes::draw::OPACITY_BINDING,
+                            resource: wgpu::BindingResource::TextureView(&opacity_view),
+                        },
+                    ],
                 ]
                 .concat(),
             })

@@ -70,5 +70,13 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         buffer(11, S::VERTEX, read),
         texture(12),
         forest_render::terrain::heights_entry(),
+        // The species' opacity volumes and their clamping sampler.
+        forest_render::opacity::opacity_entry(14),
+        wgpu::BindGroupLayoutEntry {
+            binding: 15,
+            visibility: S::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        },
     ]
 }

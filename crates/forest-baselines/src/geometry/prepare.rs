@@ -1,9 +1,10 @@
 //! The CPU preparation of the geometry-based methods: reference vertices with traced sky
-//! visibility, the LOD set, billboard images and material layers (the bake's tracer and
-//! simplifier do the work). Nothing here depends on the light: renderers light at run time.
+//! visibility, the LOD set, billboard images, material layers and opacity volumes (the bake's
+//! tracer, simplifier and voxeliser do the work). Nothing here depends on the light: renderers light at run time.
 
 use forest_bake::RefVertex;
 use forest_bake::lod::LodParams;
+use forest_format::opacity::{OpacityVolume, VOLUME_RESOLUTION};
 
 use super::params::{GeometrySpecies, SpeciesFigures};
 use super::textures::{layer_bytes, material_layer};
@@ -26,6 +27,7 @@ pub struct PreparedGeometry {
     pub(super) billboard_surface: Vec<image::RgbaImage>,
     pub(super) leaf_end: Vec<u32>,
     pub(super) leaf_centre: Vec<[f32; 4]>,
+    pub(super) opacity: Vec<OpacityVolume>,
     /// Per-species figures.
     pub figures: Vec<SpeciesFigures>,
 }
@@ -42,6 +44,7 @@ impl PreparedGeometry {
         let mut leaf_end: Vec<u32> = Vec::new();
         let mut leaf_centre: Vec<[f32; 4]> = Vec::new();
         let mut figures = Vec::new();
+        let mut opacity = Vec::new();
         for s in species {
             let material_base = materials.len() as u32;
             let (layers_base, billboards_base, vertices_base, leaves_base) = (
@@ -72,6 +75,8 @@ impl PreparedGeometry {
             let set = forest_bake::lod::build_lods(&reference, &leaf, &LodParams::default());
             let mean = forest_bake::lod::mean_leaf_colour(&s.mesh, &set.lod0);
             let sphere = forest_bake::bounding_sphere(&s.mesh);
+            // The bake's volume of the same model: the same self-shadowing as its quads.
+            let volume = forest_bake::opacity::opacity_volume(&s.mesh, &sphere, VOLUME_RESOLUTION);
             let first = vertices.len() as u32;
             let counts = [
                 set.lod0.len() as u32,
@@ -93,7 +98,10 @@ impl PreparedGeometry {
                 r: set.r,
                 mean_leaf: mean.to_array(),
                 switch_unit: s.switch_unit,
+                opacity_depth: volume.max_depth,
+                pad: [0; 3],
             });
+            opacity.push(volume);
             leaf_end.extend(&set.leaf_end);
             leaf_centre.extend(set.leaf_centre.iter().map(|c| c.extend(0.0).to_array()));
             for b in
@@ -119,6 +127,7 @@ impl PreparedGeometry {
                     + std::mem::size_of_val(&leaf_end[leaves_base..])
                     + std::mem::size_of_val(&leaf_centre[leaves_base..]))
                     as u64
+                    + u64::from(VOLUME_RESOLUTION).pow(3)
                     + layer_bytes(&layers[layers_base..])
                     + 2 * layer_bytes(&billboard_layers[billboards_base..]),
             });
@@ -132,8 +141,19 @@ impl PreparedGeometry {
             billboard_surface,
             leaf_end,
             leaf_centre,
+            opacity,
             figures,
         }
+    }
+
+    /// A copy without self-shadowing (every species' opacity volume left out): for measuring
+    /// what the self-shadowing contributes (tests, experiments).
+    pub fn without_self_shadowing(&self) -> Self {
+        let mut out = self.clone();
+        out.geo_species
+            .iter_mut()
+            .for_each(|s| s.opacity_depth = 0.0);
+        out
     }
 
     /// A copy with every vertex's traced sky visibility (both sides) replaced by

@@ -101,6 +101,7 @@ impl GeometryRenderer {
             billboard_surface,
             leaf_end,
             leaf_centre,
+            opacity,
             figures,
         } = prepared;
         opts.atmosphere.validate().map_err(RenderError::Parameter)?;
@@ -216,7 +217,25 @@ impl GeometryRenderer {
             billboard_surface,
             true,
         );
-        gpu_bytes.set(gpu_bytes.get() + material_bytes + billboard_bytes + billboard_surface_bytes);
+        let (opacity_texture, opacity_bytes) = forest_render::opacity::opacity_texture(
+            device,
+            &ctx.queue,
+            &opacity.iter().collect::<Vec<_>>(),
+        )?;
+        let opacity_view = opacity_texture.create_view(&Default::default());
+        let opacity_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("opacity"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        gpu_bytes.set(
+            gpu_bytes.get()
+                + material_bytes
+                + billboard_bytes
+                + billboard_surface_bytes
+                + opacity_bytes,
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("material"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -361,6 +380,8 @@ impl GeometryRenderer {
                 forest_render::terrain::HEIGHTS_BINDING,
                 terrain.heights.as_entire_binding(),
             ),
+            (14, wgpu::BindingResource::TextureView(&opacity_view)),
+            (15, wgpu::BindingResource::Sampler(&opacity_sampler)),
         ];
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("geometry draw"),

@@ -8,6 +8,7 @@ pub mod chart;
 mod fidelity;
 mod path;
 mod report;
+mod shadowing;
 mod stability;
 mod storage;
 mod table1;
@@ -30,8 +31,9 @@ use forest_render::work::FrameWork;
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
 /// The suites, in the order `all` runs them.
-pub const SUITES: [&str; 7] = [
+pub const SUITES: [&str; 8] = [
     "storage",
+    "shadowing",
     "table1",
     "path",
     "accuracy",
@@ -43,10 +45,11 @@ pub const SUITES: [&str; 7] = [
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Suite: storage, table1, path, accuracy, stability, budget, fidelity, or all. Every run
+    /// Suite: storage, shadowing, table1, path, accuracy, stability, budget, fidelity, or all. Every run
     /// updates REPORT.md with the sections of all suites run into the results folder so far.
     #[arg(value_parser = [
-        "storage", "table1", "path", "accuracy", "stability", "budget", "fidelity", "all",
+        "storage", "shadowing", "table1", "path", "accuracy", "stability", "budget", "fidelity",
+        "all",
     ])]
     pub suite: String,
     /// Species atlases (comma-separated).
@@ -511,6 +514,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for s in suites {
         let section = match s {
             "storage" => storage::run(&b)?,
+            "shadowing" => shadowing::run(&b)?,
             "table1" => table1::run(&b)?,
             "path" => path::run(&b)?,
             "accuracy" if args.redraw => accuracy::redraw(&b)?,

@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use anyhow::Result;
+use forest_format::shading::Lighting;
 use forest_render::options::DebugView;
 
 use super::{Viewer, Walker};
@@ -47,6 +48,10 @@ impl Viewer {
             };
             let view = output.texture.create_view(&Default::default());
             let mut enc = g.ctx.device.create_command_encoder(&Default::default());
+            if std::mem::take(&mut self.hour_changed) {
+                let light = Lighting::at_hour(self.hour, super::NOON_ELEVATION);
+                g.renderer.set_light(light)?;
+            }
             g.renderer.set_pipeline_statistics(self.count_work);
             g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
             let raw = g.egui_state.take_egui_input(&g.window);

@@ -1,10 +1,10 @@
 //! The viewer's egui HUD: frame and pass times, counters, quads per level, the ε slider, the
-//! method and debug-view switches, the key list.
+//! time-of-day slider, the method and debug-view switches, the key list.
 
 use forest_baselines::methods::Method;
 use forest_render::options::DebugView;
 
-use super::{EPSILON_RANGE, KEYS, Viewer};
+use super::{EPSILON_RANGE, HOURS, KEYS, Viewer};
 
 impl Viewer {
     /// The HUD; returns the method and debug view picked with the mouse, if any.
@@ -84,6 +84,14 @@ impl Viewer {
                         .logarithmic(true)
                         .text("ε (px)"),
                 );
+                let hours = ui.add(
+                    egui::Slider::new(&mut self.hour, HOURS.0..=HOURS.1)
+                        .step_by(0.25)
+                        .text("time of day (h): sun, its colour, the sky"),
+                );
+                if hours.changed() {
+                    self.hour_changed = true;
+                }
                 ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
                 ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
                 ui.checkbox(

@@ -41,13 +41,19 @@ use winit::window::{Window, WindowId};
 /// Eye height above the ground in walk mode (metres).
 pub const EYE_HEIGHT: f32 = 1.7;
 
+/// Range of the time-of-day slider and the T key (local solar hours: sunrise to sunset).
+pub const HOURS: (f32, f32) = (6.0, 18.0);
+/// The sun's elevation at noon under the time-of-day control (degrees).
+pub const NOON_ELEVATION: f32 = 65.0;
+
 /// Range of the ε slider and the [ / ] keys (pixels).
 pub const EPSILON_RANGE: (f32, f32) = (0.5, 64.0);
 
 /// The key list shown on screen.
-pub const KEYS: [&str; 3] = [
+pub const KEYS: [&str; 4] = [
     "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
     "F: walk/fly · 1-6: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
+    "T / Shift+T: time of day one hour later / earlier (sun, its colour and the sky)",
     "F12: screenshot · R: record path · P: play --path · Esc: quit",
 ];
 
@@ -115,6 +121,11 @@ pub struct Viewer {
     walker: Walker,
     terrain: Option<forest_format::terrain::Terrain>,
     epsilon: f32,
+    /// The time of day the HUD shows (hours); it lights the forest from its first change on
+    /// (until then the light is the one the viewer was started with).
+    hour: f32,
+    /// Whether `hour` changed since the renderer's light was last set.
+    hour_changed: bool,
     extent: f32,
     fov_deg: f32,
     methods: Vec<Method>,
@@ -173,6 +184,8 @@ impl Viewer {
             walker,
             terrain: st.terrain,
             epsilon: st.epsilon,
+            hour: 10.0,
+            hour_changed: false,
             extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),
             method: st.method.min(st.methods.len().saturating_sub(1)),
@@ -398,6 +411,13 @@ impl Viewer {
                 self.set_debug(next);
             }
             KeyCode::KeyP if self.path.is_some() => self.playing = Some(0),
+            KeyCode::KeyT => {
+                let shift = self.keys.contains(&KeyCode::ShiftLeft)
+                    || self.keys.contains(&KeyCode::ShiftRight);
+                let step = if shift { -1.0 } else { 1.0 };
+                self.hour = (self.hour + step).clamp(HOURS.0, HOURS.1);
+                self.hour_changed = true;
+            }
             KeyCode::Digit1 => self.set_method(0)?,
             KeyCode::Digit2 => self.set_method(1)?,
             KeyCode::Digit3 => self.set_method(2)?,

@@ -44,7 +44,7 @@ impl Layers {
     }
 }
 
-pub(super) fn encode_png(w: u32, h: u32, data: &[u8], colour: image::ExtendedColorType) -> Vec<u8> {
+pub(crate) fn encode_png(w: u32, h: u32, data: &[u8], colour: image::ExtendedColorType) -> Vec<u8> {
     use image::ImageEncoder;
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new_with_quality(

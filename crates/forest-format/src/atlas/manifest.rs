@@ -65,6 +65,18 @@ pub struct AtlasManifest {
     /// or before it was measured: the hybrid then uses its default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hybrid_switch: Option<HybridSwitch>,
+    /// The opacity volume in [`OPACITY_FILE`] (see [`crate::opacity`]).
+    pub opacity: OpacityInfo,
+}
+
+/// How the opacity volume ([`OPACITY_FILE`]) is sized and coded.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpacityInfo {
+    /// Voxels per side: [`crate::opacity::VOLUME_RESOLUTION`].
+    pub resolution: u32,
+    /// Optical depth per voxel length of code 255 (finite, ≥ 0).
+    pub max_depth: f32,
 }
 
 /// Where the quad stream becomes as accurate as the model's own triangles (full geometry at
@@ -110,8 +122,9 @@ impl AtlasManifest {
     }
 
     /// Bytes the runtime puts in GPU textures for this atlas: the colour and surface layers
-    /// as BC7 each (16 bytes per 4×4 block) with mips down to 4×4, plus the node texture (8 bytes per texel,
-    /// [`NODE_TEXTURE_WIDTH`] wide, rows rounded up).
+    /// as BC7 each (16 bytes per 4×4 block) with mips down to 4×4, the node texture (8 bytes
+    /// per texel, [`NODE_TEXTURE_WIDTH`] wide, rows rounded up) and the opacity volume (one
+    /// byte per voxel).
     pub fn gpu_bytes(&self) -> u64 {
         let mut per_layer = 0u64;
         let mut side = u64::from(self.params.resolution);
@@ -127,7 +140,9 @@ impl AtlasManifest {
             .node_count
             .div_ceil(u64::from(NODE_TEXTURE_WIDTH))
             .max(1);
-        2 * per_layer * u64::from(self.params.layers()) + rows * u64::from(NODE_TEXTURE_WIDTH) * 8
+        2 * per_layer * u64::from(self.params.layers())
+            + rows * u64::from(NODE_TEXTURE_WIDTH) * 8
+            + u64::from(self.opacity.resolution).pow(3)
     }
 
     /// Sampling directions as vectors.
@@ -157,6 +172,19 @@ impl AtlasManifest {
         self.params
             .validate()
             .or_else(|e| bad(format!("params: {e}")))?;
+        if self.opacity.resolution != crate::opacity::VOLUME_RESOLUTION {
+            return bad(format!(
+                "opacity.resolution = {}, but this program reads volumes of {} voxels a side",
+                self.opacity.resolution,
+                crate::opacity::VOLUME_RESOLUTION
+            ));
+        }
+        if !(self.opacity.max_depth.is_finite() && self.opacity.max_depth >= 0.0) {
+            return bad(format!(
+                "opacity.max_depth = {}, expected a finite number ≥ 0",
+                self.opacity.max_depth
+            ));
+        }
         if self.levels != self.params.levels() {
             return bad(format!(
                 "levels = {}, but resolution {} and min_quad {} give {}",
@@ -273,5 +301,9 @@ pub fn manifest_for(
         nodes_per_level,
         params,
         hybrid_switch: None,
+        opacity: OpacityInfo {
+            resolution: crate::opacity::VOLUME_RESOLUTION,
+            max_depth: 0.0,
+        },
     }
 }

@@ -10,6 +10,8 @@
 //!   linear and premultiplied by coverage like the colour: the octahedral code of the normal
 //!   facing the sampling ray (object space, [`crate::shading::oct_encode`]) in R and G, the sky
 //!   visibility in B and the translucency in A. The same tiling, lossless;
+//! - `opacity.png`: the opacity volume for self-shadowing under the run-time sun (see
+//!   [`crate::opacity`]), 8-bit grey, slices stacked downwards;
 //! - `nodes.bin`: the quad hierarchies of all layers (see [`crate::nodes_codec`]).
 //!
 //! [`Atlas::save`] writes to a temporary folder and renames it into place, so a reader never
@@ -28,14 +30,17 @@ use std::path::{Path, PathBuf};
 use crate::error::FormatError;
 use crate::node::QuadNode;
 use crate::nodes_codec;
+use crate::opacity::OpacityVolume;
 use crate::shading::srgb_encode;
 
 /// The `format` field of every atlas manifest.
 pub const ATLAS_FORMAT: &str = "forest-atlas";
-/// The atlas format version this crate reads and writes. Version 3 stores albedo and surface
-/// attributes for run-time light; versions 1 and 2 had one sun baked into the colour and are
-/// refused with a message to bake again.
-pub const ATLAS_VERSION: u32 = 3;
+/// The atlas format version this crate reads and writes. Version 4 stores albedo, surface
+/// attributes and an opacity volume for run-time light; versions 1 and 2 had one sun baked
+/// into the colour, version 3 no volume: they are refused with a message to bake again.
+pub const ATLAS_VERSION: u32 = 4;
+/// Opacity-volume file name.
+pub const OPACITY_FILE: &str = "opacity.png";
 /// Surface-attribute mosaic file name.
 pub const SURFACE_FILE: &str = "surface.png";
 /// Manifest file name inside an atlas folder.
@@ -61,6 +66,8 @@ pub struct Atlas {
     pub alpha_file: Vec<u8>,
     /// The surface mosaic file's bytes (RGBA8 PNG, see the module documentation).
     pub surface_file: Vec<u8>,
+    /// The opacity volume file's bytes (8-bit grey PNG, see [`crate::opacity`]).
+    pub opacity_file: Vec<u8>,
     /// All nodes, level by level; the roots are the first ones, in layer order.
     pub nodes: Vec<QuadNode>,
 }
@@ -68,13 +75,19 @@ pub struct Atlas {
 impl Atlas {
     /// Encode decoded layers and nodes into an atlas. `layers` (albedo and coverage) and
     /// `surface` (premultiplied surface attributes) must each hold `manifest.params.layers()`
-    /// layers of `resolution²` pixels.
+    /// layers of `resolution²` pixels; `opacity` is the model's opacity volume (its size and
+    /// coding go into the manifest).
     pub fn from_layers(
-        manifest: AtlasManifest,
+        mut manifest: AtlasManifest,
         layers: &Layers,
         surface: &Layers,
+        opacity: &OpacityVolume,
         nodes: Vec<QuadNode>,
     ) -> Result<Self, FormatError> {
+        manifest.opacity = OpacityInfo {
+            resolution: opacity.resolution,
+            max_depth: opacity.max_depth,
+        };
         let p = &manifest.params;
         assert_eq!(layers.count, p.layers(), "one layer per direction and slab");
         assert_eq!(layers.resolution, p.resolution);
@@ -113,8 +126,20 @@ impl Atlas {
             colour_file,
             alpha_file,
             surface_file,
+            opacity_file: opacity.encode_png(),
             nodes,
         })
+    }
+
+    /// Decode the opacity volume (`path` names the atlas folder in errors).
+    pub fn decode_opacity(&self, path: &Path) -> Result<OpacityVolume, FormatError> {
+        let o = &self.manifest.opacity;
+        OpacityVolume::decode_png(
+            &self.opacity_file,
+            o.resolution,
+            o.max_depth,
+            &path.join(OPACITY_FILE),
+        )
     }
 
     /// Decode the surface mosaic into layers (RGBA8, premultiplied: each channel is clamped
@@ -303,11 +328,12 @@ impl Atlas {
             std::fs::create_dir_all(&tmp).map_err(|e| FormatError::io(&tmp, e))?;
             let manifest =
                 serde_json::to_vec_pretty(&self.manifest).expect("the manifest serialises to JSON");
-            let files: [(&str, &[u8]); 5] = [
+            let files: [(&str, &[u8]); 6] = [
                 (MANIFEST_FILE, &manifest),
                 (self.manifest.params.colour.file_name(), &self.colour_file),
                 (ALPHA_FILE, &self.alpha_file),
                 (SURFACE_FILE, &self.surface_file),
+                (OPACITY_FILE, &self.opacity_file),
                 (
                     NODES_FILE,
                     &nodes_codec::encode(&self.nodes, self.root_count()),
@@ -378,6 +404,7 @@ impl Atlas {
         let colour_file = read(manifest.params.colour.file_name())?;
         let alpha_file = read(ALPHA_FILE)?;
         let surface_file = read(SURFACE_FILE)?;
+        let opacity_file = read(OPACITY_FILE)?;
         let npath = path.join(NODES_FILE);
         let node_bytes = read(NODES_FILE)?;
         // The header's count is checked against the manifest's before anything is inflated.
@@ -433,11 +460,13 @@ impl Atlas {
             colour_file,
             alpha_file,
             surface_file,
+            opacity_file,
             nodes,
         };
         // Decoding checks the image sizes too.
         let layers = atlas.decode_layers(path)?;
         atlas.decode_surface(path, &layers)?;
+        atlas.decode_opacity(path)?;
         Ok(atlas)
     }
 }
@@ -474,7 +503,13 @@ fn parse_manifest(mpath: &Path, bytes: &[u8]) -> Result<AtlasManifest, FormatErr
     {
         return Err(FormatError::Version {
             path: mpath.to_path_buf(),
-            what: if v < ATLAS_VERSION {
+            what: if v == 3 {
+                format!(
+                    "atlas version 3 has no opacity volume, which trees need to shade \
+                     themselves under the run-time sun (version {ATLAS_VERSION}): bake the \
+                     model again with `forest bake`"
+                )
+            } else if v < ATLAS_VERSION {
                 format!(
                     "atlas version {v} has one sun baked into its colours; this program lights \
                      trees at run time from version {ATLAS_VERSION} on: bake the model again \

@@ -62,7 +62,19 @@ fn synthetic(colour: ColourEncoding) -> (Atlas, Layers) {
         vec![u64::from(n), 0],
     );
     (
-        Atlas::from_layers(manifest, &layers, &surface, nodes).unwrap(),
+        Atlas::from_layers(
+            manifest,
+            &layers,
+            &surface,
+            &crate::opacity::OpacityVolume::from_depths(
+                crate::opacity::VOLUME_RESOLUTION,
+                &(0..crate::opacity::VOLUME_RESOLUTION.pow(3))
+                    .map(|i| (i % 5) as f32 * 0.1)
+                    .collect::<Vec<_>>(),
+            ),
+            nodes,
+        )
+        .unwrap(),
         layers,
     )
 }
@@ -115,11 +127,11 @@ fn the_loader_names_what_is_wrong() {
     reset();
     let manifest = path.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("\"version\": 3", "\"version\": 7")).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 4", "\"version\": 7")).unwrap();
     assert!(err(&path).contains("atlas version 7"), "{}", err(&path));
     // An atlas with baked light (version 2: a `lighting` field, the sun in its parameters) is
     // refused for what it is, not for its unknown fields.
-    let old = text.replace("\"version\": 3", "\"version\": 2").replacen(
+    let old = text.replace("\"version\": 4", "\"version\": 2").replacen(
         "\"params\": {",
         "\"lighting\": {}, \"params\": {\"sun_azimuth_deg\": 30.0,",
         1,
@@ -131,9 +143,26 @@ fn the_loader_names_what_is_wrong() {
         "{e}"
     );
     assert!(e.contains("--sun"), "{e}");
+    // Version 3 had run-time light but no opacity volume.
+    let v3 =
+        text.replace("\"version\": 4", "\"version\": 3")
+            .replacen("\"opacity\"", "\"unknown\"", 1);
+    std::fs::write(&manifest, v3).unwrap();
+    let e = err(&path);
+    assert!(
+        e.contains("atlas version 3") && e.contains("opacity volume") && e.contains("bake"),
+        "{e}"
+    );
     reset();
     std::fs::remove_file(path.join(SURFACE_FILE)).unwrap();
     assert!(err(&path).contains(SURFACE_FILE), "{}", err(&path));
+    reset();
+    std::fs::write(path.join(OPACITY_FILE), b"not a png").unwrap();
+    assert!(err(&path).contains(OPACITY_FILE), "{}", err(&path));
+    reset();
+    let bad_depth = text.replacen("\"max_depth\": ", "\"max_depth\": -", 1);
+    std::fs::write(&manifest, bad_depth).unwrap();
+    assert!(err(&path).contains("opacity.max_depth"), "{}", err(&path));
     reset();
     std::fs::write(&manifest, &text[..text.len() / 2]).unwrap();
     assert!(
@@ -218,7 +247,7 @@ fn the_manifest_loads_alone_and_is_checked_as_in_a_full_load() {
     assert!(Atlas::load(&path).is_err());
     let manifest = path.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("\"version\": 3", "\"version\": 7")).unwrap();
+    std::fs::write(&manifest, text.replace("\"version\": 4", "\"version\": 7")).unwrap();
     let e = Atlas::load_manifest(&path).unwrap_err().to_string();
     assert!(e.contains("atlas version 7"), "{e}");
     let e = Atlas::load_manifest(&dir.path().join("none.atlas"))

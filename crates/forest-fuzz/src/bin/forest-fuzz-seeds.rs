@@ -279,6 +279,7 @@ fn main() {
                 &read(forest_format::atlas::ALPHA_FILE),
                 &read(forest_format::atlas::NODES_FILE),
                 &read(forest_format::atlas::SURFACE_FILE),
+                &read(forest_format::atlas::OPACITY_FILE),
             ]),
         );
     }

@@ -25,8 +25,8 @@ pub fn vertex_storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
 /// environment, layer roots, the frame's state (where the plain quads start), the surface
-/// layers, and the
-/// terrain's heights at [`crate::terrain::HEIGHTS_BINDING`].
+/// layers, the terrain's heights at [`crate::terrain::HEIGHTS_BINDING`] and the opacity
+/// volumes at [`OPACITY_BINDING`].
 pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let storage = vertex_storage_entry;
@@ -68,9 +68,10 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             count: None,
         },
         layer_array(6),
+        // Also read by the vertex stage's march through the opacity volumes.
         wgpu::BindGroupLayoutEntry {
             binding: 7,
-            visibility: wgpu::ShaderStages::FRAGMENT,
+            visibility: vf,
             ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             count: None,
         },
@@ -79,8 +80,12 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         storage(10),
         layer_array(11),
         crate::terrain::heights_entry(),
+        crate::opacity::opacity_entry(OPACITY_BINDING),
     ]
 }
+
+/// Binding of the opacity volumes in the draw group.
+pub const OPACITY_BINDING: u32 = 14;
 
 /// The draw pass's pipelines.
 pub struct DrawPass {

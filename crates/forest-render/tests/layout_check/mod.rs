@@ -92,7 +92,7 @@ pub fn shared() -> Vec<Expect> {
                 ("lower_tri_count", offset_of!(GpuSpecies, lower_tri_count)),
                 ("resolution", offset_of!(GpuSpecies, resolution)),
                 ("switch_unit", offset_of!(GpuSpecies, switch_unit)),
-                ("pad", offset_of!(GpuSpecies, pad)),
+                ("opacity_depth", offset_of!(GpuSpecies, opacity_depth)),
             ],
         ),
         (

@@ -1,0 +1,283 @@
+//! The opacity volume: a tree's own foliage as a density on a voxel grid, so that a crown can
+//! shade itself under any run-time sun (the statistical approach of volumetric foliage
+//! shadowing: the transmittance towards the sun is `exp(−∫σ ds)` through the leaf-area
+//! density σ, instead of exact rays through every leaf).
+//!
+//! The grid is a cube of [`VOLUME_RESOLUTION`]³ voxels around the tree's bounding sphere
+//! (centre ± radius on each axis). Each voxel holds the optical depth across one voxel
+//! length, `τ = G·A/h²` for the alpha-tested surface area `A` splatted into it, voxel side
+//! `h` and the projection factor `G` ([`LEAF_PROJECTION`]), coded in 8 bits as
+//! `τ = max_depth · (code/255)²` (square-root coding keeps sparse twigs and dense cores
+//! apart). [`OpacityVolume::transmittance`] is the CPU mirror of `sun_transmittance` in the
+//! runtime's `common.wgsl`: [`MARCH_STEPS`] trilinear samples along the ray from
+//! [`START_VOXELS`] voxels off the surface to the cube's side.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::error::FormatError;
+use crate::slab::Sphere;
+
+/// Voxels along each side of every opacity volume (one size for all, so that a scene's
+/// volumes share one GPU texture).
+pub const VOLUME_RESOLUTION: u32 = 32;
+/// Samples along a ray towards the sun.
+pub const MARCH_STEPS: u32 = 16;
+/// Voxels a ray travels before its first sample: a surface point does not shadow itself.
+pub const START_VOXELS: f32 = 0.5;
+/// Projection factor of leaf area onto a ray for randomly (spherically) oriented leaves.
+pub const LEAF_PROJECTION: f32 = 1.0;
+
+/// A tree's opacity volume (see the module documentation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OpacityVolume {
+    /// Voxels per side.
+    pub resolution: u32,
+    /// Optical depth per voxel length of code 255 (≥ 0, finite; 0 for an empty volume).
+    pub max_depth: f32,
+    /// `resolution³` codes, x fastest, then y, then z (object-space axes; voxel `(i, j, k)`
+    /// is centred at `centre − radius + (i + ½, j + ½, k + ½)·h`).
+    pub codes: Vec<u8>,
+}
+
+impl OpacityVolume {
+    /// Code a grid of optical depths per voxel length (`resolution³` values, ≥ 0).
+    pub fn from_depths(resolution: u32, depths: &[f32]) -> Self {
+        assert_eq!(depths.len(), (resolution as usize).pow(3));
+        let max_depth = depths
+            .iter()
+            .copied()
+            .filter(|d| d.is_finite())
+            .fold(0.0f32, f32::max);
+        let codes = depths
+            .iter()
+            .map(|&d| {
+                if max_depth > 0.0 && d.is_finite() {
+                    ((d.max(0.0) / max_depth).sqrt() * 255.0).round() as u8
+                } else {
+                    0
+                }
+            })
+            .collect();
+        Self {
+            resolution,
+            max_depth,
+            codes,
+        }
+    }
+
+    /// An empty volume (no self-shadowing).
+    pub fn empty(resolution: u32) -> Self {
+        Self {
+            resolution,
+            max_depth: 0.0,
+            codes: vec![0; (resolution as usize).pow(3)],
+        }
+    }
+
+    /// The code of voxel `(i, j, k)` as the GPU's R8Unorm texel reads it, in `[0, 1]`.
+    fn unorm(&self, i: u32, j: u32, k: u32) -> f32 {
+        let r = self.resolution as usize;
+        f32::from(self.codes[i as usize + r * (j as usize + r * k as usize)]) / 255.0
+    }
+
+    /// Optical depth per voxel length at `u` (the cube mapped to `[0, 1]³`): the codes
+    /// filtered trilinearly between voxel centres (clamped to the outer voxels), then decoded.
+    pub fn sample(&self, u: Vec3) -> f32 {
+        let r = self.resolution;
+        let x = (u * r as f32 - 0.5).clamp(Vec3::ZERO, Vec3::splat(r as f32 - 1.0));
+        let i0 = x.floor();
+        let f = x - i0;
+        let (i, j, k) = (i0.x as u32, i0.y as u32, i0.z as u32);
+        let n = |a: u32| (a + 1).min(r - 1);
+        let mut s = 0.0;
+        for (dk, wk) in [(k, 1.0 - f.z), (n(k), f.z)] {
+            for (dj, wj) in [(j, 1.0 - f.y), (n(j), f.y)] {
+                for (di, wi) in [(i, 1.0 - f.x), (n(i), f.x)] {
+                    s += wi * wj * wk * self.unorm(di, dj, dk);
+                }
+            }
+        }
+        self.max_depth * s * s
+    }
+
+    /// Transmittance from object-space point `p` towards unit direction `dir` through the
+    /// tree whose bounding sphere the volume frames, in `[0, 1]`.
+    pub fn transmittance(&self, sphere: &Sphere, p: Vec3, dir: Vec3) -> f32 {
+        let side = 2.0 * sphere.radius;
+        let u = (p - (sphere.center - Vec3::splat(sphere.radius))) / side;
+        march(u, dir, self.resolution, |x| self.sample(x))
+    }
+
+    /// The volume as an 8-bit grey PNG: `resolution` wide, slice `k` at rows
+    /// `k·resolution ..`.
+    pub fn encode_png(&self) -> Vec<u8> {
+        let r = self.resolution;
+        crate::atlas::encode_png(r, r * r, &self.codes, image::ExtendedColorType::L8)
+    }
+
+    /// Decode [`Self::encode_png`]'s bytes (`file` names them in errors) of a volume with
+    /// `resolution` voxels per side and `max_depth`.
+    pub fn decode_png(
+        bytes: &[u8],
+        resolution: u32,
+        max_depth: f32,
+        file: &Path,
+    ) -> Result<Self, FormatError> {
+        let (w, h) = (resolution, resolution * resolution);
+        let dims = crate::bounded::image_dimensions(bytes, Some(image::ImageFormat::Png), file)?;
+        if dims != (w, h) {
+            return Err(FormatError::invalid(
+                file,
+                format!(
+                    "opacity volume is {}×{} pixels, expected {w}×{h} ({resolution} slices of \
+                     {resolution}²)",
+                    dims.0, dims.1
+                ),
+            ));
+        }
+        let img = match crate::bounded::decode_image(bytes, Some(image::ImageFormat::Png), file)? {
+            image::DynamicImage::ImageLuma8(i) => i,
+            other => {
+                return Err(FormatError::invalid(
+                    file,
+                    format!("opacity volume is {:?}, expected 8-bit grey", other.color()),
+                ));
+            }
+        };
+        if img.dimensions() != (w, h) {
+            return Err(FormatError::invalid(
+                file,
+                format!(
+                    "decoded to {}×{} pixels, expected {w}×{h}",
+                    img.width(),
+                    img.height()
+                ),
+            ));
+        }
+        Ok(Self {
+            resolution,
+            max_depth,
+            codes: img.into_raw(),
+        })
+    }
+}
+
+/// The march of [`OpacityVolume::transmittance`] from unit-cube point `u` along unit `dir`,
+/// with `depth(x)` the optical depth per voxel length at `x`: [`MARCH_STEPS`] midpoint samples
+/// from [`START_VOXELS`] voxels on to where the ray leaves the cube.
+pub fn march(u: Vec3, dir: Vec3, resolution: u32, depth: impl Fn(Vec3) -> f32) -> f32 {
+    let exit = cube_exit(u, dir);
+    let start = START_VOXELS / resolution as f32;
+    if exit <= start {
+        return 1.0;
+    }
+    let dt = (exit - start) / MARCH_STEPS as f32;
+    let sum: f32 = (0..MARCH_STEPS)
+        .map(|k| depth(u + dir * (start + (k as f32 + 0.5) * dt)))
+        .sum();
+    (-sum * dt * resolution as f32).exp()
+}
+
+/// Distance along unit `dir` from `u` to where the ray leaves `[0, 1]³` (0 when it is
+/// outside and leaving).
+pub fn cube_exit(u: Vec3, dir: Vec3) -> f32 {
+    let axis = |u: f32, d: f32| {
+        if d > 1e-8 {
+            (1.0 - u) / d
+        } else if d < -1e-8 {
+            -u / d
+        } else {
+            f32::INFINITY
+        }
+    };
+    axis(u.x, dir.x)
+        .min(axis(u.y, dir.y))
+        .min(axis(u.z, dir.z))
+        .max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere() -> Sphere {
+        Sphere {
+            center: Vec3::new(0.0, 2.0, 0.0),
+            radius: 2.0,
+        }
+    }
+
+    #[test]
+    fn a_uniform_slab_attenuates_by_beer_lambert() {
+        // A uniform medium filling the cube: from the centre straight up the ray crosses
+        // half the cube less the start offset.
+        let r = 16;
+        let tau = 0.05;
+        let v = OpacityVolume::from_depths(r, &vec![tau; (r as usize).pow(3)]);
+        let s = sphere();
+        let t = v.transmittance(&s, s.center, Vec3::Y);
+        let voxels = r as f32 / 2.0 - START_VOXELS;
+        let expected = (-tau * voxels).exp();
+        assert!((t - expected).abs() < 1e-4, "{t} vs {expected}");
+        // Along a diagonal the path is √3 longer.
+        let d = Vec3::ONE.normalize();
+        let t = v.transmittance(&s, s.center, d);
+        let expected = (-tau * (voxels * 3f32.sqrt() + START_VOXELS * (3f32.sqrt() - 1.0))).exp();
+        assert!((t - expected).abs() < 1e-3, "{t} vs {expected}");
+    }
+
+    #[test]
+    fn a_blocker_shadows_only_the_points_behind_it() {
+        let r = 16u32;
+        let mut depths = vec![0.0; (r as usize).pow(3)];
+        // A dense layer at voxel rows y = 12, 13 over the whole cube.
+        for k in 0..r {
+            for j in 12..14 {
+                for i in 0..r {
+                    depths[(i + r * (j + r * k)) as usize] = 5.0;
+                }
+            }
+        }
+        let v = OpacityVolume::from_depths(r, &depths);
+        let s = sphere();
+        let below = s.center - Vec3::Y;
+        let above = s.center + Vec3::Y * 1.9;
+        assert!(v.transmittance(&s, below, Vec3::Y) < 1e-3);
+        assert!((v.transmittance(&s, below, -Vec3::Y) - 1.0).abs() < 1e-6);
+        assert!((v.transmittance(&s, above, Vec3::Y) - 1.0).abs() < 1e-6);
+        // Sideways under the layer nothing is crossed.
+        assert!((v.transmittance(&s, below, Vec3::X) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn codes_round_trip_through_png_and_decode_by_their_square() {
+        let r = 8u32;
+        let depths: Vec<f32> = (0..r.pow(3)).map(|i| (i % 7) as f32 * 0.3).collect();
+        let v = OpacityVolume::from_depths(r, &depths);
+        assert!((v.max_depth - 1.8).abs() < 1e-6);
+        let back =
+            OpacityVolume::decode_png(&v.encode_png(), r, v.max_depth, Path::new("o.png")).unwrap();
+        assert_eq!(back, v);
+        // At a voxel centre the sample is the voxel's decoded code.
+        for (i, &d) in depths.iter().enumerate().step_by(37) {
+            let (x, y, z) = (i as u32 % r, i as u32 / r % r, i as u32 / (r * r));
+            let u = (Vec3::new(x as f32, y as f32, z as f32) + 0.5) / r as f32;
+            assert!((v.sample(u) - d).abs() <= 0.02 * v.max_depth, "{i}");
+        }
+        let err = OpacityVolume::decode_png(&v.encode_png(), 4, 1.0, Path::new("o.png"));
+        assert!(err.unwrap_err().to_string().contains("expected 4×16"));
+    }
+
+    #[test]
+    fn rays_leave_the_cube_where_expected() {
+        assert!((cube_exit(Vec3::splat(0.5), Vec3::Y) - 0.5).abs() < 1e-6);
+        assert!((cube_exit(Vec3::new(0.25, 0.5, 0.5), -Vec3::X) - 0.25).abs() < 1e-6);
+        assert_eq!(cube_exit(Vec3::new(1.5, 0.5, 0.5), Vec3::X), 0.0);
+        assert_eq!(
+            OpacityVolume::empty(4).transmittance(&sphere(), Vec3::ZERO, Vec3::Y),
+            1.0
+        );
+    }
+}

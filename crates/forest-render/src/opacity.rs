@@ -1,0 +1,95 @@
+//! The species' opacity volumes on the GPU (see [`forest_format::opacity`]): one R8Unorm 3D
+//! texture, species after species along z (species `k` at slices `k·R .. (k+1)·R`), which
+//! `sun_transmittance` in `shaders/common.wgsl` marches towards the sun. Shared by the quad
+//! stream and the triangle methods.
+
+use forest_format::opacity::{OpacityVolume, VOLUME_RESOLUTION};
+use wgpu::util::DeviceExt;
+
+use crate::context::RenderError;
+
+/// Layout entry of the opacity texture at `binding`: a filterable 3D texture read by the
+/// vertex stage (per-vertex sun visibility) and the fragment stage (billboards).
+pub fn opacity_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// Upload `volumes` (every one [`VOLUME_RESOLUTION`] a side; one empty volume when there are
+/// none) as one stacked 3D texture. Returns it and its bytes; the error names the device limit
+/// a scene of too many species exceeds.
+pub fn opacity_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    volumes: &[&OpacityVolume],
+) -> Result<(wgpu::Texture, u64), RenderError> {
+    let r = VOLUME_RESOLUTION;
+    let depth = r as u64 * volumes.len().max(1) as u64;
+    let limit = device.limits().max_texture_dimension_3d;
+    if depth > u64::from(limit) {
+        return Err(RenderError::DeviceLimit {
+            what: format!(
+                "the opacity volumes ({} species × {r} slices)",
+                volumes.len()
+            ),
+            needed: depth,
+            limit: limit.into(),
+            hint: ": split the forest into scenes of fewer species",
+        });
+    }
+    let mut data = Vec::with_capacity((r as usize).pow(2) * depth as usize);
+    for v in volumes {
+        assert_eq!(
+            v.resolution, r,
+            "atlas loading checks the volume resolution"
+        );
+        data.extend_from_slice(&v.codes);
+    }
+    data.resize((r as usize).pow(2) * depth as usize, 0);
+    let texture = device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("opacity volumes"),
+            size: wgpu::Extent3d {
+                width: r,
+                height: r,
+                depth_or_array_layers: depth as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &data,
+    );
+    Ok((texture, data.len() as u64))
+}
+
+#[cfg(test)]
+mod tests {
+    use forest_format::opacity::{MARCH_STEPS, START_VOXELS, VOLUME_RESOLUTION};
+
+    /// The WGSL march's constants are the CPU mirror's.
+    #[test]
+    fn the_shader_marches_as_the_format_says() {
+        let src = crate::passes::COMMON_WGSL;
+        for line in [
+            format!("const OPACITY_RES: f32 = {:.1};", VOLUME_RESOLUTION as f32),
+            format!("const OPACITY_STEPS: u32 = {MARCH_STEPS}u;"),
+            format!("const OPACITY_START: f32 = {START_VOXELS:?};"),
+        ] {
+            assert!(src.contains(&line), "common.wgsl lacks `{line}`");
+        }
+    }
+}
