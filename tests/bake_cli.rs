@@ -134,6 +134,25 @@ fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
     assert_eq!(v2["node_count"], v["node_count"]);
     assert_eq!(v2["gpu_bytes"], v["gpu_bytes"]);
     assert_eq!(v2["hybrid_switch"], v["hybrid_switch"]);
+    // Every file but the manifest, with its bytes on disk; the channels named.
+    let files = v2["files"].as_object().unwrap();
+    let manifest = std::fs::metadata(atlas.join("manifest.json"))
+        .unwrap()
+        .len();
+    assert_eq!(files.len(), 5, "{files:?}");
+    assert_eq!(
+        files.values().map(|b| b.as_u64().unwrap()).sum::<u64>() + manifest,
+        on_disk
+    );
+    for name in ["surface.png", "opacity.png"] {
+        let bytes = std::fs::metadata(atlas.join(name)).unwrap().len();
+        assert_eq!(files[name].as_u64(), Some(bytes), "{name}");
+    }
+    let channels = v2["channels"].as_str().unwrap();
+    assert!(
+        channels.contains("sky visibility") && channels.contains("opacity volume of 32³"),
+        "{channels}"
+    );
     let text = forest(&["info", atlas.to_str().unwrap()]);
     assert!(
         String::from_utf8_lossy(&text.stdout).contains("hybrid switch: finest quads"),

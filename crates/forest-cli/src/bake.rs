@@ -284,6 +284,11 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         "node_count": m.node_count,
         "bounding_radius": m.bounding_sphere.radius,
         "hybrid_switch": m.hybrid_switch,
+        "files": out
+            .atlas
+            .file_bytes()
+            .into_iter()
+            .collect::<std::collections::BTreeMap<_, _>>(),
         "hybrid_switch_ladder": ladder
             .iter()
             .map(|r| serde_json::json!({
@@ -327,10 +332,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             m.nodes_per_level, m.node_count
         );
         println!(
-            "  disk {:.2} MB (colour {:.2}, alpha {:.2}), GPU {:.2} MB (BC7 colour with mips + nodes)",
+            "  disk {:.2} MB ({}), GPU {:.2} MB (BC7 albedo and surface with mips, nodes, \
+             opacity volume)",
             mb(disk),
-            mb(out.atlas.colour_file.len() as u64),
-            mb(out.atlas.alpha_file.len() as u64),
+            file_summary(&out.atlas),
             mb(m.gpu_bytes())
         );
         if let Some(h) = &m.hybrid_switch {
@@ -360,6 +365,29 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     Ok(())
 }
 
+/// Each file's megabytes, e.g. `colour.jpg 0.88, alpha.png 0.44, …`.
+fn file_summary(atlas: &Atlas) -> String {
+    atlas
+        .file_bytes()
+        .iter()
+        .map(|(f, b)| format!("{f} {:.2}", *b as f64 / 1e6))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// What an atlas stores per texel and per model, in words.
+fn channels(m: &forest_format::AtlasManifest) -> String {
+    format!(
+        "premultiplied albedo (sRGB) and coverage at {r}²; normal (hemispherical octahedral), \
+         sky visibility and translucency at {s}², premultiplied, linear; an opacity volume of \
+         {v}³ voxels (optical depth per voxel length up to {d:.3})",
+        r = m.params.resolution,
+        s = m.params.resolution / forest_format::atlas::SURFACE_SCALE,
+        v = m.opacity.resolution,
+        d = m.opacity.max_depth
+    )
+}
+
 /// Run `forest info`.
 pub fn info(args: &InfoArgs) -> Result<()> {
     let atlas = Atlas::load(&args.atlas)?;
@@ -374,6 +402,12 @@ pub fn info(args: &InfoArgs) -> Result<()> {
                 "nodes_per_level": m.nodes_per_level,
                 "node_count": m.node_count,
                 "gpu_bytes": m.gpu_bytes(),
+                "files": atlas
+                    .file_bytes()
+                    .into_iter()
+                    .collect::<std::collections::BTreeMap<_, _>>(),
+                "channels": channels(m),
+                "opacity": m.opacity,
                 "bounding_sphere": m.bounding_sphere,
                 "hybrid_switch": m.hybrid_switch,
             })
@@ -392,6 +426,8 @@ pub fn info(args: &InfoArgs) -> Result<()> {
             m.node_count,
             m.gpu_bytes() as f64 / 1e6
         );
+        println!("  files: {}", file_summary(&atlas));
+        println!("  channels: {}", channels(m));
         println!("  hybrid switch: {}", crate::switch::describe(m));
     }
     Ok(())

@@ -137,8 +137,10 @@ fn atlas_round_trip(params: BakeParams, pixels: &[(u8, [u8; 3])], nodes: Vec<Qua
             "{d:?} vs {l:?}"
         );
     }
-    // The surface mosaic is lossless.
-    assert_eq!(back.decode_surface(&path, &decoded).unwrap(), surface);
+    // The surface mosaic is stored at 1/SURFACE_SCALE the resolution, losslessly.
+    let scale = forest_format::atlas::SURFACE_SCALE;
+    let expected = surface.downsampled(scale).upsampled(scale, &decoded);
+    assert!(back.decode_surface(&path, &decoded).unwrap() == expected);
     // So is the opacity volume, and its coding is in the manifest.
     assert_eq!(back.decode_opacity(&path).unwrap(), volume);
     assert_eq!(back.manifest.opacity.max_depth, volume.max_depth);

@@ -65,7 +65,8 @@ fn quad_stream_resembles_the_supersampled_full_geometry() {
 /// model) from three elevations, next to no occlusion at all.
 #[test]
 #[ignore = "open defect: the GPU's per-vertex sky visibility darkens the pine more than the \
-            bake's texels do (mean FLIP 0.057 against 0.035 with no occlusion); the two must \
+            bake's texels do (mean FLIP 0.057 against 0.035 with no occlusion; choosing the \
+            side by the triangle's plane, as the bake does, changed nothing); the two must \
             agree, as both read the same traced values"]
 fn per_vertex_sky_visibility_matches_the_bakes_texels_better_than_none() {
     use forest_bake::lod::{BILLBOARD_ELEVATIONS, billboard_images};
@@ -110,10 +111,11 @@ fn per_vertex_sky_visibility_matches_the_bakes_texels_better_than_none() {
         })
         .collect();
     let sphere = forest_bake::bounding_sphere(&mesh);
-    let traced = common::prepared();
+    // The bake's images carry no sun visibility: neither do these (no self-shadowing).
+    let traced = common::prepared().without_self_shadowing();
     let unshadowed = traced.map_sky_visibility(|_| 1.0);
     let mut flips = [0f32; 2];
-    for (k, prepared) in [traced, &unshadowed].into_iter().enumerate() {
+    for (k, prepared) in [&traced, &unshadowed].into_iter().enumerate() {
         let mut geo = GeometryRenderer::new(
             &ctx,
             prepared,

@@ -6,6 +6,7 @@ mod accuracy;
 mod budget;
 pub mod chart;
 mod fidelity;
+mod lighting;
 mod path;
 mod report;
 mod shadowing;
@@ -31,9 +32,10 @@ use forest_render::work::FrameWork;
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
 /// The suites, in the order `all` runs them.
-pub const SUITES: [&str; 8] = [
+pub const SUITES: [&str; 9] = [
     "storage",
     "shadowing",
+    "lighting",
     "table1",
     "path",
     "accuracy",
@@ -45,11 +47,12 @@ pub const SUITES: [&str; 8] = [
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Suite: storage, shadowing, table1, path, accuracy, stability, budget, fidelity, or all. Every run
+    /// Suite: storage, shadowing, lighting, table1, path, accuracy, stability, budget,
+    /// fidelity, or all. Every run
     /// updates REPORT.md with the sections of all suites run into the results folder so far.
     #[arg(value_parser = [
-        "storage", "shadowing", "table1", "path", "accuracy", "stability", "budget", "fidelity",
-        "all",
+        "storage", "shadowing", "lighting", "table1", "path", "accuracy", "stability", "budget",
+        "fidelity", "all",
     ])]
     pub suite: String,
     /// Species atlases (comma-separated).
@@ -107,6 +110,19 @@ pub struct Bench {
     pub views: Vec<String>,
     /// Accuracy suite: the methods to measure (empty: all).
     pub methods: Vec<String>,
+}
+
+/// Every method at its default parameters, in the order the suites report them.
+pub fn every_method() -> [Method; 6] {
+    use forest_baselines::geometry::{MeshMethod, Stochastic};
+    [
+        Method::Quads,
+        Method::Impostor,
+        Method::Mesh(MeshMethod::Full { depth_sort: true }),
+        Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
+        Method::Mesh(MeshMethod::Lods(Default::default())),
+        Method::Hybrid(forest_baselines::hybrid::Hybrid::default()),
+    ]
 }
 
 /// The median (the lower middle for even counts); 0 for none.
@@ -515,6 +531,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let section = match s {
             "storage" => storage::run(&b)?,
             "shadowing" => shadowing::run(&b)?,
+            "lighting" => lighting::run(&b)?,
             "table1" => table1::run(&b)?,
             "path" => path::run(&b)?,
             "accuracy" if args.redraw => accuracy::redraw(&b)?,

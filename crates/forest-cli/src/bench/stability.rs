@@ -127,14 +127,7 @@ pub fn run(b: &Bench) -> Result<Section> {
         b.renderer(&forest, viewport, 4.0, true, Background::Transparent)?,
         b.renderer(&dense, viewport, 4.0, true, Background::Transparent)?,
     ];
-    let methods = [
-        Method::Quads,
-        Method::Impostor,
-        Method::Mesh(MeshMethod::Full { depth_sort: true }),
-        Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
-        Method::Mesh(MeshMethod::Lods(Default::default())),
-        Method::Hybrid(forest_baselines::hybrid::Hybrid::default()),
-    ];
+    let methods = super::every_method();
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&["case", "method", "flip_mean", "flicker", "pops", "frame_ms"]);
     let mut series: Vec<Series> = methods

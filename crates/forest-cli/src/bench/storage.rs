@@ -51,6 +51,8 @@ pub fn run(b: &Bench) -> Result<Section> {
     // Per species and method.
     let mut table = Table::new(&["method", "species", "disk_bytes", "gpu_bytes"]);
     let mut quad_total = (0u64, 0u64);
+    // Each atlas's files (the channels it stores), for the text.
+    let mut files = Vec::new();
     let mut geo_total = (0u64, 0u64);
     for (k, (path, data)) in b.species_paths.iter().zip(&b.species).enumerate() {
         let name = path
@@ -59,6 +61,15 @@ pub fn run(b: &Bench) -> Result<Section> {
             .unwrap_or_default();
         let disk = folder_bytes(path);
         let gpu = data.atlas.manifest.gpu_bytes();
+        files.push(format!(
+            "{name}: {}",
+            data.atlas
+                .file_bytes()
+                .iter()
+                .map(|(f, b)| format!("{f} {:.2}", *b as f64 / MB))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
         quad_total.0 += disk;
         quad_total.1 += gpu;
         for m in ["quads", "impostor"] {
@@ -250,13 +261,17 @@ pub fn run(b: &Bench) -> Result<Section> {
          estimate (the level-0 quads of the visible trees, at most a quarter of the screen's \
          pixels, plus what refinement can add) and grow when a frame overflows them \
          (`QuadStream::fit`, to the frame's need plus an eighth); the last chart compares the \
-         allocation after the measured frames with what they needed.",
+         allocation after the measured frames with what they needed. An atlas's files (MiB): \
+         the colour mosaic (premultiplied albedo), alpha (coverage), surface (normal, sky \
+         visibility and translucency at half the slab resolution), opacity (the 32³ \
+         self-shadowing volume) and nodes: {}.",
         quad_total.0 as f64 / MB,
         quad_total.1 as f64 / MB,
         geo_total.0 as f64 / MB,
         geo_total.1 as f64 / MB,
         per_instance("quads"),
         per_instance("geometry"),
+        files.join("; "),
     );
     let mut all = table;
     all.rows.sort_by(|a, b| a[0].cmp(&b[0]));

@@ -6,10 +6,11 @@
 //!   sRGB-encoded albedo (no light: light is applied at run time), tiled into one mosaic (layer `L = direction·slabs + slab` at column
 //!   `L mod mosaic_columns`, row `L div mosaic_columns`);
 //! - `alpha.png`: the coverage (alpha) mosaic, 8-bit, lossless;
-//! - `surface.png`: what the run-time light needs besides the albedo, per slab pixel as RGBA8,
-//!   linear and premultiplied by coverage like the colour: the octahedral code of the normal
-//!   facing the sampling ray (object space, [`crate::shading::oct_encode`]) in R and G, the sky
-//!   visibility in B and the translucency in A. The same tiling, lossless;
+//! - `surface.png`: what the run-time light needs besides the albedo, as RGBA8, linear and
+//!   premultiplied by coverage like the colour: the octahedral code of the normal facing the
+//!   sampling ray (object space, [`crate::shading::oct_encode`]) in R and G, the sky
+//!   visibility in B and the translucency in A. The same tiling at [`SURFACE_SCALE`] times
+//!   fewer pixels a side, lossless;
 //! - `opacity.png`: the opacity volume for self-shadowing under the run-time sun (see
 //!   [`crate::opacity`]), 8-bit grey, slices stacked downwards;
 //! - `nodes.bin`: the quad hierarchies of all layers (see [`crate::nodes_codec`]).
@@ -20,10 +21,12 @@
 mod codecs;
 mod manifest;
 mod params;
+mod surface;
 
 pub use codecs::*;
 pub use manifest::*;
 pub use params::*;
+pub use surface::SURFACE_SCALE;
 
 use std::path::{Path, PathBuf};
 
@@ -119,8 +122,9 @@ impl Atlas {
             }
         };
         let alpha_file = encode_alpha_png(w, h, &alpha);
-        let (_, _, surf) = surface.mosaic(cols, &[0, 1, 2, 3]);
-        let surface_file = encode_png(w, h, &surf, image::ExtendedColorType::Rgba8);
+        let small = surface.downsampled(SURFACE_SCALE);
+        let (sw, sh, surf) = small.mosaic(cols, &[0, 1, 2, 3]);
+        let surface_file = encode_png(sw, sh, &surf, image::ExtendedColorType::Rgba8);
         Ok(Self {
             manifest,
             colour_file,
@@ -142,14 +146,27 @@ impl Atlas {
         )
     }
 
-    /// Decode the surface mosaic into layers (RGBA8, premultiplied: each channel is clamped
-    /// to the pixel's coverage from the alpha mosaic, `alpha`'s layers as
+    /// Decode the surface mosaic (stored at `resolution /` [`SURFACE_SCALE`]) into layers at the slab resolution (RGBA8, premultiplied: each channel is
+    /// clamped to the pixel's coverage from the alpha mosaic, `alpha`'s layers as
     /// [`Self::decode_layers`] returns them).
     pub fn decode_surface(&self, path: &Path, alpha: &Layers) -> Result<Layers, FormatError> {
         let p = &self.manifest.params;
         let file = path.join(SURFACE_FILE);
         let (cols, rows) = (p.mosaic_columns(), p.mosaic_rows());
-        let (w, h) = (cols * p.resolution, rows * p.resolution);
+        let side = p.resolution / SURFACE_SCALE;
+        let (w, h) = (cols * side, rows * side);
+        if (alpha.resolution, alpha.count) != (p.resolution, p.layers()) {
+            return Err(FormatError::invalid(
+                &file,
+                format!(
+                    "the coverage given holds {} layers of {}², the atlas {} of {}²",
+                    alpha.count,
+                    alpha.resolution,
+                    p.layers(),
+                    p.resolution
+                ),
+            ));
+        }
         let dims = crate::bounded::image_dimensions(
             &self.surface_file,
             Some(image::ImageFormat::Png),
@@ -159,8 +176,9 @@ impl Atlas {
             return Err(FormatError::invalid(
                 &file,
                 format!(
-                    "mosaic is {}×{} pixels, expected {w}×{h} ({cols}×{rows} tiles of {})",
-                    dims.0, dims.1, p.resolution
+                    "mosaic is {}×{} pixels, expected {w}×{h} ({cols}×{rows} tiles of {side}: \
+                     the slab resolution over {SURFACE_SCALE})",
+                    dims.0, dims.1
                 ),
             ));
         }
@@ -185,26 +203,25 @@ impl Atlas {
                 ),
             ));
         }
-        let r = p.resolution as usize;
+        let r = side as usize;
         let mut rgba = vec![0u8; p.layers() as usize * r * r * 4];
         for l in 0..p.layers() {
-            let (tx, ty) = ((l % cols) * p.resolution, (l / cols) * p.resolution);
+            let (tx, ty) = ((l % cols) * side, (l / cols) * side);
             let base = l as usize * r * r * 4;
-            let cover = alpha.layer(l);
             for y in 0..r {
                 for x in 0..r {
                     let c = img.get_pixel(tx + x as u32, ty + y as u32).0;
                     let d = base + (y * r + x) * 4;
-                    let a = cover[(y * r + x) * 4 + 3];
-                    rgba[d..d + 4].copy_from_slice(&c.map(|v| v.min(a)));
+                    rgba[d..d + 4].copy_from_slice(&c);
                 }
             }
         }
-        Ok(Layers {
-            resolution: p.resolution,
+        let small = Layers {
+            resolution: side,
             count: p.layers(),
             rgba,
-        })
+        };
+        Ok(small.upsampled(SURFACE_SCALE, alpha))
     }
 
     /// Decode the colour and alpha mosaics into layers. Colour is clamped to the alpha
@@ -360,6 +377,24 @@ impl Atlas {
         }
         crate::atomic::done(&tmp);
         result
+    }
+
+    /// Each file of the atlas folder with its bytes on disk, in [`Atlas::save`]'s order after
+    /// the manifest: the colour mosaic, alpha, surface attributes, opacity volume and nodes.
+    pub fn file_bytes(&self) -> Vec<(&'static str, u64)> {
+        vec![
+            (
+                self.manifest.params.colour.file_name(),
+                self.colour_file.len() as u64,
+            ),
+            (ALPHA_FILE, self.alpha_file.len() as u64),
+            (SURFACE_FILE, self.surface_file.len() as u64),
+            (OPACITY_FILE, self.opacity_file.len() as u64),
+            (
+                NODES_FILE,
+                nodes_codec::encode(&self.nodes, self.root_count()).len() as u64,
+            ),
+        ]
     }
 
     /// Number of non-blank layers, whose roots are the first nodes.
