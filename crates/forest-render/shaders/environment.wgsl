@@ -39,12 +39,23 @@ fn optical_depth(p: vec3<f32>) -> f32 {
     return env.horizon.w * distance(p, eye) * f;
 }
 
+// The sky irradiance of forest_format::shading::Lighting::default(): the light the
+// atmosphere's sky and haze colours are given for.
+const REFERENCE_SKY: vec3<f32> = vec3<f32>(0.32, 0.38, 0.48);
+
+// How the frame's light tints the sky and the haze: its sky irradiance over the reference's,
+// per channel (1 under the default light), so that a sinking sun dims and warms them.
+fn sky_tint() -> vec3<f32> {
+    return camera.sky_light.rgb / REFERENCE_SKY;
+}
+
 // Premultiplied colour `c` of a surface at `world` seen through the haze: it keeps
-// T = exp(−τ) and takes (1 − T) of the horizon colour, in proportion to its coverage.
+// T = exp(−τ) and takes (1 − T) of the horizon colour (tinted by the light), in proportion
+// to its coverage.
 fn hazed(c: vec4<f32>, world: vec3<f32>) -> vec4<f32> {
     if (env.horizon.w <= 0.0) { return c; }
     let t = exp(-optical_depth(world));
-    return vec4<f32>(c.rgb * t + env.horizon.rgb * (c.a * (1.0 - t)), c.a);
+    return vec4<f32>(c.rgb * t + env.horizon.rgb * sky_tint() * (c.a * (1.0 - t)), c.a);
 }
 
 // The world direction (not normalised, in front of the eye) through pixel `pixel`: the 3×3 of
@@ -62,11 +73,11 @@ fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
     return d;
 }
 
-// The sky seen along unit direction `d`: the horizon colour rising to the zenith's, the sun's
-// disc with a faint glow around it.
+// The sky seen along unit direction `d`: the horizon colour rising to the zenith's (tinted by
+// the light), the sun's disc with a faint glow around it.
 fn sky(d: vec3<f32>) -> vec3<f32> {
     let up = clamp(d.y, 0.0, 1.0);
-    var c = mix(env.horizon.rgb, env.zenith.rgb, sqrt(up));
+    var c = mix(env.horizon.rgb, env.zenith.rgb, sqrt(up)) * sky_tint();
     let s = dot(d, camera.sun.xyz);
     if (env.sun.x <= 1.0) {
         c = c + camera.sun_colour.rgb * (0.25 * pow(max(s, 0.0), 256.0));

@@ -525,6 +525,21 @@ impl RendererOptions {
 mod tests {
     use super::*;
 
+    /// The environment shader tints the atmosphere's sky by the frame's sky light over the
+    /// default light's: its reference is that sky.
+    #[test]
+    fn the_sky_is_tinted_relative_to_the_default_light() {
+        let sky = forest_format::shading::Lighting::default().sky;
+        let line = format!(
+            "const REFERENCE_SKY: vec3<f32> = vec3<f32>({:?}, {:?}, {:?});",
+            sky.x, sky.y, sky.z
+        );
+        assert!(
+            crate::passes::ENVIRONMENT_WGSL.contains(&line),
+            "environment.wgsl lacks `{line}`"
+        );
+    }
+
     #[test]
     fn the_ground_mixes_soil_and_moss_in_patches() {
         let (mut soil, mut moss) = (0, 0);
