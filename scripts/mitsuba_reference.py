@@ -66,7 +66,7 @@ def material_bsdf(m, model_dir, tmp):
         a = np.asarray(img, dtype=np.float64) / 255.0
         lin = srgb_decode(a[..., :3]) * kd
         rgb = Image.fromarray((srgb_encode(lin) * 255 + 0.5).astype(np.uint8), "RGB")
-        tex = os.path.join(tmp, m["map_Kd"] + ".tinted.png")
+        tex = os.path.join(tmp, os.path.basename(m["map_Kd"]) + ".tinted.png")
         rgb.save(tex)
         reflectance = {"type": "bitmap", "filename": tex}
     else:
@@ -99,9 +99,15 @@ def read_obj(path):
         elif p[0] == "usemtl":
             cur = p[1]
         elif p[0] == "f":
-            idx = [[int(x) if x else 0 for x in (c.split("/") + ["", ""])[:3]] for c in p[1:]]
+            # 1-based indices; negative ones count back from the latest element (0: none).
+            counts = (len(v), len(vt), len(vn))
+            idx = [
+                [(int(x) if int(x) > 0 else counts[j] + 1 + int(x)) if x else 0
+                 for j, x in enumerate((c.split("/") + ["", ""])[:3])]
+                for c in p[1:]
+            ]
             for k in range(1, len(idx) - 1):
-                faces.setdefault(cur, []).append([idx[0], idx[k], idx[k + 1]])
+                faces.setdefault(cur or "default", []).append([idx[0], idx[k], idx[k + 1]])
     v, vt, vn = np.array(v), np.array(vt or [[0.0, 0.0]]), np.array(vn or [[0.0, 1.0, 0.0]])
     out = {}
     for m, fs in faces.items():

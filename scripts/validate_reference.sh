@@ -16,7 +16,7 @@ PYTHON=${PYTHON:-python3}
 # FOREST: a forest binary to use instead of building one.
 if [ -z "${FOREST:-}" ]; then
   cargo build --release --locked -p forest-cli
-  FOREST=./target/release/forest
+  FOREST=${CARGO_TARGET_DIR:-target}/release/forest
 fi
 forest=$FOREST
 out=results/mitsuba
@@ -41,7 +41,7 @@ print(*m['center'], m['radius'])")
     "$PYTHON" scripts/mitsuba_reference.py "$model" --sun "$sun" --eye="$eye" --target="$target" \
       --fov 50 --size 320x240 --spp 64 -o "$stem-mitsuba" >/dev/null
     flip=$("$forest" compare "$stem-mitsuba.png" "$stem-forest.png" --json)
-    rows+=("$("$PYTHON" - "$s" "$sun" "$stem" "$flip" <<'EOF'
+    row=$("$PYTHON" - "$s" "$sun" "$stem" "$flip" <<'EOF'
 import json, sys
 import numpy as np
 from PIL import Image
@@ -54,12 +54,15 @@ covered = (mi[..., 3] > 0.99) & (ours[..., 3] > 0.99)
 lit = covered & (lum(sun_only) > 0.05)
 shade = covered & (lum(sun_only) <= 0.05)
 m = lambda im, k: lum(im)[k].mean() if k.any() else float("nan")
-print(f"| {s} | {sun} | {flip['flip_mean']:.4f} | {flip['coverage_iou']:.3f} | "
+iou = flip.get("coverage_iou")
+iou = "n/a" if iou is None else f"{iou:.3f}"
+print(f"| {s} | {sun} | {flip['flip_mean']:.4f} | {iou} | "
       f"{lit.sum() / max(covered.sum(), 1):.2f} | {m(mi, lit):.3f} / {m(ours, lit):.3f} | "
       f"{m(mi, shade):.3f} / {m(ours, shade):.3f} |")
 EOF
-)")
-    echo "${rows[-1]}"
+)
+    rows+=("$row")
+    echo "$row"
   done
 done
 {

@@ -8,9 +8,11 @@
 //! Candidates:
 //! - none: visibility 1 everywhere (no self-shadowing);
 //! - the opacity volume ([`crate::opacity`]) at a given resolution, what the renderers use;
-//! - per-vertex directional visibility in first-order spherical harmonics (4 coefficients per
-//!   vertex, projected from `SH_RAYS` rays over the sphere), the "few coefficients per
-//!   texel" alternative.
+//! - directional visibility in first-order spherical harmonics (4 coefficients, projected
+//!   from `SH_RAYS` rays over the sphere), the "few coefficients per texel or vertex"
+//!   alternative. It is projected and evaluated at the reference's own sample points, so its
+//!   error is a lower bound on what storing it per vertex would give; its bytes are counted
+//!   per vertex.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -32,7 +34,7 @@ pub enum Candidate {
     None,
     /// The opacity volume at this many voxels a side.
     Volume(u32),
-    /// First-order spherical harmonics of each point's visibility.
+    /// First-order spherical harmonics of each sample point's visibility.
     Harmonics,
 }
 
@@ -42,7 +44,7 @@ impl Candidate {
         match self {
             Self::None => "none".into(),
             Self::Volume(r) => format!("volume {r}³"),
-            Self::Harmonics => "SH L1 per vertex".into(),
+            Self::Harmonics => "SH L1 (per point; bytes per vertex)".into(),
         }
     }
 

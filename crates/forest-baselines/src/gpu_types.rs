@@ -3,7 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// A species of the geometry-based methods (80 bytes; `GeoSpecies` in
+/// A species of the geometry-based methods (96 bytes; `GeoSpecies` in
 /// `shaders/geometry_types.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

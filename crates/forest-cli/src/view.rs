@@ -275,6 +275,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
         methods,
         method: start,
         debug_view: args.debug_view,
+        hour: args.light.time.unwrap_or(12.0),
         path,
         record_to: args.record.clone(),
         screenshots: args.screenshots.clone(),

@@ -166,10 +166,11 @@ impl OpacityVolume {
 
 /// The march of [`OpacityVolume::transmittance`] from unit-cube point `u` along unit `dir`,
 /// with `depth(x)` the optical depth per voxel length at `x`: [`MARCH_STEPS`] midpoint samples
-/// from [`START_VOXELS`] voxels on to where the ray leaves the cube.
+/// over the part of the ray inside the cube, from [`START_VOXELS`] voxels on (or from where a
+/// ray from outside enters).
 pub fn march(u: Vec3, dir: Vec3, resolution: u32, depth: impl Fn(Vec3) -> f32) -> f32 {
-    let exit = cube_exit(u, dir);
-    let start = START_VOXELS / resolution as f32;
+    let (enter, exit) = cube_span(u, dir);
+    let start = (START_VOXELS / resolution as f32).max(enter);
     if exit <= start {
         return 1.0;
     }
@@ -180,22 +181,21 @@ pub fn march(u: Vec3, dir: Vec3, resolution: u32, depth: impl Fn(Vec3) -> f32) -
     (-sum * dt * resolution as f32).exp()
 }
 
-/// Distance along unit `dir` from `u` to where the ray leaves `[0, 1]³` (0 when it is
-/// outside and leaving).
-pub fn cube_exit(u: Vec3, dir: Vec3) -> f32 {
-    let axis = |u: f32, d: f32| {
-        if d > 1e-8 {
-            (1.0 - u) / d
-        } else if d < -1e-8 {
-            -u / d
-        } else {
-            f32::INFINITY
+/// Distances along unit `dir` from `u` to where the ray enters and leaves `[0, 1]³` (the
+/// slab method; entry 0 or less from inside; exit ≤ entry when the ray misses the cube or it
+/// lies behind).
+pub fn cube_span(u: Vec3, dir: Vec3) -> (f32, f32) {
+    let (mut enter, mut exit) = (f32::NEG_INFINITY, f32::INFINITY);
+    for (u, d) in [(u.x, dir.x), (u.y, dir.y), (u.z, dir.z)] {
+        if d.abs() > 1e-8 {
+            let (a, b) = (-u / d, (1.0 - u) / d);
+            enter = enter.max(a.min(b));
+            exit = exit.min(a.max(b));
+        } else if !(0.0..=1.0).contains(&u) {
+            return (0.0, 0.0);
         }
-    };
-    axis(u.x, dir.x)
-        .min(axis(u.y, dir.y))
-        .min(axis(u.z, dir.z))
-        .max(0.0)
+    }
+    (enter, exit)
 }
 
 #[cfg(test)]
@@ -271,13 +271,34 @@ mod tests {
     }
 
     #[test]
-    fn rays_leave_the_cube_where_expected() {
-        assert!((cube_exit(Vec3::splat(0.5), Vec3::Y) - 0.5).abs() < 1e-6);
-        assert!((cube_exit(Vec3::new(0.25, 0.5, 0.5), -Vec3::X) - 0.25).abs() < 1e-6);
-        assert_eq!(cube_exit(Vec3::new(1.5, 0.5, 0.5), Vec3::X), 0.0);
+    fn rays_enter_and_leave_the_cube_where_expected() {
+        let exit = |u, d| cube_span(u, d).1;
+        assert!((exit(Vec3::splat(0.5), Vec3::Y) - 0.5).abs() < 1e-6);
+        assert!((exit(Vec3::new(0.25, 0.5, 0.5), -Vec3::X) - 0.25).abs() < 1e-6);
+        // From outside: entering at 0.5, leaving at 1.5; leaving or missing: an empty span.
+        let (a, b) = cube_span(Vec3::new(-0.5, 0.5, 0.5), Vec3::X);
+        assert!((a - 0.5).abs() < 1e-6 && (b - 1.5).abs() < 1e-6);
+        let (a, b) = cube_span(Vec3::new(1.5, 0.5, 0.5), Vec3::X);
+        assert!(b <= a.max(0.0));
+        let (a, b) = cube_span(Vec3::new(-0.5, 2.0, 0.5), Vec3::X);
+        assert!(b <= a);
         assert_eq!(
             OpacityVolume::empty(4).transmittance(&sphere(), Vec3::ZERO, Vec3::Y),
             1.0
         );
+    }
+
+    #[test]
+    fn a_ray_from_outside_is_attenuated_only_inside() {
+        // A uniform medium; a point below the cube looking up crosses the whole cube's height
+        // (no start offset: it is not on a surface inside).
+        let r = 16;
+        let tau = 0.05;
+        let v = OpacityVolume::from_depths(r, &vec![tau; (r as usize).pow(3)]);
+        let s = sphere();
+        let below = s.center - Vec3::Y * (s.radius * 1.5);
+        let t = v.transmittance(&s, below, Vec3::Y);
+        let expected = (-tau * r as f32).exp();
+        assert!((t - expected).abs() < 1e-4, "{t} vs {expected}");
     }
 }

@@ -139,7 +139,9 @@ fn atlas_round_trip(params: BakeParams, pixels: &[(u8, [u8; 3])], nodes: Vec<Qua
     }
     // The surface mosaic is stored at 1/SURFACE_SCALE the resolution, losslessly.
     let scale = forest_format::atlas::SURFACE_SCALE;
-    let expected = surface.downsampled(scale).upsampled(scale, &decoded);
+    let expected = surface
+        .surface_downsampled(&layers, scale)
+        .surface_upsampled(&decoded, scale);
     assert!(back.decode_surface(&path, &decoded).unwrap() == expected);
     // So is the opacity volume, and its coding is in the manifest.
     assert_eq!(back.decode_opacity(&path).unwrap(), volume);

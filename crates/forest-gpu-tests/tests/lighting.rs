@@ -152,8 +152,9 @@ fn a_low_sun_matches_the_reference_and_baked_light_does_not() {
     let m_relit = forest_metrics::compare(&reference, &relit).unwrap();
     let m_baked = forest_metrics::compare(&reference, &baked).unwrap();
     eprintln!("low sun: relit {m_relit:?}\nbaked sun: {m_baked:?}");
-    // Measured: relit 0.076, baked 0.114 (64-px test atlases, surface attributes stored at
-    // 32 px); the threshold lies between them.
+    // Measured: relit 0.080, baked 0.131 (64-px test atlases, surface attributes stored at
+    // 32 px; 0.12 sat just above the baked figure with a plainer surface filter); the
+    // threshold lies between them.
     const THRESHOLD: f32 = 0.095;
     let out = common::root().join("target/test-output");
     std::fs::create_dir_all(&out).unwrap();

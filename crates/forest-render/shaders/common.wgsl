@@ -46,17 +46,22 @@ const OPACITY_RES: f32 = 32.0;
 const OPACITY_STEPS: u32 = 16u;
 const OPACITY_START: f32 = 0.5;
 
-// Distance along unit `d` from `u` to where the ray leaves [0, 1]³ (opacity::cube_exit).
-fn cube_exit(u: vec3<f32>, d: vec3<f32>) -> f32 {
-    var t = 3.0e38;
+// Distances along unit `d` from `u` to where the ray enters and leaves [0, 1]³
+// (opacity::cube_span).
+fn cube_span(u: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    var enter = -3.0e38;
+    var exit = 3.0e38;
     for (var i = 0u; i < 3u; i++) {
-        if (d[i] > 1e-8) {
-            t = min(t, (1.0 - u[i]) / d[i]);
-        } else if (d[i] < -1e-8) {
-            t = min(t, -u[i] / d[i]);
+        if (abs(d[i]) > 1e-8) {
+            let a = -u[i] / d[i];
+            let b = (1.0 - u[i]) / d[i];
+            enter = max(enter, min(a, b));
+            exit = min(exit, max(a, b));
+        } else if (u[i] < 0.0 || u[i] > 1.0) {
+            return vec2<f32>(0.0);
         }
     }
-    return max(t, 0.0);
+    return vec2<f32>(enter, exit);
 }
 
 // Transmittance towards the sun from object-space point `p` of a tree of species `k`
@@ -68,8 +73,9 @@ fn sun_transmittance(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f
                      max_depth: f32, p: vec3<f32>, sun: vec3<f32>) -> f32 {
     if (max_depth <= 0.0) { return 1.0; }
     let u = (p - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
-    let exit = cube_exit(u, sun);
-    let start = OPACITY_START / OPACITY_RES;
+    let span = cube_span(u, sun);
+    let start = max(OPACITY_START / OPACITY_RES, span.x);
+    let exit = span.y;
     if (exit <= start) { return 1.0; }
     let dt = (exit - start) / f32(OPACITY_STEPS);
     let slices = f32(textureDimensions(vol).z);

@@ -64,22 +64,23 @@ struct VsOut {
     // The quad's point (world, metres), for the haze.
     @location(6) world: vec3<f32>,
     // The sampling direction's frame turned into world space (the instance's rotation): the
-    // axes the baked normal codes are relative to.
+    // axes the baked normal codes are relative to. Its third axis is right × up
+    // (forest_format::slab::DirectionFrame), which rotations keep, so it is not passed: the
+    // inter-stage variables are few (GLES 3.0 guarantees 15).
     @location(7) @interpolate(flat) frame_right: vec3<f32>,
     @location(8) @interpolate(flat) frame_up: vec3<f32>,
-    @location(9) @interpolate(flat) frame_dir: vec3<f32>,
     // Transmittance towards the sun through the tree's own crown at the vertex (its opacity
     // volume), interpolated over the quad.
-    @location(10) sun_vis: f32,
+    @location(9) sun_vis: f32,
     // For a composited quad, which marches per fragment: the points in object space on its
     // front slab's root plane and its second slab's, where the march starts (between them
     // by the slabs' shares of the pixel), the species, its bounding sphere, and the sun's
     // direction in object space with the species' opacity depth in w.
-    @location(11) obj_front: vec3<f32>,
-    @location(12) obj_back: vec3<f32>,
-    @location(13) @interpolate(flat) species: u32,
-    @location(14) @interpolate(flat) sphere: vec4<f32>,
-    @location(15) @interpolate(flat) sun_obj: vec4<f32>,
+    @location(10) obj_front: vec3<f32>,
+    @location(11) obj_back: vec3<f32>,
+    @location(12) @interpolate(flat) species: u32,
+    @location(13) @interpolate(flat) sphere: vec4<f32>,
+    @location(14) @interpolate(flat) sun_obj: vec4<f32>,
 }
 
 // 1 inside a slab image, 0 outside (a shifted sample must not repeat the edge texels).
@@ -262,7 +263,6 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
     out.share = vec4<u32>(lo, hi, q.instance, form);
     out.frame_right = to_world_dir(inst, f.right.xyz);
     out.frame_up = to_world_dir(inst, f.up.xyz);
-    out.frame_dir = to_world_dir(inst, f.dir.xyz);
     let sun_obj = to_object_dir(inst, camera.sun.xyz);
     // Stack depth d lies (1 − 2d)·r along the direction from the centre (slab_point); the
     // quad's plane is at d = ½.
@@ -291,7 +291,8 @@ fn lit_texel(in: VsOut, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
     if (c.a <= 0.0) { return vec4<f32>(0.0); }
     let inv = 1.0 / c.a;
     let local = hemi_oct_decode(g.xy * inv);
-    let n = normalize(local.x * in.frame_right + local.y * in.frame_up + local.z * in.frame_dir);
+    let frame_dir = cross(in.frame_right, in.frame_up);
+    let n = normalize(local.x * in.frame_right + local.y * in.frame_up + local.z * frame_dir);
     let sky = min(g.z * inv, 1.0);
     let tau = min(g.w * inv, 1.0);
     return vec4<f32>(shade_light(c.rgb * inv, n, in.sun_vis, sky, tau) * c.a, c.a);

@@ -60,7 +60,7 @@ pub struct GpuInstance {
     pub pad: u32,
 }
 
-/// Per-species table entry (48 bytes).
+/// Per-species table entry (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuSpecies {

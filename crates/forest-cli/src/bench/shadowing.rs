@@ -131,9 +131,10 @@ pub fn run(b: &Bench) -> Result<Section> {
          texels only), predicted by each candidate and compared with exact alpha-tested rays \
          towards {} seeded suns (azimuth uniform, elevation stratified uniformly in 5°–90°; seed 29). \
          Bytes are per model: one per voxel for the volumes, 4 half floats per vertex for \
-         the harmonics (the slab texels would need 4 more channels on top). Summed over the \
+         the harmonics (evaluated at the sample points themselves, a lower bound on their \
+         error stored per vertex; the slab texels would need 4 more channels on top). Summed over the \
          species, the 32³ volume leaves {:.0} % of the error of no self-shadowing, 16³ {:.0} \
-         %, 64³ {:.0} %, and the per-vertex harmonics {:.0} %. The renderers use the 32³ \
+         %, 64³ {:.0} %, and the harmonics {:.0} %. The renderers use the 32³ \
          volume: one 32 KiB texture per species whatever the model's size, shared by every \
          method. `low_sun_abs_error` is over the suns below 25°.",
         suns.len(),

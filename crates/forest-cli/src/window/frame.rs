@@ -49,7 +49,11 @@ impl Viewer {
             let view = output.texture.create_view(&Default::default());
             let mut enc = g.ctx.device.create_command_encoder(&Default::default());
             if std::mem::take(&mut self.hour_changed) {
-                let light = Lighting::at_hour(self.hour, super::NOON_ELEVATION);
+                // The time moves the sun, its colour and the sky; the exposure stays.
+                let light = Lighting {
+                    exposure: g.renderer.stream.light().exposure,
+                    ..Lighting::at_hour(self.hour, super::NOON_ELEVATION)
+                };
                 g.renderer.set_light(light)?;
             }
             g.renderer.set_pipeline_statistics(self.count_work);

@@ -101,6 +101,9 @@ pub struct Settings {
     pub method: usize,
     /// Starting debug view.
     pub debug_view: DebugView,
+    /// The time of day the HUD starts at (hours, 6–18): `--time`, else noon. The light is
+    /// the one the renderers were built with until the time is first changed.
+    pub hour: f32,
     /// A camera path to play from the start (P replays it).
     pub path: Option<CameraPath>,
     /// Where R saves a recorded path.
@@ -184,7 +187,7 @@ impl Viewer {
             walker,
             terrain: st.terrain,
             epsilon: st.epsilon,
-            hour: 10.0,
+            hour: st.hour.clamp(HOURS.0, HOURS.1),
             hour_changed: false,
             extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),

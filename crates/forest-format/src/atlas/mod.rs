@@ -10,7 +10,7 @@
 //!   premultiplied by coverage like the colour: the octahedral code of the normal facing the
 //!   sampling ray (object space, [`crate::shading::oct_encode`]) in R and G, the sky
 //!   visibility in B and the translucency in A. The same tiling at [`SURFACE_SCALE`] times
-//!   fewer pixels a side, lossless;
+//!   fewer pixels a side, straight (each texel its block's coverage-weighted mean), lossless;
 //! - `opacity.png`: the opacity volume for self-shadowing under the run-time sun (see
 //!   [`crate::opacity`]), 8-bit grey, slices stacked downwards;
 //! - `nodes.bin`: the quad hierarchies of all layers (see [`crate::nodes_codec`]).
@@ -122,7 +122,7 @@ impl Atlas {
             }
         };
         let alpha_file = encode_alpha_png(w, h, &alpha);
-        let small = surface.downsampled(SURFACE_SCALE);
+        let small = surface.surface_downsampled(layers, SURFACE_SCALE);
         let (sw, sh, surf) = small.mosaic(cols, &[0, 1, 2, 3]);
         let surface_file = encode_png(sw, sh, &surf, image::ExtendedColorType::Rgba8);
         Ok(Self {
@@ -221,7 +221,7 @@ impl Atlas {
             count: p.layers(),
             rgba,
         };
-        Ok(small.upsampled(SURFACE_SCALE, alpha))
+        Ok(small.surface_upsampled(alpha, SURFACE_SCALE))
     }
 
     /// Decode the colour and alpha mosaics into layers. Colour is clamped to the alpha
@@ -547,7 +547,8 @@ fn parse_manifest(mpath: &Path, bytes: &[u8]) -> Result<AtlasManifest, FormatErr
             } else if v < ATLAS_VERSION {
                 format!(
                     "atlas version {v} has one sun baked into its colours; this program lights \
-                     trees at run time from version {ATLAS_VERSION} on: bake the model again \
+                     trees at run time (from version 3 on) and reads version {ATLAS_VERSION}: \
+                     bake the model again \
                      with `forest bake` (the sun is now `forest render --sun AZ,EL`)"
                 )
             } else {

@@ -105,11 +105,11 @@ fn save_then_load_round_trips_and_replaces_atomically() {
         .max();
     assert_eq!(worst.map(|w| w <= 1), Some(true), "{worst:?}");
     // The surface mosaic is stored at 1/SURFACE_SCALE the resolution, losslessly: the
-    // attributes come back as the box filter's bilinear upsampling, within the coverage.
+    // attributes come back as its filters give them back, within the coverage.
     let surface = back.decode_surface(&path, &decoded).unwrap();
     let expected = synthetic_surface(&layers)
-        .downsampled(SURFACE_SCALE)
-        .upsampled(SURFACE_SCALE, &decoded);
+        .surface_downsampled(&layers, SURFACE_SCALE)
+        .surface_upsampled(&decoded, SURFACE_SCALE);
     assert!(
         surface.rgba == expected.rgba,
         "the surface round trip differs"
