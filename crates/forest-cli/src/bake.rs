@@ -265,6 +265,8 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     }
 
     let m = &out.atlas.manifest;
+    // Each file's bytes, for the report and the summary (the nodes are encoded to count them).
+    let files = out.atlas.file_bytes();
     let report = serde_json::json!({
         "model": args.model.display().to_string(),
         "output": args.output.display().to_string(),
@@ -284,11 +286,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         "node_count": m.node_count,
         "bounding_radius": m.bounding_sphere.radius,
         "hybrid_switch": m.hybrid_switch,
-        "files": out
-            .atlas
-            .file_bytes()
-            .into_iter()
-            .collect::<std::collections::BTreeMap<_, _>>(),
+        "files": files.iter().copied().collect::<std::collections::BTreeMap<_, _>>(),
         "hybrid_switch_ladder": ladder
             .iter()
             .map(|r| serde_json::json!({
@@ -335,7 +333,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             "  disk {:.2} MB ({}), GPU {:.2} MB (BC7 albedo and surface with mips, nodes, \
              opacity volume)",
             mb(disk),
-            file_summary(&out.atlas),
+            file_summary(&files),
             mb(m.gpu_bytes())
         );
         if let Some(h) = &m.hybrid_switch {
@@ -365,10 +363,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     Ok(())
 }
 
-/// Each file's megabytes, e.g. `colour.jpg 0.88, alpha.png 0.44, …`.
-fn file_summary(atlas: &Atlas) -> String {
-    atlas
-        .file_bytes()
+/// Each file's megabytes, e.g. `colour.jpg 0.88, alpha.png 0.44, …`, from
+/// [`Atlas::file_bytes`].
+fn file_summary(files: &[(&str, u64)]) -> String {
+    files
         .iter()
         .map(|(f, b)| format!("{f} {:.2}", *b as f64 / 1e6))
         .collect::<Vec<_>>()
@@ -426,7 +424,7 @@ pub fn info(args: &InfoArgs) -> Result<()> {
             m.node_count,
             m.gpu_bytes() as f64 / 1e6
         );
-        println!("  files: {}", file_summary(&atlas));
+        println!("  files: {}", file_summary(&atlas.file_bytes()));
         println!("  channels: {}", channels(m));
         println!("  hybrid switch: {}", crate::switch::describe(m));
     }

@@ -30,6 +30,20 @@ pub fn scene(b: &Bench) -> (u32, f32, (u32, u32)) {
     }
 }
 
+/// A 60° camera at `eye` looking at `target` over a forest of side `side` metres (near plane
+/// 5 cm, far plane 3 sides), refining to `epsilon` pixels.
+pub fn look_at(eye: Vec3, target: Vec3, side: f32, viewport: (u32, u32), epsilon: f32) -> Camera {
+    Camera {
+        eye,
+        target,
+        fov_y_deg: 60.0,
+        near: 0.05,
+        far: side * 3.0,
+        viewport,
+        epsilon,
+    }
+}
+
 /// Base of the tree nearest `p` (ground level), and its scale.
 pub fn nearest_tree(forest: &Forest, p: Vec3) -> (Vec3, f32) {
     forest

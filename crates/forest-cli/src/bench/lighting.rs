@@ -13,7 +13,7 @@ use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
-use super::accuracy::{clear_eye, nearest_tree, reference};
+use super::accuracy::{clear_eye, look_at, nearest_tree, reference};
 use super::chart::{Chart, Series};
 use super::report::Section;
 use super::shadowing::seeded_suns;
@@ -31,15 +31,7 @@ fn cameras(
 ) -> Vec<(&'static str, Camera)> {
     let mut rng = SplitMix64(SEED ^ 0xca3e);
     let mut heading = || rng.next_f32() * std::f32::consts::TAU;
-    let cam = |eye: Vec3, target: Vec3| Camera {
-        eye,
-        target,
-        fov_y_deg: 60.0,
-        near: 0.05,
-        far: side * 3.0,
-        viewport,
-        epsilon: 16.0,
-    };
+    let cam = |eye: Vec3, target: Vec3| look_at(eye, target, side, viewport, 16.0);
     let (tree, scale) = nearest_tree(forest, Vec3::ZERO);
     let crown = tree + Vec3::Y * 2.5 * scale;
     let a = heading();

@@ -10,7 +10,7 @@ use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;
 
-use super::accuracy::{nearest_tree, reference};
+use super::accuracy::{look_at, nearest_tree, reference};
 use super::chart::{Chart, Series};
 use super::report::Section;
 use super::{Bench, Table, ms};
@@ -25,15 +25,7 @@ type Case = (&'static str, bool, Box<dyn Fn(f32) -> Camera>);
 fn cases(forest: &Forest, side: f32, viewport: (u32, u32)) -> Vec<Case> {
     let (tree, scale) = nearest_tree(forest, Vec3::ZERO);
     let centre = tree + Vec3::Y * 2.5 * scale;
-    let cam = move |eye: Vec3, target: Vec3| Camera {
-        eye,
-        target,
-        fov_y_deg: 60.0,
-        near: 0.05,
-        far: side * 3.0,
-        viewport,
-        epsilon: 4.0,
-    };
+    let cam = move |eye: Vec3, target: Vec3| look_at(eye, target, side, viewport, 4.0);
     // Halfway between presort directions (22.5° azimuth steps of 45°) and between the
     // horizon and 45° sampling rings.
     let halfway = |t: f32| {
