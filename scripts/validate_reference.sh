@@ -37,7 +37,7 @@ print(*m['center'], m['radius'])")
     target="$cx,$cy,$cz"
     stem="$out/$s-${sun/,/-}"
     "$forest" render "$work/$s.json" -o "$stem-forest.png" --eye "$eye" --target "$target" --fov 50 \
-      --size 320x240 --sun "$sun" --transparent --method geometry --models "$model" --supersample 4 >/dev/null
+      --size 320x240 --sun "$sun" --transparent --method reference --models "$model" --supersample 4 >/dev/null
     "$PYTHON" scripts/mitsuba_reference.py "$model" --sun "$sun" --eye="$eye" --target="$target" \
       --fov 50 --size 320x240 --spp 64 -o "$stem-mitsuba" >/dev/null
     flip=$("$forest" compare "$stem-mitsuba.png" "$stem-forest.png" --json)
@@ -68,7 +68,7 @@ done
 {
   echo "# The reference against Mitsuba 3"
   echo
-  echo "Full geometry 4×4 (forest) against Mitsuba 3 (direct light only, exact shadow rays,"
+  echo "The reference (full geometry 4×4, textures at their finest level; forest) against Mitsuba 3 (direct light only, exact shadow rays,"
   echo "alpha test as geometry), same model, camera and light; 320×240, transparent."
   echo "Sunlit pixels are those Mitsuba's sun-only render lights (luminance > 0.05), of the"
   echo "pixels both cover fully; luminance is of the sRGB-encoded values. \`bash scripts/validate_reference.sh\`."

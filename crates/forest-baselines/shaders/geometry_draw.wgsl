@@ -107,7 +107,8 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
     var albedo = m.kd.rgb;
     if (m.layer != NONE) {
         // OBJ texture coordinates: v = 0 is the bottom row.
-        let t = textureSample(textures, tex_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y), m.layer);
+        let t = textureSampleBias(textures, tex_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y),
+                                  m.layer, method.texture_bias);
         if (m.alpha_tested != 0u && t.a < 0.5) { discard; }
         albedo = albedo * t.rgb;
     }

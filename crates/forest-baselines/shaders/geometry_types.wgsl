@@ -62,7 +62,9 @@ struct Method {
     d0: f32,
     exponent: f32,
     fade: f32,
-    pad: f32,
+    // Mip bias of the material textures' lookups: 0, or -16 (the finest level) for the
+    // reference.
+    texture_bias: f32,
     // LODs: distances (m) where LOD 1, LOD 2 and billboards start.
     lod: vec4<f32>,
 }

@@ -33,6 +33,10 @@ pub struct GpuGeoSpecies {
     pub pad: [u32; 3],
 }
 
+/// The mip bias that makes every lookup read a texture's finest level (WGSL clamps biases to
+/// [-16, 15.99], and no texture here has 2¹⁶ texels a side).
+pub const FINEST_TEXTURES: f32 = -16.0;
+
 /// The geometry method and its parameters (48 bytes; `Method` in
 /// `shaders/geometry_types.wgsl`).
 #[repr(C)]
@@ -52,8 +56,9 @@ pub struct GpuMethod {
     pub exponent: f32,
     /// Stochastic: fading width (fraction of λ).
     pub fade: f32,
-    /// Padding.
-    pub pad: f32,
+    /// Mip bias of the material textures' lookups: 0, or [`FINEST_TEXTURES`] for the
+    /// reference.
+    pub texture_bias: f32,
     /// LODs: object-space distances where LOD 1, LOD 2 and billboards start; w unused.
     pub lod: [f32; 4],
 }

@@ -36,6 +36,7 @@ impl Method {
             Method::Impostor => "impostor",
             Method::Mesh(MeshMethod::Full { depth_sort: true }) => "geometry",
             Method::Mesh(MeshMethod::Full { depth_sort: false }) => "geometry-unsorted",
+            Method::Mesh(MeshMethod::Reference) => "reference",
             Method::Mesh(MeshMethod::Stochastic(_)) => "stochastic",
             Method::Mesh(MeshMethod::Lods(_)) => "lods",
             Method::Hybrid(_) => "hybrid",

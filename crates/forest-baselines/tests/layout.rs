@@ -61,7 +61,7 @@ fn geometry_structs_match_the_host() {
                 ("d0", offset_of!(GpuMethod, d0)),
                 ("exponent", offset_of!(GpuMethod, exponent)),
                 ("fade", offset_of!(GpuMethod, fade)),
-                ("pad", offset_of!(GpuMethod, pad)),
+                ("texture_bias", offset_of!(GpuMethod, texture_bias)),
                 ("lod", offset_of!(GpuMethod, lod)),
             ],
         ),

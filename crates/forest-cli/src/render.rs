@@ -126,10 +126,11 @@ pub(crate) fn parse_sun(s: &str) -> Result<(f32, f32), String> {
 }
 
 /// The `--method` values.
-pub const METHODS: [&str; 6] = [
+pub const METHODS: [&str; 7] = [
     "quads",
     "impostor",
     "geometry",
+    "reference",
     "stochastic",
     "lods",
     "hybrid",
@@ -139,9 +140,10 @@ pub const METHODS: [&str; 6] = [
 #[derive(clap::Args, Debug, Clone)]
 pub struct MethodArgs {
     /// Rendering method: the quad stream; static impostors (the stream without refinement);
-    /// full geometry (the reference and brute-force baseline); stochastic simplification;
+    /// full geometry (the brute-force baseline); the reference (full geometry with every
+    /// texture read at its finest level, for --supersample 4); stochastic simplification;
     /// discrete LODs + billboards; hybrid (trees nearer than --near as full geometry, the
-    /// rest as the quad stream). The last four need --models.
+    /// rest as the quad stream). The last five need --models.
     #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
     /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods).
@@ -233,6 +235,7 @@ impl MethodArgs {
             "geometry" | "hybrid" => MeshMethod::Full {
                 depth_sort: !self.unsorted,
             },
+            "reference" => MeshMethod::Reference,
             "stochastic" => MeshMethod::Stochastic(Stochastic {
                 d0: self.d0,
                 h: self.h,

@@ -5,7 +5,7 @@
 //! from its crown's centre (in crown radii; azimuth uniform, elevation −20° to 40°, eyes kept
 //! 0.3 m above the ground, looking at the centre; 400×300, 60°, transparent background).
 //! Each view is drawn as full geometry at 1× and as the quad stream at ε 2, and both are
-//! compared (mean FLIP) with the 4×4 supersampled full geometry. The crossover is where the
+//! compared (mean FLIP) with the 4×4 supersampled reference ([`MeshMethod::Reference`]). The crossover is where the
 //! stream's mean error, minus the geometry's, first reaches zero (linear between the two
 //! distances around it); it is recorded as the width the finest quads project to there
 //! ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree size.
@@ -174,9 +174,10 @@ pub fn measure(
             };
             let mut cam_big = cam;
             cam_big.viewport = (VIEWPORT.0 * REFERENCE_SS, VIEWPORT.1 * REFERENCE_SS);
-            r.set_method(ctx, full)?;
+            r.set_method(ctx, Method::Mesh(MeshMethod::Reference))?;
             r.render_fitted(ctx, &cam_big, &big)?;
             let reference = forest_baselines::geometry::downsample(&big.read(ctx), REFERENCE_SS);
+            r.set_method(ctx, full)?;
             r.render_fitted(ctx, &cam, &small)?;
             let geometry = small.read(ctx);
             r.set_method(ctx, Method::Quads)?;

@@ -143,6 +143,8 @@ fn reference(ctx: &GpuContext, cam: &Camera) -> image::RgbaImage {
     let big = Target::new(ctx, SIZE.0 * SS, SIZE.1 * SS);
     let mut c = *cam;
     c.viewport = (SIZE.0 * SS, SIZE.1 * SS);
+    geo.set_method(ctx, forest_baselines::geometry::MeshMethod::Reference)
+        .unwrap();
     geo.render_frame(ctx, &c, &big).unwrap();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     downsample(&big.read(ctx), SS)

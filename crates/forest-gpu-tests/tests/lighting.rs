@@ -146,6 +146,8 @@ fn a_low_sun_matches_the_reference_and_baked_light_does_not() {
     let big = Target::new(&ctx, SIZE * 4, SIZE * 4);
     let mut big_cam = cam;
     big_cam.viewport = (SIZE * 4, SIZE * 4);
+    geo.set_method(&ctx, forest_baselines::geometry::MeshMethod::Reference)
+        .unwrap();
     geo.render_frame(&ctx, &big_cam, &big).unwrap();
     let reference = downsample(&big.read(&ctx), 4);
     assert_eq!(ctx.take_errors(), Vec::<String>::new());

@@ -520,6 +520,8 @@ fn far_reference() -> image::RgbaImage {
     let big = Target::new(&ctx, 640, 480);
     let mut cam = far_camera(&forest);
     cam.viewport = (640, 480);
+    geo.set_method(&ctx, forest_baselines::geometry::MeshMethod::Reference)
+        .unwrap();
     geo.render_frame(&ctx, &cam, &big).unwrap();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     forest_baselines::geometry::downsample(&big.read(&ctx), 4)

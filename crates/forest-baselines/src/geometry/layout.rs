@@ -66,7 +66,8 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         // The environment: the terrain's grid is read by `vs_terrain`.
         buffer(8, S::VERTEX_FRAGMENT, uniform),
         buffer(9, S::VERTEX, read),
-        buffer(10, S::VERTEX, uniform),
+        // The method: its texture bias is read by `fs_geo`.
+        buffer(10, S::VERTEX_FRAGMENT, uniform),
         buffer(11, S::VERTEX, read),
         texture(12),
         forest_render::terrain::heights_entry(),

@@ -79,6 +79,12 @@ pub enum MeshMethod {
         /// Draw near trees first (seed 003's tree depth sorting).
         depth_sort: bool,
     },
+    /// The ground truth, to be drawn supersampled: every tree's full model, nearest bands
+    /// first, with every texture read at its finest level, so that each sample is a point
+    /// sample of the model as the bake's ray tracer takes it. Mip-mapped alpha tests thin
+    /// needle-like leaves and darken them (the denser, darker parts of a leaf texture pass at
+    /// coarse levels); supersampling does the filtering instead.
+    Reference,
     /// Stochastic simplification of the leaves; branches drawn whole.
     Stochastic(Stochastic),
     /// Three mesh LODs and camera-facing multi-elevation billboards.
@@ -96,7 +102,7 @@ impl MeshMethod {
     pub fn validate(&self) -> Result<(), RenderError> {
         let bad = |s: String| Err(RenderError::Parameter(s));
         match self {
-            MeshMethod::Full { .. } => Ok(()),
+            MeshMethod::Full { .. } | MeshMethod::Reference => Ok(()),
             MeshMethod::Stochastic(s) => {
                 if !(s.d0.is_finite() && s.d0 > 0.0) {
                     return bad(format!(
@@ -135,6 +141,12 @@ impl MeshMethod {
                 depth_sort: u32::from(depth_sort),
                 ..Default::default()
             },
+            MeshMethod::Reference => GpuMethod {
+                mode: 0,
+                depth_sort: 1,
+                texture_bias: crate::gpu_types::FINEST_TEXTURES,
+                ..Default::default()
+            },
             MeshMethod::Stochastic(s) => GpuMethod {
                 mode: 1,
                 area: u32::from(s.area),
@@ -166,6 +178,7 @@ impl MeshMethod {
         let distance_band =
             |d: f32| ((2.0 * d.max(1.0).log2()).floor().max(0.0) as u32).min(BANDS - 1);
         match *self {
+            MeshMethod::Reference => distance_band(d),
             MeshMethod::Full { depth_sort } => {
                 if depth_sort {
                     distance_band(d)

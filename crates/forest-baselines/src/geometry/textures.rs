@@ -47,20 +47,6 @@ pub(super) fn material_layer(
     out
 }
 
-/// Mip chain of an RGBA8 (sRGB) image down to 1×1, level 0 first, concatenated.
-///
-/// The geometry methods alpha-test every texture at 0.5, so a texel either shows its own
-/// colour or nothing. Each level's colour is therefore the mean, in linear light, of the
-/// level-0 texels under it that pass the test (triangle-filtered level by level with those
-/// texels as weights; the bake's point samples see the same colours), encoded back to sRGB;
-/// where no passing texel lies under a texel, it keeps the filtered colour of the dilated
-/// image (the nearest passing texel's). Averaging the colours of failing texels instead
-/// (blank, or the faint fringe that leaf textures carry, often matted against white or sky
-/// blue) tints distant foliage with them.
-///
-/// Alpha is rescaled per level so that the share of texels passing the 0.5 alpha test stays
-/// that of level 0 (Castaño's coverage-preserving mips): plain averaging erodes alpha-tested
-/// leaves into nothing at a distance.
 /// Every mip level of linear data down to 1×1, each the box filter of the one above (bytes and
 /// level count, as [`mip_chain`]).
 pub(super) fn box_mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
@@ -83,15 +69,28 @@ pub(super) fn box_mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     (data, mips)
 }
 
+/// Mip chain of an RGBA8 (sRGB) image down to 1×1, level 0 first, concatenated.
+///
+/// The geometry methods alpha-test every texture at 0.5, so a texel either shows its own
+/// colour or nothing. Each level's colour is therefore the mean, in linear light, of the
+/// level-0 texels under it that pass the test (triangle-filtered level by level with those
+/// texels as weights; the bake's point samples see the same colours), encoded back to sRGB;
+/// where no passing texel lies under a texel, it keeps the filtered colour of the dilated
+/// image (the nearest passing texel's). Averaging the colours of failing texels instead
+/// (blank, or the faint fringe that leaf textures carry, often matted against white or sky
+/// blue) tints distant foliage with them.
+///
+/// Alpha is rescaled per level, level 0 included, so that the share of the level's area that
+/// passes the 0.5 alpha test *as the GPU's bilinear filter sees it* (4×4 points per texel,
+/// wrapping as the sampler repeats) is the share of level-0 texels that pass it, which is what
+/// the bake's point-sampling ray tracer sees (Castaño's coverage-preserving mips, with his
+/// bilinear coverage estimate). Plain averaging erodes alpha-tested leaves into nothing at a
+/// distance; counting texels instead of filtered area still thins needle-like leaves by 7 %
+/// at the reference's resolution.
 pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     use forest_format::shading::{srgb_decode_table, srgb_encode};
-    let coverage = |m: &image::RgbaImage, scale: f32| {
-        m.pixels()
-            .filter(|p| f32::from(p[3]) * scale >= 127.5)
-            .count() as f32
-            / (m.width() * m.height()) as f32
-    };
-    let target = coverage(img, 1.0);
+    let target = img.pixels().filter(|p| p[3] >= ALPHA_TEST_BYTE).count() as f64
+        / f64::from(img.width() * img.height());
     let mut data = Vec::new();
     let mut dilated = img.clone();
     // Level 0's bilinear filter must not mix in the colour of failing texels either.
@@ -134,7 +133,9 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
         })
     };
     let mips = img.width().max(img.height()).ilog2() + 1;
-    data.extend_from_slice(dilated.as_raw());
+    let mut level0 = dilated.clone();
+    preserve_coverage(&mut level0, target);
+    data.extend_from_slice(level0.as_raw());
     for level in 1..mips {
         let (w, h) = (
             (img.width() >> level).max(1),
@@ -144,24 +145,51 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
         plain = resize(&plain, w, h, FilterType::Triangle);
         passing = resize(&passing, w, h, FilterType::Triangle);
         let mut m = encode(&plain, &passing);
-        if target > 0.0 && target < 1.0 {
-            // Bisect the alpha scale whose coverage matches level 0's.
-            let (mut lo, mut hi) = (0.0f32, 8.0f32);
-            for _ in 0..20 {
-                let mid = 0.5 * (lo + hi);
-                if coverage(&m, mid) < target {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            for p in m.pixels_mut() {
-                p[3] = (f32::from(p[3]) * hi).round().min(255.0) as u8;
-            }
-        }
+        preserve_coverage(&mut m, target);
         data.extend_from_slice(m.as_raw());
     }
     (data, mips)
+}
+
+/// Scale `m`'s alpha so that a share of at least `target` of its bilinearly filtered area
+/// (4×4 points per texel, wrapping) passes the 0.5 alpha test, with the smallest such scale
+/// (at most 255, where every non-zero texel passes). Levels with no coverage or full coverage
+/// are left as they are.
+fn preserve_coverage(m: &mut image::RgbaImage, target: f64) {
+    if !(target > 0.0 && target < 1.0) {
+        return;
+    }
+    const SUB: u32 = 4;
+    let (w, h) = (m.width(), m.height());
+    let alpha = |x: i64, y: i64| {
+        let x = x.rem_euclid(i64::from(w)) as u32;
+        let y = y.rem_euclid(i64::from(h)) as u32;
+        f32::from(m.get_pixel(x, y)[3])
+    };
+    let mut filtered = Vec::with_capacity((w * h * SUB * SUB) as usize);
+    for y in 0..h * SUB {
+        // The point's position in texel units, relative to texel centres.
+        let fy = (y as f32 + 0.5) / SUB as f32 - 0.5;
+        let (y0, ty) = (fy.floor() as i64, fy - fy.floor());
+        for x in 0..w * SUB {
+            let fx = (x as f32 + 0.5) / SUB as f32 - 0.5;
+            let (x0, tx) = (fx.floor() as i64, fx - fx.floor());
+            let top = alpha(x0, y0) * (1.0 - tx) + alpha(x0 + 1, y0) * tx;
+            let bottom = alpha(x0, y0 + 1) * (1.0 - tx) + alpha(x0 + 1, y0 + 1) * tx;
+            filtered.push(top * (1.0 - ty) + bottom * ty);
+        }
+    }
+    // The k-th largest filtered alpha must reach 127.5 after scaling.
+    let k = ((target * filtered.len() as f64).ceil() as usize).clamp(1, filtered.len());
+    let (_, kth, _) = filtered.select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a));
+    let scale = if *kth > 0.0 {
+        (127.5 / *kth).min(255.0)
+    } else {
+        255.0
+    };
+    for p in m.pixels_mut() {
+        p[3] = (f32::from(p[3]) * scale).round().min(255.0) as u8;
+    }
 }
 
 /// The smallest alpha byte that passes the geometry shaders' 0.5 alpha test.

@@ -162,13 +162,7 @@ pub fn reference(b: &Bench, r: &mut ForestRenderer, cam: &Camera) -> Result<imag
     let big = Target::new(&b.ctx, w * REFERENCE_SS, h * REFERENCE_SS);
     let mut c = *cam;
     c.viewport = (w * REFERENCE_SS, h * REFERENCE_SS);
-    b.measure(
-        r,
-        Method::Mesh(MeshMethod::Full { depth_sort: true }),
-        &c,
-        &big,
-        0,
-    )?;
+    b.measure(r, Method::Mesh(MeshMethod::Reference), &c, &big, 0)?;
     Ok(downsample(&big.read(&b.ctx), REFERENCE_SS))
 }
 

@@ -376,6 +376,7 @@ impl Bench {
             method,
             Method::Mesh(
                 forest_baselines::geometry::MeshMethod::Full { .. }
+                    | forest_baselines::geometry::MeshMethod::Reference
                     | forest_baselines::geometry::MeshMethod::Stochastic(_)
             )
         );
