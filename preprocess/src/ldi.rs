@@ -95,9 +95,11 @@ pub struct SlabSetup<'a> {
     pub spp: u32,
 }
 
-/// Trace every layer. `progress(done, total)` is called as image rows complete.
+/// Trace every layer, with `sky` the sky visibility of the scene's triangles
+/// ([`crate::sky::triangle_sky`]). `progress(done, total)` is called as image rows complete.
 pub fn trace_layers(
     scene: &Scene,
+    sky: &[crate::sky::TriangleSky],
     setup: &SlabSetup,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> SlabImages {
@@ -108,7 +110,6 @@ pub fn trace_layers(
         resolution,
         spp,
     } = *setup;
-    let sky = crate::sky::triangle_sky(scene);
     let sphere = &sphere;
     let r = resolution as usize;
     let layers = frames.len() as u32 * slabs;
@@ -139,7 +140,7 @@ pub fn trace_layers(
                     while let Some(hit) = scene.closest(origin, dir, tmin, diameter) {
                         let d = hit.t / diameter;
                         let s = ((d * slabs as f32) as u32).min(slabs - 1);
-                        let hit_surface = surface_at(scene, &sky, &table, &hit, dir);
+                        let hit_surface = surface_at(scene, sky, &table, &hit, dir);
                         let a = &mut acc[s as usize];
                         a.albedo += hit_surface.albedo;
                         a.normal += hit_surface.normal;

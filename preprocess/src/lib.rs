@@ -8,6 +8,7 @@
 //! Everything is deterministic: the same input gives a byte-identical atlas.
 
 pub mod contact_sheet;
+pub mod cutout;
 pub mod error;
 pub mod gltf_mesh;
 pub mod ldi;
@@ -42,6 +43,9 @@ pub struct BakeOutput {
     pub atlas: Atlas,
     /// The traced slab images, including per-pixel depth.
     pub images: ldi::SlabImages,
+    /// Sky visibility of the mesh's triangles, in its order ([`sky::triangle_sky`]), which
+    /// the geometry methods' preparation can reuse.
+    pub sky: Vec<sky::TriangleSky>,
     /// Triangles baked.
     pub triangles: u64,
     /// Seconds spent (load, BVH, trace, hierarchy, encode).
@@ -132,7 +136,8 @@ pub fn bake_mesh(
         resolution: params.resolution,
         spp: params.spp,
     };
-    let images = ldi::trace_layers(&scene, &setup, progress);
+    let sky = sky::triangle_sky(&scene);
+    let images = ldi::trace_layers(&scene, &sky, &setup, progress);
 
     // Quad hierarchies, one per layer, in parallel.
     let r2 = (params.resolution as usize).pow(2);
@@ -232,6 +237,7 @@ pub fn bake_mesh(
     Ok(BakeOutput {
         atlas,
         images,
+        sky,
         triangles: mesh.tris.len() as u64,
         seconds: start.elapsed().as_secs_f64(),
     })
@@ -282,16 +288,17 @@ pub struct RefVertex {
 }
 
 /// The full-geometry reference's vertices: the model's triangles, non-indexed (three vertices
-/// per triangle, in the tracer's order), each corner with the sky visibility of both sides
-/// from [`sky::triangle_sky`], the same values the slab images are baked with. No light: the
-/// renderers light them at run time.
-pub fn reference_vertices(mesh: &Mesh) -> Vec<RefVertex> {
-    let scene = trace::Scene::new(mesh);
-    let sky = sky::triangle_sky(&scene);
-    scene
-        .tris
+/// per triangle, in the mesh's order), each corner with the sky visibility of both sides from
+/// `sky` ([`sky::triangle_sky`] of the mesh, the same values the slab images are baked with).
+/// No light: the renderers light them at run time.
+///
+/// # Panics
+/// If `sky` does not have one entry per triangle of `mesh`.
+pub fn reference_vertices(mesh: &Mesh, sky: &[sky::TriangleSky]) -> Vec<RefVertex> {
+    assert_eq!(sky.len(), mesh.tris.len(), "one sky entry per triangle");
+    mesh.tris
         .iter()
-        .zip(&sky)
+        .zip(sky)
         .flat_map(|(t, s)| {
             // Vertex normals turned to the front side, so that "the side the normal faces"
             // is the front one on the GPU as in the bake.

@@ -1,4 +1,5 @@
-//! Alpha-tested ray queries over a compressed wide BVH (obvhs' CWBVH, built with PLOC).
+//! Alpha-tested ray queries over a compressed wide BVH (obvhs' CWBVH, built with PLOC), whose
+//! alpha-tested triangles are cut to their texture's opaque hull ([`crate::cutout`]).
 
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::{
@@ -15,50 +16,57 @@ use crate::mesh::{ALPHA_CUTOFF, Mesh, Tri};
 pub struct Hit {
     /// Distance along the (unit) ray direction.
     pub t: f32,
-    /// Triangle index in [`Scene::tris`].
+    /// Triangle index in [`Scene::tris`] (the mesh's order).
     pub tri: u32,
-    /// Barycentric coordinates of vertices 1 and 2.
+    /// Barycentric coordinates of vertices 1 and 2 of that triangle.
     pub bary: Vec2,
 }
 
-/// The model ready for tracing: triangles reordered to the BVH's leaf order.
+/// The model ready for tracing.
 pub struct Scene<'a> {
     /// The model (materials, textures).
     pub mesh: &'a Mesh,
-    /// Triangles in BVH order.
-    pub tris: Vec<Tri>,
-    /// What the ray test reads of each triangle, in the same order: a third of a [`Tri`]'s
-    /// bytes, so that the many leaf cards a ray crosses in a crown stay in cache.
-    edges: Vec<Edges>,
+    /// Triangles, in the mesh's order: what [`Hit::tri`] indexes.
+    pub tris: &'a [Tri],
+    /// What the ray test reads, in the BVH's leaf order: a third of a [`Tri`]'s bytes, so
+    /// that the many leaf cards a ray crosses in a crown stay in cache.
+    pieces: Vec<Piece>,
+    /// Each piece's corners as barycentrics `(b1, b2)` of its triangle, in the same order.
+    corners: Vec<[Vec2; 3]>,
     bvh: CwBvh,
 }
 
-/// A triangle's first vertex and its two edges from it, as Möller–Trumbore uses them.
+/// One primitive of the BVH: a triangle's first vertex, its two edges from it (as
+/// Möller–Trumbore uses them) and which triangle it is.
 #[derive(Clone, Copy, Debug)]
-struct Edges {
+struct Piece {
     p0: Vec3,
     e1: Vec3,
     e2: Vec3,
+    /// Index in [`Scene::tris`].
+    tri: u32,
 }
 
-impl Edges {
-    fn new(t: &Tri) -> Self {
+impl Piece {
+    /// Triangle `t` whole, as triangle `tri`.
+    fn new(t: &Tri, tri: u32) -> Self {
         Self {
             p0: t.p[0],
             e1: t.p[1] - t.p[0],
             e2: t.p[2] - t.p[0],
+            tri,
         }
     }
 }
 
 /// Möller–Trumbore: `(t, b1, b2)` when the ray hits the triangle within `[tmin, tmax]`.
 pub fn intersect(tri: &Tri, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<(f32, Vec2)> {
-    intersect_edges(&Edges::new(tri), o, d, tmin, tmax)
+    intersect_piece(&Piece::new(tri, 0), o, d, tmin, tmax)
 }
 
-/// [`intersect`] on a triangle's precomputed edges.
+/// [`intersect`] on a piece's precomputed edges.
 #[inline]
-fn intersect_edges(t: &Edges, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<(f32, Vec2)> {
+fn intersect_piece(t: &Piece, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<(f32, Vec2)> {
     let (e1, e2) = (t.e1, t.e2);
     let pv = d.cross(e2);
     let det = e1.dot(pv);
@@ -88,36 +96,94 @@ fn bvh_ray(o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Ray {
 }
 
 impl<'a> Scene<'a> {
-    /// Build the BVH (in parallel) over the mesh's triangles.
+    /// Build the BVH (in parallel) over the mesh's triangles, the alpha-tested ones cut to
+    /// the opaque hull of their texture.
     pub fn new(mesh: &'a Mesh) -> Self {
-        let bvh_tris: Vec<Triangle> = mesh
+        use rayon::prelude::*;
+        // One hull per alpha source (texture, channel) that a material tests.
+        let mut sources: Vec<(usize, bool)> =
+            mesh.materials.iter().filter_map(|m| m.alpha).collect();
+        sources.sort_unstable();
+        sources.dedup();
+        let hulls: Vec<((usize, bool), Option<crate::cutout::Polygon>)> = sources
+            .into_par_iter()
+            .map(|(t, c)| ((t, c), crate::cutout::opaque_hull(mesh, t, c)))
+            .collect();
+        let hull_of = |alpha: (usize, bool)| {
+            hulls
+                .iter()
+                .find(|(k, _)| *k == alpha)
+                .and_then(|(_, h)| h.as_ref())
+        };
+        const WHOLE: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
+        let cut: Vec<(u32, [Vec2; 3])> = mesh
             .tris
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(i, t)| {
+                let corners = match mesh.materials[t.material as usize].alpha {
+                    Some(alpha) => crate::cutout::pieces(t, hull_of(alpha)),
+                    None => vec![WHOLE],
+                };
+                corners.into_iter().map(move |c| (i as u32, c))
+            })
+            .collect();
+        let at = |t: &Tri, b: Vec2| t.p[0] + (t.p[1] - t.p[0]) * b.x + (t.p[2] - t.p[0]) * b.y;
+        let bvh_tris: Vec<Triangle> = cut
             .iter()
-            .map(|t| Triangle {
-                v0: Vec3A::from(t.p[0]),
-                v1: Vec3A::from(t.p[1]),
-                v2: Vec3A::from(t.p[2]),
+            .map(|&(i, c)| {
+                let t = &mesh.tris[i as usize];
+                if c == WHOLE {
+                    return Triangle {
+                        v0: Vec3A::from(t.p[0]),
+                        v1: Vec3A::from(t.p[1]),
+                        v2: Vec3A::from(t.p[2]),
+                    };
+                }
+                Triangle {
+                    v0: Vec3A::from(at(t, c[0])),
+                    v1: Vec3A::from(at(t, c[1])),
+                    v2: Vec3A::from(at(t, c[2])),
+                }
             })
             .collect();
         let mut build_time = std::time::Duration::ZERO;
         let bvh = build_cwbvh_from_tris(&bvh_tris, BvhBuildParams::medium_build(), &mut build_time);
-        let tris: Vec<Tri> = bvh
+        let (pieces, corners) = bvh
             .primitive_indices
             .iter()
-            .map(|&i| mesh.tris[i as usize])
-            .collect();
-        let edges = tris.iter().map(Edges::new).collect();
+            .map(|&k| {
+                let (i, c) = cut[k as usize];
+                let b = &bvh_tris[k as usize];
+                let (p0, p1, p2) = (Vec3::from(b.v0), Vec3::from(b.v1), Vec3::from(b.v2));
+                let piece = Piece {
+                    p0,
+                    e1: p1 - p0,
+                    e2: p2 - p0,
+                    tri: i,
+                };
+                (piece, c)
+            })
+            .unzip();
         Self {
             mesh,
-            tris,
-            edges,
+            tris: &mesh.tris,
+            pieces,
+            corners,
             bvh,
         }
     }
 
+    /// Barycentrics of the triangle of piece `id` from barycentrics `b` of the piece.
+    #[inline]
+    fn triangle_bary(&self, id: usize, b: Vec2) -> Vec2 {
+        let c = &self.corners[id];
+        c[0] + (c[1] - c[0]) * b.x + (c[2] - c[0]) * b.y
+    }
+
     /// Whether triangle `i` is solid at barycentrics `b` (alpha test).
-    fn solid(&self, i: usize, b: Vec2) -> bool {
-        let t = &self.tris[i];
+    fn solid(&self, i: u32, b: Vec2) -> bool {
+        let t = &self.tris[i as usize];
         if self.mesh.materials[t.material as usize].alpha.is_none() {
             return true;
         }
@@ -129,22 +195,28 @@ impl<'a> Scene<'a> {
     pub fn closest(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
         let ray = bvh_ray(o, d, tmin, tmax);
         let mut hit = RayHit::none();
-        let mut bary = Vec2::ZERO;
+        let mut last = (0u32, Vec2::ZERO);
         let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| {
-            match intersect_edges(&self.edges[id], o, d, r.tmin, r.tmax) {
-                Some((t, b)) if t < r.tmax && self.solid(id, b) => {
-                    bary = b;
-                    t
+            let piece = &self.pieces[id];
+            match intersect_piece(piece, o, d, r.tmin, r.tmax) {
+                Some((t, b)) if t < r.tmax => {
+                    let b = self.triangle_bary(id, b);
+                    if self.solid(piece.tri, b) {
+                        last = (piece.tri, b);
+                        t
+                    } else {
+                        f32::INFINITY
+                    }
                 }
                 _ => f32::INFINITY,
             }
         });
-        // `bary` belongs to the last hit returned, which is the closest: the traversal accepts
+        // `last` belongs to the last hit returned, which is the closest: the traversal accepts
         // every `t < tmax` and then lowers `tmax` to it.
         found.then_some(Hit {
             t: hit.t,
-            tri: hit.primitive_id,
-            bary,
+            tri: last.0,
+            bary: last.1,
         })
     }
 
@@ -152,11 +224,12 @@ impl<'a> Scene<'a> {
     pub fn occluded(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32, skip: u32) -> bool {
         let ray = bvh_ray(o, d, tmin, tmax);
         !self.bvh.ray_traverse_miss(ray, |r, id| {
-            if id as u32 == skip {
+            let piece = &self.pieces[id];
+            if piece.tri == skip {
                 return f32::INFINITY;
             }
-            match intersect_edges(&self.edges[id], o, d, r.tmin, r.tmax) {
-                Some((t, b)) if self.solid(id, b) => t,
+            match intersect_piece(piece, o, d, r.tmin, r.tmax) {
+                Some((t, b)) if self.solid(piece.tri, self.triangle_bary(id, b)) => t,
                 _ => f32::INFINITY,
             }
         })

@@ -57,7 +57,12 @@ fn alpha_textured_quad_seen_head_on_covers_exactly_the_expected_pixels() {
         resolution: 32,
         spp: 4,
     };
-    let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
+    let img = ldi::trace_layers(
+        &scene,
+        &forest_bake::sky::triangle_sky(&scene),
+        &setup,
+        &|_, _| {},
+    );
     // Expected colour: the albedo, Kd 0.5 (sRGB) × white texture; no light is baked.
     let albedo = Vec3::splat(srgb_decode(0.5));
     let want = albedo
@@ -136,7 +141,12 @@ fn texel_normals_of_tilted_cards_match_the_geometry() {
             resolution: 16,
             spp: 1,
         };
-        let img = ldi::trace_layers(&scene, &setup, &|_, _| {});
+        let img = ldi::trace_layers(
+            &scene,
+            &forest_bake::sky::triangle_sky(&scene),
+            &setup,
+            &|_, _| {},
+        );
         let f = &frames[0];
         let facing = if normal.dot(view) >= 0.0 {
             normal

@@ -235,8 +235,14 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 };
                 let species =
                     forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
-                let (switch, rungs) = crate::switch::measure(&ctx, species, &args.model, &progress)
-                    .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
+                let (switch, rungs) = crate::switch::measure(
+                    &ctx,
+                    species,
+                    &args.model,
+                    Some(std::mem::take(&mut out.sky)),
+                    &progress,
+                )
+                .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
                 bar.finish_and_clear();
                 out.atlas.manifest.hybrid_switch = Some(switch);
                 ladder = rungs;

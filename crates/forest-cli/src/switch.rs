@@ -7,7 +7,8 @@
 //! Each view is drawn as full geometry at 1× and as the quad stream at ε 2, and both are
 //! compared (mean FLIP) with the 4×4 supersampled reference ([`MeshMethod::Reference`]). The crossover is where the
 //! stream's mean error, minus the geometry's, first reaches zero (linear between the two
-//! distances around it); it is recorded as the width the finest quads project to there
+//! distances around it), found by bisection over the ladder (4 or 5 of its 9 rungs: the
+//! difference falls with distance); it is recorded as the width the finest quads project to there
 //! ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree size.
 
 use std::path::Path;
@@ -49,6 +50,29 @@ pub struct Rung {
     pub geometry: f32,
     /// The quad stream at [`EPSILON`].
     pub quads: f32,
+}
+
+/// Rungs a bisection of [`DISTANCES`] measures at most: ⌈log₂ 9⌉ + 1 for the rung before the
+/// crossing (what the progress bar counts).
+pub const SEARCHED_RUNGS: usize = 5;
+
+/// The first index in `0..n` at which `crossed` holds, by bisection, assuming that once it
+/// holds it holds for every later index; `None` when it holds nowhere. `crossed` is asked at
+/// most ⌈log₂(n + 1)⌉ times.
+pub fn first_crossing(
+    n: usize,
+    mut crossed: impl FnMut(usize) -> Result<bool>,
+) -> Result<Option<usize>> {
+    let (mut lo, mut hi) = (0, n);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if crossed(mid)? {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    Ok((lo < n).then_some(lo))
 }
 
 /// The crossover of a ladder (crown radii): where `quads − geometry` first reaches zero,
@@ -104,12 +128,14 @@ pub fn describe(m: &forest_format::AtlasManifest) -> String {
     }
 }
 
-/// Measure the switch of the model `model` baked into `species`; `progress(done, total)`
-/// counts the views. Returns the record and the ladder it came from.
+/// Measure the switch of the model `model` baked into `species`, reusing `sky`, the bake's
+/// traced sky visibility of its triangles, when the model is the one the atlas was baked
+/// from; `progress(done, total)` counts the views. Returns the record and the ladder it came from.
 pub fn measure(
     ctx: &GpuContext,
     species: SpeciesData,
     model: &Path,
+    sky: Option<Vec<forest_bake::sky::TriangleSky>>,
     progress: &dyn Fn(u64, u64),
 ) -> Result<(HybridSwitch, Vec<Rung>)> {
     let manifest = species.atlas.manifest.clone();
@@ -126,7 +152,13 @@ pub fn measure(
     );
     let mesh = forest_bake::Mesh::load(model)
         .with_context(|| format!("loading {} for the geometry", model.display()))?;
-    let prepared = PreparedGeometry::new(&[GeometrySpecies::new(mesh, &manifest)]);
+    // The bake's traced sky visibility, when it traced this very model.
+    let same_model = manifest.source.hash == format!("{:016x}", mesh.hash);
+    let mut geometry_species = GeometrySpecies::new(mesh, &manifest);
+    if let Some(sky) = sky.filter(|_| same_model) {
+        geometry_species = geometry_species.with_sky(sky);
+    }
+    let prepared = PreparedGeometry::new(&[geometry_species]);
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         viewport: VIEWPORT,
@@ -150,11 +182,21 @@ pub fn measure(
             (azimuth, elevation)
         })
         .collect();
-    let total = (DISTANCES.len() * directions.len()) as u64;
-    let mut ladder = Vec::with_capacity(DISTANCES.len());
-    for (i, &radii) in DISTANCES.iter().enumerate() {
+    // The rungs are measured lazily, in the order a bisection for the crossover asks for
+    // them: the difference `quads − geometry` falls with distance on every model measured
+    // (the full ladders of the bundled trees each cross once), so the first rung where it
+    // reaches zero is found with 4 or 5 rungs instead of 9, and the crossover is then
+    // interpolated between it and the rung before, as over the full ladder.
+    let mut measured: Vec<Option<Rung>> = vec![None; DISTANCES.len()];
+    let total = (SEARCHED_RUNGS * directions.len()) as u64;
+    let mut views = 0u64;
+    let mut rung = |i: usize, measured: &mut Vec<Option<Rung>>| -> Result<Rung> {
+        if let Some(r) = measured[i] {
+            return Ok(r);
+        }
+        let radii = DISTANCES[i];
         let (mut g_sum, mut q_sum) = (0.0f32, 0.0f32);
-        for (j, &(azimuth, elevation)) in directions.iter().enumerate() {
+        for &(azimuth, elevation) in &directions {
             let d = radii * sphere.radius;
             let offset = Vec3::new(
                 elevation.cos() * azimuth.cos(),
@@ -186,15 +228,26 @@ pub fn measure(
             ctx.check_errors()?;
             g_sum += forest_metrics::flip(&reference, &geometry)?.0;
             q_sum += forest_metrics::flip(&reference, &quads)?.0;
-            progress((i * directions.len() + j + 1) as u64, total);
+            views += 1;
+            progress(views.min(total), total);
         }
         let n = directions.len() as f32;
-        ladder.push(Rung {
+        let out = Rung {
             radii,
             geometry: g_sum / n,
             quads: q_sum / n,
-        });
+        };
+        measured[i] = Some(out);
+        Ok(out)
+    };
+    let first = first_crossing(DISTANCES.len(), |i| {
+        rung(i, &mut measured).map(|r| r.quads - r.geometry <= 0.0)
+    })?;
+    if let Some(i) = first.filter(|&i| i > 0) {
+        rung(i - 1, &mut measured)?;
     }
+    progress(total, total);
+    let ladder: Vec<Rung> = measured.into_iter().flatten().collect();
     let (radii, _) = crossover(&ladder);
     let pixels = finest_quad_pixels(manifest.levels, radii)
         .clamp(HybridSwitch::MIN_PIXELS, HybridSwitch::MAX_PIXELS);
@@ -214,6 +267,26 @@ pub fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bisection_finds_the_first_crossing_in_few_questions() {
+        for n in [1usize, 2, 5, 9] {
+            for first in 0..=n {
+                let mut asked = Vec::new();
+                let found = first_crossing(n, |i| {
+                    asked.push(i);
+                    Ok(i >= first)
+                })
+                .unwrap();
+                assert_eq!(found, (first < n).then_some(first), "n {n}, first {first}");
+                let bound = (n as f32 + 1.0).log2().ceil() as usize;
+                assert!(asked.len() <= bound, "n {n}: asked {asked:?}");
+                if n == DISTANCES.len() {
+                    assert!(asked.len() < SEARCHED_RUNGS);
+                }
+            }
+        }
+    }
 
     fn rung(radii: f32, geometry: f32, quads: f32) -> Rung {
         Rung {

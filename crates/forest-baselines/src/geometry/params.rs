@@ -15,6 +15,10 @@ pub struct GeometrySpecies {
     /// The hybrid's switch unit of its atlas ([`forest_render::forms::switch_unit`]), so that
     /// both forms agree where each tree switches (any value when the hybrid is not used).
     pub switch_unit: f32,
+    /// The sky visibility of the mesh's triangles when it is already traced (the bake's, one
+    /// entry per triangle: [`forest_bake::sky::triangle_sky`]); traced at preparation when
+    /// `None`.
+    pub sky: Option<Vec<forest_bake::sky::TriangleSky>>,
 }
 
 impl GeometrySpecies {
@@ -24,7 +28,16 @@ impl GeometrySpecies {
         Self {
             mesh,
             switch_unit: forest_render::forms::switch_unit(manifest),
+            sky: None,
         }
+    }
+
+    /// The same with the mesh's sky visibility already traced (one entry per triangle, in the
+    /// mesh's order), which preparation then reuses; a `sky` of another length is ignored and
+    /// traced again.
+    pub fn with_sky(mut self, sky: Vec<forest_bake::sky::TriangleSky>) -> Self {
+        self.sky = (sky.len() == self.mesh.tris.len()).then_some(sky);
+        self
     }
 }
 

@@ -67,7 +67,16 @@ impl PreparedGeometry {
                     pad: [0; 2],
                 });
             }
-            let reference = forest_bake::reference_vertices(&s.mesh);
+            let traced;
+            let sky = match &s.sky {
+                Some(sky) => sky,
+                None => {
+                    traced =
+                        forest_bake::sky::triangle_sky(&forest_bake::trace::Scene::new(&s.mesh));
+                    &traced
+                }
+            };
+            let reference = forest_bake::reference_vertices(&s.mesh, sky);
             let leaf: Vec<bool> = reference
                 .chunks_exact(3)
                 .map(|t| s.mesh.materials[t[0].material as usize].alpha.is_some())
@@ -104,9 +113,12 @@ impl PreparedGeometry {
             opacity.push(volume);
             leaf_end.extend(&set.leaf_end);
             leaf_centre.extend(set.leaf_centre.iter().map(|c| c.extend(0.0).to_array()));
-            for b in
-                forest_bake::lod::billboard_images(&s.mesh, BILLBOARD_RESOLUTION, BILLBOARD_SPP)
-            {
+            for b in forest_bake::lod::billboard_images(
+                &s.mesh,
+                sky,
+                BILLBOARD_RESOLUTION,
+                BILLBOARD_SPP,
+            ) {
                 billboard_layers.push(b.albedo);
                 billboard_surface.push(b.surface);
             }
