@@ -719,3 +719,30 @@ fn a_forest_on_hills_or_a_height_field_stands_on_it_and_bad_height_fields_are_na
     ));
     assert!(e.contains("input"), "{e}");
 }
+
+/// Without `XDG_RUNTIME_DIR` the binary makes a private one for the Vulkan loader in the
+/// temporary folder, and removes it when the command ends, whether it succeeds or fails.
+#[test]
+fn the_private_runtime_folder_is_removed_at_exit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let atlas = tmp.path().join("missing.atlas");
+    for args in [
+        vec!["info", atlas.to_str().unwrap()], // fails: no such atlas
+        vec!["compare", "--help"],             // clap's own exit
+    ] {
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_forest"))
+            .args(&args)
+            .env_remove("XDG_RUNTIME_DIR")
+            .env("TMPDIR", tmp.path())
+            .output()
+            .unwrap()
+            .status;
+        assert!(status.code().is_some(), "{args:?}: {status}");
+        let left: Vec<_> = std::fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .filter(|n| n.to_string_lossy().starts_with("forest-xdg-"))
+            .collect();
+        assert!(left.is_empty(), "{args:?} left {left:?}");
+    }
+}

@@ -60,14 +60,6 @@ enum Cli {
 }
 
 fn main() -> ExitCode {
-    // Vulkan loaders print a warning without it; give them a private folder.
-    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-        let dir = std::env::temp_dir().join(format!("forest-xdg-{}", std::process::id()));
-        if std::fs::create_dir_all(&dir).is_ok() {
-            // SAFETY: at the start of main, before any other thread exists.
-            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
-        }
-    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version
@@ -79,10 +71,21 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // Vulkan loaders print a warning without it; give them a private folder, removed again
+    // when the command ends.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join(format!("forest-xdg-{}", std::process::id()));
+        if std::fs::create_dir_all(&dir).is_ok() {
+            // SAFETY: in main before any other thread exists (the signal handler's is next).
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+            let _ = RUNTIME_DIR.set(dir);
+        }
+    }
     // Stopped by SIGINT or SIGTERM: remove the temporary files being written, then exit as
     // the shell expects (128 + SIGINT).
     let _ = ctrlc::set_handler(|| {
         forest_format::atomic::remove_pending();
+        remove_runtime_dir();
         eprintln!("forest: interrupted; temporary files removed");
         std::process::exit(130);
     });
@@ -95,12 +98,23 @@ fn main() -> ExitCode {
         Cli::View(args) => view::run(&args),
         Cli::Compare(args) => compare::run(&args),
     };
+    remove_runtime_dir();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("forest: error: {}", message(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The private `XDG_RUNTIME_DIR` this process made for the Vulkan loader, if it made one.
+static RUNTIME_DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+
+/// Remove [`RUNTIME_DIR`] and what the loader left in it.
+fn remove_runtime_dir() {
+    if let Some(dir) = RUNTIME_DIR.get() {
+        let _ = std::fs::remove_dir_all(dir);
     }
 }
 
