@@ -12,7 +12,7 @@
 
 use glam::Vec2;
 
-use crate::mesh::{ALPHA_CUTOFF, Mesh, Tri};
+use crate::mesh::{ALPHA_CUTOFF, Mesh, Tri, texel_alpha};
 
 /// Most vertices a hull keeps: a triangle cut by it is at most `MAX_HULL_VERTICES + 1`
 /// pieces. Fewer vertices add area (measured on the bundled leaf textures: a few per cent).
@@ -20,6 +20,9 @@ pub const MAX_HULL_VERTICES: usize = 6;
 
 /// A convex polygon in texture space (`uv`, OBJ convention), counter-clockwise.
 pub type Polygon = Vec<Vec2>;
+
+/// A whole triangle as barycentric corners `(b1, b2)`: the one piece of an uncut triangle.
+pub const WHOLE: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
 
 /// The convex hull, simplified outward to at most [`MAX_HULL_VERTICES`] vertices, of the
 /// texels of texture `t` of `mesh` that pass the alpha test as [`Mesh::alpha`] reads them
@@ -29,13 +32,14 @@ pub fn opaque_hull(mesh: &Mesh, t: usize, channel: bool) -> Option<Polygon> {
     let tex = &mesh.textures[t];
     let (w, h) = (tex.width as usize, tex.height as usize);
     let pass = |x: usize, y: usize| {
-        let p = &tex.rgba[(y * w + x) * 4..(y * w + x) * 4 + 4];
-        let a = if channel {
-            p[3]
-        } else {
-            ((u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) / 3) as u8
-        };
-        f32::from(a) / 255.0 >= ALPHA_CUTOFF
+        let i = (y * w + x) * 4;
+        let texel = [
+            tex.rgba[i],
+            tex.rgba[i + 1],
+            tex.rgba[i + 2],
+            tex.rgba[i + 3],
+        ];
+        f32::from(texel_alpha(texel, channel)) / 255.0 >= ALPHA_CUTOFF
     };
     // Texel (x, y) covers u ∈ [x/w, (x+1)/w] and v ∈ [1 − (y+1)/h, 1 − y/h] (row 0 on top;
     // `Texture::texel`): the corners of each row's outermost passing texels, grown by a
@@ -158,7 +162,6 @@ pub fn clip_convex(subject: &[Vec2], clip: &[Vec2]) -> Polygon {
 /// hull of its texture. A triangle whose texture coordinates leave `[0,1]²` (a repeating
 /// texture) or are degenerate is kept whole; one outside the hull gives no piece.
 pub fn pieces(t: &Tri, hull: Option<&Polygon>) -> Vec<[Vec2; 3]> {
-    const WHOLE: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
     let Some(hull) = hull else {
         return Vec::new();
     };

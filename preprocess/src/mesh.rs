@@ -413,15 +413,19 @@ impl Mesh {
         match self.materials[m as usize].alpha {
             None => 1.0,
             Some((t, channel)) => {
-                let texel = self.textures[t].fetch(uv);
-                let a = if channel {
-                    texel[3]
-                } else {
-                    ((u32::from(texel[0]) + u32::from(texel[1]) + u32::from(texel[2])) / 3) as u8
-                };
-                f32::from(a) / 255.0
+                f32::from(texel_alpha(self.textures[t].fetch(uv), channel)) / 255.0
             }
         }
+    }
+}
+
+/// The alpha byte a material reads from an RGBA8 texel: its alpha channel when `channel`,
+/// else its grey (the mean of R, G and B).
+pub fn texel_alpha(texel: [u8; 4], channel: bool) -> u8 {
+    if channel {
+        texel[3]
+    } else {
+        ((u32::from(texel[0]) + u32::from(texel[1]) + u32::from(texel[2])) / 3) as u8
     }
 }
 

@@ -37,11 +37,7 @@ pub(super) fn material_layer(
             resize(a)
         };
         for (o, p) in out.pixels_mut().zip(src.pixels()) {
-            o[3] = if channel {
-                p[3]
-            } else {
-                ((u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) / 3) as u8
-            };
+            o[3] = forest_bake::mesh::texel_alpha(p.0, channel);
         }
     }
     out
