@@ -17,12 +17,26 @@
 //!   URIs percent-decoded; read with the same size limits as the OBJ's files), images as PNG
 //!   or JPEG.
 //!
+//! Every accessor is read through [`crate::gltf_accessor`], which checks it against its
+//! buffer view and buffer (offset, stride, count, component type, normalised flag) before
+//! reading, instead of the gltf crate's reader (which asserts on a stride below the element
+//! size and cuts reads short at a buffer's end).
+//!
 //! Refused, with a message naming it: `extensionsRequired`, `KHR_texture_transform` (it moves
-//! texture coordinates), `data:` URIs, skins, non-triangle primitives, textures on a
-//! coordinate set other than 0, sparse accessors, and a file with no mesh; and, before the
-//! gltf crates (1.4.1) would panic on them, attributes naming missing accessors, accessors of
-//! types glTF does not allow for their attribute, images without a source or MIME type, and
-//! node hierarchies that are not trees.
+//! texture coordinates), `data:` URIs, skins, non-triangle primitives, index counts that are
+//! not whole triangles, textures on a coordinate set other than 0, sparse accessors, a file
+//! with no mesh; node transforms that are not finite, a rotation that is not a unit
+//! quaternion (beyond rounding; a zero one is not taken as the identity), a scale of 0 or a
+//! singular or projective matrix; `alphaCutoff` or `baseColorFactor` outside [0, 1]; a base
+//! colour texture that does not repeat while its coordinates leave [0, 1] (the bake repeats
+//! every texture); and, before the gltf crates (1.4.1) would panic on them, attributes
+//! naming missing accessors, images without a source or MIME type, and node hierarchies that
+//! are not trees.
+//!
+//! Read past, with a note in [`Mesh::notes`]: animations, morph targets, cameras,
+//! single-sided materials (baked double-sided), normal, occlusion, emissive and
+//! metal-roughness maps, and extensions the file uses without requiring them. `extras`
+//! anywhere are ignored whatever their JSON type.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -175,42 +189,149 @@ fn check_json(path: &Path, json: &gltf::json::Root) -> Result<(), BakeError> {
     Ok(())
 }
 
-/// The accessors a primitive is read through have the types glTF requires of them (the gltf
-/// crate's readers assume them and panic otherwise), and none is sparse.
-fn check_accessors(path: &Path, at: &str, prim: &gltf::Primitive) -> Result<(), BakeError> {
-    use gltf::accessor::{DataType as D, Dimensions as N};
+/// A primitive's vertex data as the file holds it: positions, normals, texture coordinates
+/// (set 0) and indices (in order when it has none), every accessor read through
+/// [`crate::gltf_accessor`]'s checks, the counts matching and every index in range.
+type PrimitiveData = (
+    Vec<[f32; 3]>,
+    Option<Vec<[f32; 3]>>,
+    Option<Vec<[f32; 2]>>,
+    Vec<u32>,
+);
+
+fn read_primitive(
+    prim: &gltf::Primitive,
+    buffers: &[std::borrow::Cow<[u8]>],
+    at: &str,
+) -> Result<PrimitiveData, String> {
+    use crate::gltf_accessor::{read_floats, read_indices};
+    use gltf::accessor::DataType as D;
     use gltf::mesh::Semantic as S;
-    let check = |name: &str, a: gltf::Accessor, types: &[D], dims: N| {
-        if a.sparse().is_some() {
-            return Err(parse_err(
-                path,
-                format!("{at}: {name} is a sparse accessor, which is not supported"),
-            ));
-        }
-        if !types.contains(&a.data_type()) || a.dimensions() != dims {
-            return Err(parse_err(
-                path,
-                format!(
-                    "{at}: {name} is {:?} {:?}; glTF requires {dims:?} of {types:?}",
-                    a.dimensions(),
-                    a.data_type()
-                ),
-            ));
-        }
-        Ok(())
+    let max = bounded::limit::DATA;
+    let named = |what: &str, a: &gltf::Accessor| format!("{at}: {what} (accessor {})", a.index());
+    let position = prim
+        .get(&S::Positions)
+        .ok_or_else(|| format!("{at} has no POSITION attribute"))?;
+    let pos: Vec<[f32; 3]> = read_floats(
+        &position,
+        buffers,
+        &named("POSITION", &position),
+        &[D::F32],
+        max,
+    )?;
+    let nrm = match prim.get(&S::Normals) {
+        Some(a) => Some(read_floats::<3>(
+            &a,
+            buffers,
+            &named("NORMAL", &a),
+            &[D::F32],
+            max,
+        )?),
+        None => None,
     };
-    for (semantic, a) in prim.attributes() {
-        match semantic {
-            S::Positions => check("POSITION", a, &[D::F32], N::Vec3)?,
-            S::Normals => check("NORMAL", a, &[D::F32], N::Vec3)?,
-            S::TexCoords(0) => check("TEXCOORD_0", a, &[D::F32, D::U8, D::U16], N::Vec2)?,
-            _ => {}
+    let uv = match prim.get(&S::TexCoords(0)) {
+        Some(a) => Some(read_floats::<2>(
+            &a,
+            buffers,
+            &named("TEXCOORD_0", &a),
+            &[D::F32, D::U8, D::U16],
+            max,
+        )?),
+        None => None,
+    };
+    for (what, n) in [
+        ("NORMAL", nrm.as_ref().map(Vec::len)),
+        ("TEXCOORD_0", uv.as_ref().map(Vec::len)),
+    ] {
+        if let Some(n) = n.filter(|&n| n != pos.len()) {
+            return Err(format!(
+                "{at}: {what} has {n} elements, POSITION {}; glTF requires the same count",
+                pos.len()
+            ));
         }
     }
-    if let Some(a) = prim.indices() {
-        check("the indices", a, &[D::U8, D::U16, D::U32], N::Scalar)?;
+    let idx = match prim.indices() {
+        Some(a) => read_indices(&a, buffers, &named("the indices", &a), max)?,
+        None => (0..pos.len() as u32).collect(),
+    };
+    if idx.len() % 3 != 0 {
+        return Err(format!(
+            "{at}: {} indices (or vertices, without indices) are not whole triangles",
+            idx.len()
+        ));
     }
-    Ok(())
+    if let Some((i, v)) = idx
+        .iter()
+        .enumerate()
+        .find(|(_, v)| **v as usize >= pos.len())
+    {
+        return Err(format!(
+            "{at}: index {i} is {v}, past its {} vertices",
+            pos.len()
+        ));
+    }
+    Ok((pos, nrm, uv, idx))
+}
+
+/// How far a node's rotation may be from a unit quaternion (in length) and still be taken
+/// as one, normalised: exporters writing rounded decimals stay within it.
+const QUATERNION_TOLERANCE: f32 = 1e-3;
+
+/// A node's local transform, checked: finite; a matrix affine and invertible; a rotation a
+/// unit quaternion (within [`QUATERNION_TOLERANCE`], then normalised; a zero one is refused,
+/// not taken as the identity); no scale of 0, which would flatten its mesh.
+fn node_matrix(node: &gltf::Node) -> Result<Mat4, String> {
+    let at = format!("node {}", node.index());
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => {
+            let m = Mat4::from_cols_array_2d(&matrix);
+            if !m.is_finite() {
+                return Err(format!("{at}: its matrix is not finite"));
+            }
+            if m.row(3) != glam::Vec4::W {
+                return Err(format!(
+                    "{at}: its matrix's last row is {:?}, not (0, 0, 0, 1) (glTF matrices                      are affine)",
+                    m.row(3).to_array()
+                ));
+            }
+            let det = m.determinant();
+            if !det.is_normal() {
+                return Err(format!(
+                    "{at}: its matrix is singular (determinant {det:e}): it flattens its mesh"
+                ));
+            }
+            Ok(m)
+        }
+        gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let all = translation.iter().chain(&rotation).chain(&scale);
+            if let Some(x) = all.copied().find(|x| !x.is_finite()) {
+                return Err(format!(
+                    "{at}: its transform holds {x}, which is not finite"
+                ));
+            }
+            let q = glam::Quat::from_array(rotation);
+            let len = q.length();
+            if (len - 1.0).abs() > QUATERNION_TOLERANCE {
+                return Err(format!(
+                    "{at}: its rotation {rotation:?} is not a unit quaternion (length {len};                      glTF requires 1)"
+                ));
+            }
+            if scale.contains(&0.0) {
+                return Err(format!(
+                    "{at}: its scale {scale:?} has a 0, which flattens its mesh"
+                ));
+            }
+            Ok(Mat4::from_scale_rotation_translation(
+                Vec3::from_array(scale),
+                q.normalize(),
+                Vec3::from_array(translation),
+            ))
+        }
+    }
 }
 
 /// Load a glTF 2.0 model (see the module docs for what is read and what is refused).
@@ -273,6 +394,12 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     let mut materials: Vec<Material> = Vec::new();
     // For each glTF material: its index in `materials`, or None when nothing of it passes.
     let mut material_of: Vec<Option<u32>> = Vec::new();
+    // For each glTF material whose base colour texture does not repeat: its sampler's wrap
+    // modes, which the bake (repeating every texture) honours only for coordinates in [0, 1].
+    let mut clamped: Vec<Option<String>> = Vec::new();
+    let mut notes: Vec<String> = Vec::new();
+    let mut single_sided = Vec::new();
+    let mut unused_maps = Vec::new();
     for m in doc.materials() {
         let name = m
             .name()
@@ -280,6 +407,24 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
         let pbr = m.pbr_metallic_roughness();
         let factor = pbr.base_color_factor();
+        if factor.iter().any(|x| !(0.0..=1.0).contains(x)) {
+            return Err(parse_err(
+                path,
+                format!(
+                    "material {name:?}: baseColorFactor {factor:?} lies outside [0, 1] (glTF \
+                     requires it inside)"
+                ),
+            ));
+        }
+        if let Some(c) = m.alpha_cutoff().filter(|c| !(0.0..=1.0).contains(c)) {
+            return Err(parse_err(
+                path,
+                format!(
+                    "material {name:?}: alphaCutoff {c} lies outside [0, 1] (glTF requires \
+                     it inside)"
+                ),
+            ));
+        }
         let mode = m.alpha_mode();
         // The cutoff on texture alpha (None: opaque).
         let cutoff = match mode {
@@ -287,6 +432,22 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5) / factor[3]),
             gltf::material::AlphaMode::Blend => Some(0.5 / factor[3]),
         };
+        if !m.double_sided() {
+            single_sided.push(name.clone());
+        }
+        if m.normal_texture().is_some()
+            || m.occlusion_texture().is_some()
+            || m.emissive_texture().is_some()
+            || pbr.metallic_roughness_texture().is_some()
+        {
+            unused_maps.push(name.clone());
+        }
+        use gltf::texture::WrappingMode as W;
+        clamped.push(pbr.base_color_texture().and_then(|info| {
+            let sampler = info.texture().sampler();
+            let (s, t) = (sampler.wrap_s(), sampler.wrap_t());
+            (s != W::Repeat || t != W::Repeat).then(|| format!("wraps {s:?} × {t:?}"))
+        }));
         let colour = match pbr.base_color_texture() {
             None => None,
             Some(info) => {
@@ -404,7 +565,16 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 "the node hierarchy is not a tree (a cycle, or a node with two parents)",
             ));
         }
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * node_matrix(&node).map_err(|reason| parse_err(path, reason))?;
+        if !world.is_finite() {
+            return Err(parse_err(
+                path,
+                format!(
+                    "node {}: its transform times its parents' is not finite",
+                    node.index()
+                ),
+            ));
+        }
         if node.skin().is_some() {
             return Err(parse_err(
                 path,
@@ -434,35 +604,37 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                     None => continue,
                 },
             };
-            check_accessors(path, &at(), &prim)?;
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.as_ref()));
-            let pos: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| parse_err(path, format!("{}: no POSITION", at())))?
+            let (pos, nrm, uv, idx) =
+                read_primitive(&prim, &buffers, &at()).map_err(|reason| parse_err(path, reason))?;
+            let wrap = prim.material().index().and_then(|i| clamped[i].as_ref());
+            if let (Some(wrap), Some(uv)) = (wrap, &uv) {
+                let outside = uv
+                    .iter()
+                    .flatten()
+                    .find(|x| !(-1e-4..=1.0 + 1e-4).contains(*x));
+                if let Some(x) = outside {
+                    return Err(parse_err(
+                        path,
+                        format!(
+                            "{}: its material's base colour texture {wrap}, but TEXCOORD_0 \
+                             reaches {x} outside [0, 1]; the bake repeats every texture \
+                             (use REPEAT, or keep the coordinates inside [0, 1])",
+                            at()
+                        ),
+                    ));
+                }
+            }
+            let pos: Vec<Vec3> = pos
+                .into_iter()
                 .map(|p| world.transform_point3(Vec3::from_array(p)))
                 .collect();
-            let nrm: Option<Vec<Vec3>> = reader
-                .read_normals()
-                .map(|n| n.map(|n| normal_matrix * Vec3::from_array(n)).collect());
-            let uv: Option<Vec<Vec2>> = reader
-                .read_tex_coords(0)
-                .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
-            let idx: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..pos.len() as u32).collect(),
-            };
-            let n_ok = nrm.as_ref().is_none_or(|n| n.len() == pos.len());
-            let uv_ok = uv.as_ref().is_none_or(|t| t.len() == pos.len());
-            if !n_ok || !uv_ok || idx.iter().any(|&i| i as usize >= pos.len()) {
-                return Err(parse_err(
-                    path,
-                    format!(
-                        "{}: an index or attribute count does not match its {} positions",
-                        at(),
-                        pos.len()
-                    ),
-                ));
-            }
+            let nrm: Option<Vec<Vec3>> = nrm.map(|n| {
+                n.into_iter()
+                    .map(|n| normal_matrix * Vec3::from_array(n))
+                    .collect()
+            });
+            let uv: Option<Vec<Vec2>> =
+                uv.map(|t| t.into_iter().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
             for f in idx.chunks_exact(3) {
                 let f = [f[0] as usize, f[1] as usize, f[2] as usize];
                 raw.push((
@@ -515,12 +687,53 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     if tris.is_empty() {
         return Err(crate::mesh::no_triangles(path, degenerate));
     }
+    let count = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    if doc.animations().len() > 0 {
+        notes.push(format!(
+            "{} ignored: the model is baked at rest",
+            count(doc.animations().len(), "animation")
+        ));
+    }
+    let morphs = doc
+        .meshes()
+        .flat_map(|m| m.primitives())
+        .filter(|p| p.morph_targets().len() > 0);
+    if morphs.clone().count() > 0 {
+        notes.push(format!(
+            "morph targets of {} ignored: the base shape is baked",
+            count(morphs.count(), "primitive")
+        ));
+    }
+    if doc.cameras().len() > 0 {
+        notes.push(format!("{} ignored", count(doc.cameras().len(), "camera")));
+    }
+    if !single_sided.is_empty() {
+        notes.push(format!(
+            "material(s) {} are single-sided in the file; every triangle is baked double-sided",
+            single_sided.join(", ")
+        ));
+    }
+    if !unused_maps.is_empty() {
+        notes.push(format!(
+            "material(s) {}: normal, occlusion, emissive and metal-roughness maps are ignored \
+             (the bake shades base colour and alpha)",
+            unused_maps.join(", ")
+        ));
+    }
+    let other: Vec<&str> = doc.extensions_used().collect();
+    if !other.is_empty() {
+        notes.push(format!(
+            "extension(s) {} ignored (not required by the file)",
+            other.join(", ")
+        ));
+    }
     Ok(Mesh {
         tris,
         materials,
         textures,
         degenerate,
         hash,
+        notes,
     })
 }
 

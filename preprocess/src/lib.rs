@@ -10,6 +10,7 @@
 pub mod contact_sheet;
 pub mod cutout;
 pub mod error;
+pub mod gltf_accessor;
 pub mod gltf_mesh;
 pub mod ldi;
 pub mod lod;
@@ -50,6 +51,8 @@ pub struct BakeOutput {
     pub triangles: u64,
     /// Seconds spent (load, BVH, trace, hierarchy, encode).
     pub seconds: f64,
+    /// The model loader's notes on what it left out ([`Mesh::notes`]).
+    pub notes: Vec<String>,
 }
 
 /// Bounding sphere of the triangles: the centre of their box and the farthest vertex from it
@@ -240,6 +243,7 @@ pub fn bake_mesh(
         sky,
         triangles: mesh.tris.len() as u64,
         seconds: start.elapsed().as_secs_f64(),
+        notes: mesh.notes.clone(),
     })
 }
 

@@ -62,6 +62,9 @@ pub struct Mesh {
     pub degenerate: u64,
     /// FNV-1a 64 hash of the OBJ, MTL and texture bytes.
     pub hash: u64,
+    /// What the loader read past without using, for the user to see (a glTF's animations,
+    /// cameras, morph targets, …); empty when nothing was left out.
+    pub notes: Vec<String>,
 }
 
 /// FNV-1a 64-bit hash, continued from `h`.
@@ -397,6 +400,7 @@ impl Mesh {
             textures,
             degenerate,
             hash,
+            notes: Vec::new(),
         })
     }
 

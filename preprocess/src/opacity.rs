@@ -115,6 +115,7 @@ mod tests {
             textures: vec![],
             degenerate: 0,
             hash: 0,
+            notes: Vec::new(),
         }
     }
 

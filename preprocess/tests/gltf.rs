@@ -280,3 +280,300 @@ fn a_mask_cutoff_keeps_exactly_the_texels_at_or_above_it() {
         );
     }
 }
+
+/// A glTF file whose JSON is `json` (a template: `BIN` is replaced by the buffer's byte
+/// length) and whose buffer file holds `bin`.
+fn write_raw(dir: &Path, json: &str, bin: &[u8]) -> PathBuf {
+    std::fs::write(dir.join("raw.bin"), bin).unwrap();
+    let path = dir.join("raw.gltf");
+    std::fs::write(&path, json.replace("BIN", &bin.len().to_string())).unwrap();
+    path
+}
+
+fn floats(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// One triangle's positions (36 bytes from byte 0), then `tail`; `accessors` and `views`
+/// are appended to a POSITION accessor 0 over view 0 (stride `stride`).
+fn raw_json(attributes: &str, accessors: &str, views: &str, extra: &str) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},{extra}"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0{attributes}}}}}]}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}{accessors}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}{views}],
+        "buffers":[{{"uri":"raw.bin","byteLength":BIN}}]}}"#
+    )
+}
+
+const TRI: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+/// Loading `json` over `bin` fails with a message holding every one of `causes`, and leaves
+/// both files as they were.
+fn refused_with(dir: &Path, json: &str, bin: &[u8], causes: &[&str]) {
+    let path = write_raw(dir, json, bin);
+    let before = (
+        std::fs::read(&path).unwrap(),
+        std::fs::read(dir.join("raw.bin")).unwrap(),
+    );
+    let e = Mesh::load(&path).unwrap_err().to_string();
+    for c in causes {
+        assert!(e.contains(c), "expected {c:?} in: {e}");
+    }
+    let _ = forest_bake::mesh::source_files(&path);
+    let after = (
+        std::fs::read(&path).unwrap(),
+        std::fs::read(dir.join("raw.bin")).unwrap(),
+    );
+    assert!(before == after, "the inputs changed");
+}
+
+#[test]
+fn accessors_are_checked_against_their_views_and_buffers_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bin = floats(&TRI);
+    // A stride smaller than the element once panicked inside the gltf crate's reader.
+    let json = raw_json("", "", "", "")
+        .replace(r#""byteLength":36}"#, r#""byteLength":36,"byteStride":4}"#);
+    refused_with(d, &json, &bin, &["accessor 0", "byteStride 4", "12-byte"]);
+    // A view past its buffer: named as such, not as a missing POSITION.
+    let json = raw_json("", "", "", "").replace(
+        r#""buffer":0,"byteLength":36}"#,
+        r#""buffer":0,"byteOffset":24,"byteLength":36}"#,
+    );
+    refused_with(
+        d,
+        &json,
+        &bin,
+        &["POSITION (accessor 0)", "reaches past the 36 bytes"],
+    );
+    // An accessor whose count reaches past its view.
+    let json = raw_json("", "", "", "").replace(r#""count":3"#, r#""count":4"#);
+    refused_with(d, &json, &bin, &["4 elements", "reach past the 36 bytes"]);
+    // Indices, texture coordinates and normals past the buffer were cut short or dropped.
+    let mut more = bin.clone();
+    more.extend(floats(&[0.0; 6]));
+    more.extend([0u8, 0, 1, 0, 2, 0]);
+    let idx = raw_json(
+        "",
+        r#",{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}"#,
+        r#",{"buffer":0,"byteOffset":60,"byteLength":6}"#,
+        "",
+    )
+    .replace(r#""POSITION":0}"#, r#""POSITION":0},"indices":1"#);
+    refused_with(
+        d,
+        &idx,
+        &more,
+        &["the indices (accessor 1)", "6 elements", "reach past"],
+    );
+    let uv = raw_json(
+        r#","TEXCOORD_0":1"#,
+        r#",{"bufferView":1,"componentType":5126,"count":3,"type":"VEC2"}"#,
+        r#",{"buffer":0,"byteOffset":36,"byteLength":16}"#,
+        "",
+    );
+    refused_with(
+        d,
+        &uv,
+        &more,
+        &["TEXCOORD_0 (accessor 1)", "reach past the 16 bytes"],
+    );
+    let nrm = raw_json(
+        r#","NORMAL":1"#,
+        r#",{"bufferView":1,"componentType":5126,"count":2,"type":"VEC3"}"#,
+        r#",{"buffer":0,"byteOffset":36,"byteLength":24}"#,
+        "",
+    );
+    refused_with(d, &nrm, &more, &["NORMAL has 2 elements, POSITION 3"]);
+    // Texture coordinates as bytes must be normalised.
+    let uv8 = raw_json(
+        r#","TEXCOORD_0":1"#,
+        r#",{"bufferView":1,"componentType":5121,"count":3,"type":"VEC2"}"#,
+        r#",{"buffer":0,"byteOffset":36,"byteLength":6}"#,
+        "",
+    );
+    refused_with(d, &uv8, &more, &["TEXCOORD_0", "without normalized: true"]);
+    // Indices that are not whole triangles, and an index past the vertices.
+    let mut two = bin.clone();
+    two.extend([0u8, 1, 2, 0]);
+    let idx = raw_json(
+        "",
+        r#",{"bufferView":1,"componentType":5121,"count":4,"type":"SCALAR"}"#,
+        r#",{"buffer":0,"byteOffset":36,"byteLength":4}"#,
+        "",
+    )
+    .replace(r#""POSITION":0}"#, r#""POSITION":0},"indices":1"#);
+    refused_with(d, &idx, &two, &["4 indices", "not whole triangles"]);
+    let mut far = bin.clone();
+    far.extend([0u8, 1, 9]);
+    let idx = idx
+        .replace(r#""count":4"#, r#""count":3"#)
+        .replace(r#""byteLength":4}"#, r#""byteLength":3}"#);
+    refused_with(d, &idx, &far, &["index 2 is 9, past its 3 vertices"]);
+    // A non-finite normal.
+    let mut bad = bin.clone();
+    bad.extend(floats(&[0.0, 0.0, 1.0, f32::NAN, 0.0, 1.0, 0.0, 0.0, 1.0]));
+    let nrm = raw_json(
+        r#","NORMAL":1"#,
+        r#",{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}"#,
+        r#",{"buffer":0,"byteOffset":36,"byteLength":36}"#,
+        "",
+    );
+    refused_with(
+        d,
+        &nrm,
+        &bad,
+        &["NORMAL (accessor 1)", "element 1", "not finite"],
+    );
+}
+
+#[test]
+fn strided_and_normalised_data_read_as_the_specification_says() {
+    let dir = tempfile::tempdir().unwrap();
+    // Positions interleaved with 4 bytes of padding (stride 16), texture coordinates as
+    // normalised u16.
+    let mut bin = Vec::new();
+    for v in TRI.chunks(3) {
+        bin.extend(floats(v));
+        bin.extend([0xffu8; 4]);
+    }
+    for uv in [[0u16, 0], [65535, 0], [0, 32768]] {
+        bin.extend(uv.iter().flat_map(|x| x.to_le_bytes()));
+    }
+    let json = raw_json(
+        r#","TEXCOORD_0":1"#,
+        r#",{"bufferView":1,"componentType":5123,"normalized":true,"count":3,"type":"VEC2"}"#,
+        r#",{"buffer":0,"byteOffset":48,"byteLength":12}"#,
+        r#""extras":[1,2],"#,
+    )
+    .replace(r#""byteLength":36}"#, r#""byteLength":48,"byteStride":16}"#);
+    let path = write_raw(dir.path(), &json, &bin);
+    let mesh = Mesh::load(&path).unwrap();
+    assert_eq!(mesh.tris.len(), 1);
+    let t = &mesh.tris[0];
+    assert_eq!(t.p, [Vec3::ZERO, Vec3::X, Vec3::Y]);
+    // v = 1 − v (the OBJ convention).
+    assert!((t.uv[1].x - 1.0).abs() < 1e-6 && (t.uv[1].y - 1.0).abs() < 1e-6);
+    assert!((t.uv[2].y - (1.0 - 32768.0 / 65535.0)).abs() < 1e-6);
+}
+
+#[test]
+fn node_transforms_and_materials_outside_the_specification_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bin = floats(&TRI);
+    let node = |n: &str| raw_json("", "", "", "").replace(r#"{"mesh":0}"#, n);
+    let cases: [(&str, &[&str]); 6] = [
+        (
+            r#"{"mesh":0,"rotation":[0,0,0,0]}"#,
+            &["node 0", "not a unit quaternion", "length 0"],
+        ),
+        (
+            r#"{"mesh":0,"rotation":[0,0,0,2]}"#,
+            &["not a unit quaternion"],
+        ),
+        (r#"{"mesh":0,"scale":[1,0,1]}"#, &["scale", "has a 0"]),
+        (
+            r#"{"mesh":0,"matrix":[1,0,0,0, 0,1,0,0, 0,0,0,0, 0,0,0,1]}"#,
+            &["singular"],
+        ),
+        (
+            r#"{"mesh":0,"matrix":[1,0,0,0, 0,1,0,0, 0,0,1,1, 0,0,0,1]}"#,
+            &["last row", "affine"],
+        ),
+        (
+            r#"{"mesh":0,"translation":[1e39,0,0]}"#,
+            &["node 0", "not finite"],
+        ),
+    ];
+    for (n, causes) in cases {
+        refused_with(d, &node(n), &bin, causes);
+    }
+    // A rotation rounded by an exporter (length 1 + 2e-4) is taken, normalised.
+    let path = write_raw(d, &node(r#"{"mesh":0,"rotation":[0,0,0,1.0002]}"#), &bin);
+    assert_eq!(Mesh::load(&path).unwrap().tris[0].p[1], Vec3::X);
+    let material = |m: &str| {
+        raw_json("", "", "", &format!(r#""materials":[{m}],"#))
+            .replace(r#""POSITION":0}"#, r#""POSITION":0},"material":0"#)
+    };
+    refused_with(
+        d,
+        &material(r#"{"name":"leaf","alphaMode":"MASK","alphaCutoff":-0.5}"#),
+        &bin,
+        &["\"leaf\"", "alphaCutoff -0.5", "outside [0, 1]"],
+    );
+    refused_with(
+        d,
+        &material(r#"{"name":"bark","pbrMetallicRoughness":{"baseColorFactor":[2,0,0,1]}}"#),
+        &bin,
+        &["\"bark\"", "baseColorFactor"],
+    );
+}
+
+#[test]
+fn a_clamped_texture_is_refused_only_where_coordinates_leave_the_unit_square() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([80, 150, 60, 255]))
+        .save(d.join("leaf.png"))
+        .unwrap();
+    let json = |uv_max: f32| {
+        let mut bin = floats(&TRI);
+        bin.extend(floats(&[0.0, 0.0, uv_max, 0.0, 0.0, uv_max]));
+        let json = raw_json(
+            r#","TEXCOORD_0":1"#,
+            r#",{"bufferView":1,"componentType":5126,"count":3,"type":"VEC2"}"#,
+            r#",{"buffer":0,"byteOffset":36,"byteLength":24}"#,
+            r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+            "textures":[{"source":0,"sampler":0}],"images":[{"uri":"leaf.png"}],
+            "samplers":[{"wrapS":33071,"wrapT":33648}],"#,
+        )
+        .replace(r#"}}]}]"#, r#"},"material":0}]}]"#);
+        (json, bin)
+    };
+    let (j, b) = json(1.0);
+    let path = write_raw(d, &j, &b);
+    assert_eq!(Mesh::load(&path).unwrap().tris.len(), 1);
+    let (j, b) = json(2.5);
+    refused_with(
+        d,
+        &j,
+        &b,
+        &["ClampToEdge", "MirroredRepeat", "reaches 2.5", "repeats"],
+    );
+}
+
+#[test]
+fn what_the_bake_leaves_out_is_noted_and_the_rest_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let bin = floats(&TRI);
+    let json = raw_json(
+        "",
+        "",
+        "",
+        r#""extensionsUsed":["KHR_materials_emissive_strength"],
+        "animations":[{"channels":[{"sampler":0,"target":{"node":0,"path":"translation"}}],
+          "samplers":[{"input":0,"output":0}]}],
+        "cameras":[{"type":"perspective","perspective":{"yfov":1.0,"znear":0.1}}],
+        "materials":[{"name":"leaf","doubleSided":false,"normalTexture":{"index":0}}],
+        "textures":[{"source":0}],"images":[{"uri":"n.png"}],
+        "extras":{"exporter":"test"},"#,
+    )
+    .replace(r#""POSITION":0}"#, r#""POSITION":0},"material":0"#);
+    let path = write_raw(dir.path(), &json, &bin);
+    let mesh = Mesh::load(&path).unwrap();
+    assert_eq!(mesh.tris.len(), 1);
+    let notes = mesh.notes.join("\n");
+    for n in [
+        "1 animation ignored",
+        "1 camera ignored",
+        "single-sided",
+        "normal",
+        "KHR_materials_emissive_strength",
+    ] {
+        assert!(notes.contains(n), "expected {n:?} in the notes:\n{notes}");
+    }
+}

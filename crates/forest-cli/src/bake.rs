@@ -302,7 +302,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             }))
             .collect::<Vec<_>>(),
     });
-    if let Some(note) = &switch_note {
+    for note in out.notes.iter().chain(&switch_note) {
         eprintln!("forest: note: {note}");
     }
     if args.json {
