@@ -383,3 +383,78 @@ fn the_memory_estimate_bounds_a_measured_bake_and_refuses_what_cannot_fit() {
         );
     }
 }
+
+/// The glTF corpus (`scripts/make_gltf_corpus.py`: trees stored as Blender, an interleaving
+/// exporter and the Khronos sample models store them) bakes, says what it left out, and
+/// renders as quads and as geometry from its own model.
+#[test]
+fn the_gltf_corpus_bakes_and_renders() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/gltf-corpus");
+    let dir = tempfile::tempdir().unwrap();
+    let p = |s: &str| dir.path().join(s).display().to_string();
+    for (file, notes) in [
+        (
+            "blender.glb",
+            &["1 animation ignored", "KHR_materials_specular"][..],
+        ),
+        ("interleaved.gltf", &["COLOR_0"][..]),
+        ("instanced.gltf", &["1 camera ignored"][..]),
+    ] {
+        let model = corpus.join(file);
+        let before = std::fs::read(&model).unwrap();
+        let atlas = p(&format!("{file}.atlas"));
+        let mut args = vec!["bake", model.to_str().unwrap(), "-o", &atlas, "--json"];
+        args.extend(SMALL);
+        args.push("--no-hybrid-switch");
+        let out = forest(&args);
+        let report = ok(&out);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        for n in notes {
+            assert!(
+                stderr.contains(n),
+                "{file}: expected the note {n:?} in: {stderr}"
+            );
+        }
+        let v: serde_json::Value = serde_json::from_str(report.trim()).unwrap();
+        // 12 trunk triangles and 80 of leaf cards, once per instance.
+        let instances = if file == "instanced.gltf" { 3 } else { 1 };
+        assert_eq!(v["triangles"], 92 * instances, "{file}: {v}");
+        assert_eq!(std::fs::read(&model).unwrap(), before, "{file} changed");
+        let forest_file = p(&format!("{file}.json"));
+        ok(&forest(&[
+            "scene",
+            "--model-sizes",
+            "--trees",
+            "6",
+            "--species",
+            &atlas,
+            "-o",
+            &forest_file,
+        ]));
+        for method in ["quads", "geometry"] {
+            let png = p(&format!("{file}-{method}.png"));
+            let text = ok(&forest(&[
+                "render",
+                &forest_file,
+                "-o",
+                &png,
+                "--view",
+                "birds-eye",
+                "--size",
+                "64x48",
+                "--method",
+                method,
+                "--models",
+                model.to_str().unwrap(),
+                "--transparent",
+                "--json",
+            ]));
+            let img = image::open(&png).unwrap().to_rgba8();
+            let covered = img.pixels().filter(|p| p[3] > 0).count();
+            assert!(
+                covered > 20,
+                "{file} {method}: {covered} pixels covered ({text})"
+            );
+        }
+    }
+}

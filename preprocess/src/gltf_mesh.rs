@@ -33,7 +33,7 @@
 //! naming missing accessors, images without a source or MIME type, and node hierarchies that
 //! are not trees.
 //!
-//! Read past, with a note in [`Mesh::notes`]: animations, morph targets, cameras,
+//! Read past, with a note in [`Mesh::notes`]: animations, morph targets, vertex colours, cameras,
 //! single-sided materials (baked double-sided), normal, occlusion, emissive and
 //! metal-roughness maps, and extensions the file uses without requiring them. `extras`
 //! anywhere are ignored whatever their JSON type.
@@ -400,6 +400,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     let mut notes: Vec<String> = Vec::new();
     let mut single_sided = Vec::new();
     let mut unused_maps = Vec::new();
+    let mut coloured = 0usize;
     for m in doc.materials() {
         let name = m
             .name()
@@ -604,6 +605,9 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                     None => continue,
                 },
             };
+            if prim.get(&gltf::mesh::Semantic::Colors(0)).is_some() {
+                coloured += 1;
+            }
             let (pos, nrm, uv, idx) =
                 read_primitive(&prim, &buffers, &at()).map_err(|reason| parse_err(path, reason))?;
             let wrap = prim.material().index().and_then(|i| clamped[i].as_ref());
@@ -702,6 +706,12 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
         notes.push(format!(
             "morph targets of {} ignored: the base shape is baked",
             count(morphs.count(), "primitive")
+        ));
+    }
+    if coloured > 0 {
+        notes.push(format!(
+            "vertex colours (COLOR_0) of {} ignored",
+            count(coloured, "primitive")
         ));
     }
     if doc.cameras().len() > 0 {
