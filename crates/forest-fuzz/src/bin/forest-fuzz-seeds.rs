@@ -243,6 +243,25 @@ fn main() {
     );
     let (json, bin) = gltf_parts(&leaf, true);
     write("gltf", "seed-1.glb", &glb(&json, &bin));
+    // The glTF corpus's Blender-shaped GLB and its interleaved .gltf (its buffer and images
+    // renamed to the files the target writes).
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/gltf-corpus");
+    let read = |f: &str| std::fs::read(corpus.join(f)).expect("the glTF corpus is there");
+    write("gltf", "seed-2.glb", &read("blender.glb"));
+    let json = String::from_utf8(read("interleaved.gltf"))
+        .expect("UTF-8 JSON")
+        .replace("interleaved.bin", "model.bin")
+        .replace("interleaved-bark.png", "leaf.png")
+        .replace("interleaved-leaf.png", "leaf.png");
+    write(
+        "gltf",
+        "seed-3",
+        &join_files(&[
+            json.as_bytes(),
+            &read("interleaved.bin"),
+            &read("interleaved-leaf.png"),
+        ]),
+    );
 
     // Atlases baked from the OBJ seed, JPEG and PNG colour.
     for obj in
