@@ -89,9 +89,33 @@ fn external(path: &Path, uri: &str, what: &str) -> Result<PathBuf, BakeError> {
     Ok(dir.join(name.as_ref()))
 }
 
+/// A GLB's header, checked before the gltf crate (1.4.1) reads it: it subtracts the header's
+/// 12 bytes from the length the header states without checking that it is at least that.
+fn check_glb_header(path: &Path, bytes: &[u8]) -> Result<(), BakeError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(length) = bytes.get(8..12) else {
+        return Err(parse_err(path, "a GLB shorter than its 12-byte header"));
+    };
+    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+    if length < 12 || length as usize > bytes.len() {
+        return Err(parse_err(
+            path,
+            format!(
+                "its GLB header says the file is {length} bytes; it is {} (and the header \
+                 alone is 12)",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The files a glTF model is read from: itself, and the buffers and images its URIs name.
 pub fn source_files(path: &Path) -> Result<Vec<PathBuf>, BakeError> {
     let bytes = bounded::read(path, bounded::limit::DATA)?;
+    check_glb_header(path, &bytes)?;
     let doc = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| parse_err(path, e.to_string()))?;
     // From the JSON itself: the document is not validated, and the crate's accessors unwrap.
@@ -341,6 +365,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     // Parsed, then checked for what validation would call invalid without naming (an
     // unsupported required extension) or lets through to a panic in the gltf crates, then
     // validated.
+    check_glb_header(path, &bytes)?;
     let parsed = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| parse_err(path, e.to_string()))?;
     refuse_extensions(path, &parsed)?;

@@ -185,10 +185,9 @@ pub(crate) fn no_triangles(path: &Path, degenerate: u64) -> BakeError {
     }
 }
 
-/// The largest vertex coordinate (absolute value, model units) a model may have: beyond it,
-/// areas of the model's triangles (fourth powers of coordinates in the zero-area test)
-/// overflow `f32`. NaN and infinities are refused by the same test.
-pub const MAX_MODEL_COORDINATE: f32 = 1e6;
+/// The largest vertex coordinate (absolute value, model units) a model may have (NaN and
+/// infinities are refused by the same test).
+pub use forest_format::species::MAX_MODEL_COORDINATE;
 
 impl Mesh {
     /// Load a model with its materials and textures: OBJ, or glTF 2.0 (`.gltf`, `.glb`; see

@@ -225,6 +225,16 @@ fn malformed_gltf_is_refused_without_a_panic() {
     assert!(e.contains("no mimeType"), "{e}");
     let e = refused(r#"{"mesh":0}"#, r#"{"mesh":0,"children":[0]}"#);
     assert!(e.contains("not a tree"), "{e}");
+    // A GLB whose header states a length below its own 12 bytes (the fuzz target's find).
+    let glb = dir.path().join("short.glb");
+    let mut bytes = b"glTF".to_vec();
+    bytes.extend(2u32.to_le_bytes());
+    bytes.extend(0u32.to_le_bytes());
+    bytes.extend([0u8; 20]);
+    std::fs::write(&glb, &bytes).unwrap();
+    let e = Mesh::load(&glb).unwrap_err().to_string();
+    assert!(e.contains("GLB header says the file is 0 bytes"), "{e}");
+    assert!(forest_bake::mesh::source_files(&glb).is_err());
 }
 
 #[test]

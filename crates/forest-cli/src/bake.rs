@@ -15,34 +15,39 @@ pub struct BakeArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Sampling directions over the upper hemisphere (horizon to zenith).
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = 15, allow_negative_numbers = true)]
     pub directions: u32,
     /// Sampling directions below the horizon, for trees seen from below (walkthroughs): a ring
     /// at −45° and the nadir at the default 5; 0 clamps views from below onto the horizon.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub below: u32,
     /// How quad planes are fitted: gap-aware (no plane bridges a depth gap) or least-squares
     /// (the paper's fit over all of a quad's pixels).
     #[arg(long, default_value = "gap-aware", value_parser = ["gap-aware", "least-squares"])]
     pub plane_fit: String,
     /// Parallel slabs per direction.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = 2, allow_negative_numbers = true)]
     pub slabs: u32,
     /// Slab image side in pixels (a power of two).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, allow_negative_numbers = true)]
     pub resolution: u32,
     /// Smallest quad side in pixels (a power of two below the resolution).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
     pub min_quad: u32,
     /// Jittered samples per pixel.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
     pub spp: u32,
     /// Refused: atlases store no light since format 3. The sun is chosen at run time
     /// (`forest render --sun AZ,EL`, `forest view`, every bench).
     #[arg(long, hide = true, allow_hyphen_values = true)]
     pub sun: Option<String>,
     /// JPEG quality of the colour mosaic (1–100).
-    #[arg(long, default_value_t = 80, conflicts_with = "lossless")]
+    #[arg(
+        long,
+        default_value_t = 80,
+        conflicts_with = "lossless",
+        allow_negative_numbers = true
+    )]
     pub quality: u8,
     /// Store colour losslessly (PNG) instead of JPEG.
     #[arg(long)]
@@ -58,7 +63,7 @@ pub struct BakeArgs {
     pub json: bool,
     /// Refuse bakes whose estimated peak memory exceeds this many GiB (default: the memory
     /// the system reports available).
-    #[arg(long, value_name = "GIB")]
+    #[arg(long, value_name = "GIB", allow_negative_numbers = true)]
     pub memory_limit: Option<f64>,
     /// Do not measure the hybrid method's switch distance. By default the bake renders the
     /// new atlas against its model on the GPU (54 views of one tree, 400×300) to find where
@@ -159,10 +164,18 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             args.output.display()
         );
     }
+    forest_format::atlas::check_only_atlas_files(&args.output)?;
     let out_parent = args.output.parent().filter(|p| !p.as_os_str().is_empty());
     if let Some(p) = out_parent
         && !p.is_dir()
     {
+        if p.exists() {
+            bail!(
+                "{} is a file, not a folder: the output atlas {} cannot be made in it",
+                p.display(),
+                args.output.display()
+            );
+        }
         bail!("output folder {} does not exist", p.display());
     }
     // Refuse what cannot fit before tracing for minutes and then failing an allocation.

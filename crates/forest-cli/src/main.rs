@@ -44,6 +44,9 @@ pub(crate) fn gpu_context() -> Result<forest_render::GpuContext, forest_render::
 #[command(name = "forest", version, about, long_about = None)]
 enum Cli {
     /// Bake a tree model (OBJ + MTL + textures, or glTF 2.0) into a quad-stream atlas.
+    ///
+    /// Baking again into an existing atlas folder replaces it whole; a folder holding any
+    /// file a bake does not write is refused, so nothing of yours in it is lost.
     Bake(bake::BakeArgs),
     /// Check an atlas and print its summary.
     Info(bake::InfoArgs),
@@ -54,6 +57,10 @@ enum Cli {
     /// Run benchmark suites: CSV, charts (PNG + SVG) and, for `all`, REPORT.md.
     Bench(bench::BenchArgs),
     /// Accuracy of an image against a reference: mean FLIP, SSIM, PSNR, coverage IoU.
+    ///
+    /// Colour is compared as stored (renders over a transparent background are
+    /// premultiplied), except under alpha 0, where it is taken as black in both images: no
+    /// compositing shows it, and straight-alpha images leave anything there.
     Compare(compare::CompareArgs),
     /// Walkthrough viewer (a window), or a camera path rendered headless to numbered PNGs.
     View(view::ViewArgs),

@@ -63,7 +63,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub light: LightArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub supersample: u32,
 }
 
@@ -146,9 +146,12 @@ pub struct MethodArgs {
     /// rest as the quad stream). The last five need --models.
     #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
-    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods).
+    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods). Each must be the file its atlas was baked from (the same bytes, or else the same bounding sphere within 1 %)
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<PathBuf>,
+    /// Draw --models that are not the files their atlases were baked from (each is named on stderr)
+    #[arg(long)]
+    pub allow_other_models: bool,
     /// Full geometry: draw trees in submission order instead of nearest distance band first.
     #[arg(long)]
     pub unsorted: bool,
@@ -304,9 +307,15 @@ pub(crate) fn parse_vec3(s: &str) -> Result<Vec3, String> {
                 .map_err(|_| format!("{x:?} is not a number"))
         })
         .collect::<Result<_, _>>()?;
+    if let Some(c) = v.iter().find(|c| !c.is_finite()) {
+        return Err(format!("{s:?}: {c} is not a finite number"));
+    }
     match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
-        _ => Err(format!("{s:?}: expected x,y,z")),
+        [x, y, z] => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(format!(
+            "{s:?}: expected three numbers x,y,z, got {}",
+            v.len()
+        )),
     }
 }
 
@@ -354,6 +363,8 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
             SpeciesData::load(&p).with_context(|| format!("species {s} of {}", path.display()))
         })
         .collect::<Result<Vec<_>>>()?;
+    let manifests: Vec<_> = species.iter().map(|s| &s.atlas.manifest).collect();
+    forest_format::species::check(&forest, &manifests, path)?;
     spinner.finish_and_clear();
     Ok((forest, species))
 }
@@ -675,7 +686,7 @@ fn render_hybrid(
     species: &[SpeciesData],
     cameras: &[(String, Camera)],
 ) -> Result<()> {
-    let prepared = prepare_models(&args.m.models, species)?;
+    let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
     let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
@@ -775,18 +786,62 @@ pub fn write_png(img: &image::RgbaImage, out: &Path) -> Result<()> {
 
 /// Load the species' OBJ models and prepare them for the geometry-based methods, lit as their
 /// atlases were baked.
-pub fn prepare_models(models: &[PathBuf], species: &[SpeciesData]) -> Result<PreparedGeometry> {
+pub fn prepare_models(
+    models: &[PathBuf],
+    species: &[SpeciesData],
+    allow_other: bool,
+) -> Result<PreparedGeometry> {
     let geo_species = models
         .iter()
         .zip(species)
         .map(|(m, s)| {
-            Ok(GeometrySpecies::new(
-                forest_bake::Mesh::load(m)?,
-                &s.atlas.manifest,
-            ))
+            let mesh = forest_bake::Mesh::load(m)?;
+            check_model(m, &mesh, &s.atlas.manifest, allow_other)?;
+            Ok(GeometrySpecies::new(mesh, &s.atlas.manifest))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(PreparedGeometry::new(&geo_species))
+}
+
+/// How far (a fraction of the atlas's bounding radius) a model's bounding sphere may lie from
+/// its atlas's for the model to count as the one baked, when its bytes differ (re-exported,
+/// or a texture edited).
+pub const MODEL_SPHERE_TOLERANCE: f32 = 0.01;
+
+/// A model drawn for a species is the one its atlas was baked from: the same bytes (the hash
+/// the bake recorded), or else the same bounding sphere within [`MODEL_SPHERE_TOLERANCE`]
+/// (said on stderr). Anything else is an error naming both, unless `allow_other`.
+pub fn check_model(
+    path: &Path,
+    mesh: &forest_bake::Mesh,
+    manifest: &forest_format::AtlasManifest,
+    allow_other: bool,
+) -> Result<()> {
+    if format!("{:016x}", mesh.hash) == manifest.source.hash {
+        return Ok(());
+    }
+    let baked = manifest.bounding_sphere;
+    let sphere = forest_bake::bounding_sphere(mesh);
+    let off = (sphere.center - baked.center).length() + (sphere.radius - baked.radius).abs();
+    let close = off <= MODEL_SPHERE_TOLERANCE * baked.radius;
+    let what = format!(
+        "model {} is not the file its atlas was baked from ({}): its bytes differ, and its \
+         bounding sphere (centre {:.3}, radius {:.3}) is {} the atlas's (centre {:.3}, radius \
+         {:.3})",
+        path.display(),
+        manifest.source.file,
+        sphere.center,
+        sphere.radius,
+        if close { "within 1 % of" } else { "not" },
+        baked.center,
+        baked.radius
+    );
+    if close || allow_other {
+        eprintln!("forest: note: {what}");
+        Ok(())
+    } else {
+        bail!("{what} (--allow-other-models draws it anyway)")
+    }
 }
 
 /// The geometry-based methods: full geometry (reference / brute force), stochastic
@@ -799,7 +854,7 @@ fn render_geometry(
     species: &[SpeciesData],
     cameras: &[(String, Camera)],
 ) -> Result<()> {
-    let prepared = prepare_models(&args.m.models, species)?;
+    let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
     let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
     render_views(args, ctx, cameras, |cam, target| {

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::generate::{GenerateParams, GroundRules, generate, species_height};
 use forest_format::terrain::{Terrain, TerrainParams};
@@ -11,13 +11,13 @@ use forest_format::terrain::{Terrain, TerrainParams};
 #[derive(Args, Debug)]
 pub struct SceneArgs {
     /// Number of trees.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = 10_000, allow_negative_numbers = true)]
     pub trees: u32,
     /// Species atlases (comma-separated or repeated); each must be a baked atlas folder.
     #[arg(long, value_delimiter = ',', required = true)]
     pub species: Vec<PathBuf>,
     /// Random seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Mean ground area per tree in m² (sets the forest's size).
     #[arg(long, allow_negative_numbers = true, default_value_t = 30.0)]
@@ -26,7 +26,7 @@ pub struct SceneArgs {
     #[arg(long, allow_negative_numbers = true, default_value_t = 60.0)]
     pub clump_size: f32,
     /// Presort directions.
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = 15, allow_negative_numbers = true)]
     pub presort_directions: u32,
     /// Tree heights per species, `NAME=MIN-MAX` in metres (comma-separated; NAME is the
     /// atlas folder's name without `.atlas`), drawn uniformly per tree. They override the
@@ -221,6 +221,9 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     }
     crate::guard::not_an_input(&args.output, "output", &inputs)?;
     let mut species = Vec::new();
+    // Every atlas loaded whole, as render loads it: a forest is not written over atlases
+    // that render would refuse.
+    let mut manifests = Vec::new();
     for s in &args.species {
         if !s.join(forest_format::atlas::MANIFEST_FILE).is_file() {
             bail!(
@@ -228,6 +231,9 @@ pub fn run(args: &SceneArgs) -> Result<()> {
                 s.display()
             );
         }
+        let atlas =
+            forest_format::Atlas::load(s).with_context(|| format!("species {}", s.display()))?;
+        manifests.push(atlas.manifest);
         species.push(stored_path(s, &args.output)?);
     }
     let (species_scale, size_lines) = species_scales(args)?;
@@ -269,6 +275,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     .map_err(anyhow::Error::msg)?;
     // What `render` would refuse is refused here, before anything is written.
     forest.check(&args.output)?;
+    forest_format::species::check(&forest, &manifests.iter().collect::<Vec<_>>(), &args.output)?;
     spinner.set_message(format!("writing {}", args.output.display()));
     forest.save(&args.output)?;
     spinner.finish_and_clear();

@@ -180,7 +180,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let geometry = match mesh_method {
         Some(_) => Some(geometry(
             &ctx,
-            &prepare_models(&args_models.models, &species)?,
+            &prepare_models(
+                &args_models.models,
+                &species,
+                args_models.allow_other_models,
+            )?,
             &forest,
             TARGET_FORMAT,
             light,
@@ -241,7 +245,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
     let prepared = if m.models.is_empty() {
         None
     } else {
-        Some(prepare_models(&m.models, &species)?)
+        Some(prepare_models(&m.models, &species, m.allow_other_models)?)
     };
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
     let chosen = m.chosen(mesh_method)?;

@@ -39,7 +39,7 @@ pub struct Instance {
     pub position: [f32; 3],
     /// Rotation about +Y in radians (counter-clockwise seen from above).
     pub rotation: f32,
-    /// Uniform scale (> 0).
+    /// Uniform scale, in [`MIN_SCALE`, `MAX_SCALE`].
     pub scale: f32,
     /// Index into [`Forest::species`].
     pub species: u32,
@@ -93,6 +93,11 @@ impl Presort {
 /// Largest coordinate of a tree (metres from the origin on any axis): far enough for any
 /// forest, near enough that far planes and camera matrices stay finite in single precision.
 pub const MAX_COORDINATE: f32 = 1.0e7;
+
+/// Smallest instance scale: a model shrunk more than this many times is no tree.
+pub const MIN_SCALE: f32 = 1e-4;
+/// Largest instance scale (models in centimetres scaled to metres are 100 times).
+pub const MAX_SCALE: f32 = 1e4;
 
 /// A forest: species (atlas names), instances and presorts.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,7 +164,8 @@ impl Forest {
         self
     }
 
-    /// Check values: species indices in range, finite positions, positive finite scales,
+    /// Check values: species indices in range, finite positions, scales in [`MIN_SCALE`,
+    /// `MAX_SCALE`],
     /// presort orders that are permutations sorted along finite unit directions, and trees
     /// within [`MAX_COORDINATE`] of the origin.
     pub fn check(&self, path: &Path) -> Result<(), FormatError> {
@@ -193,8 +199,11 @@ impl Forest {
                     i.position
                 ));
             }
-            if !(i.scale.is_finite() && i.scale > 0.0) {
-                return bad(format!("instance {k} has scale {}, not positive", i.scale));
+            if !(MIN_SCALE..=MAX_SCALE).contains(&i.scale) {
+                return bad(format!(
+                    "instance {k} has scale {:e}, outside [{MIN_SCALE:e}, {MAX_SCALE:e}]",
+                    i.scale
+                ));
             }
         }
         if let Some(t) = &self.terrain {

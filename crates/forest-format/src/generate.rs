@@ -199,9 +199,13 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
     if !(p.clump_size.is_finite() && p.clump_size > 0.0) {
         return Err(format!("clump size = {}: must be positive", p.clump_size));
     }
-    let good = |(lo, hi): (f32, f32)| lo > 0.0 && hi >= lo && hi.is_finite();
+    use crate::forest::{MAX_SCALE, MIN_SCALE};
+    let good = |(lo, hi): (f32, f32)| lo >= MIN_SCALE && hi >= lo && hi <= MAX_SCALE;
     if !good(p.scale) {
-        return Err(format!("scale range {:?}: must be 0 < min ≤ max", p.scale));
+        return Err(format!(
+            "scale range {:?}: must be {MIN_SCALE:e} ≤ min ≤ max ≤ {MAX_SCALE:e}",
+            p.scale
+        ));
     }
     if !p.species_scale.is_empty() && p.species_scale.len() != p.species.len() {
         return Err(format!(
@@ -212,7 +216,7 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
     }
     if let Some((i, r)) = p.species_scale.iter().enumerate().find(|(_, r)| !good(**r)) {
         return Err(format!(
-            "scale range {r:?} of species {}: must be 0 < min ≤ max",
+            "scale range {r:?} of species {}: must be {MIN_SCALE:e} ≤ min ≤ max ≤ {MAX_SCALE:e}",
             p.species[i]
         ));
     }

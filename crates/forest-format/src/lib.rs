@@ -25,6 +25,7 @@ pub mod nodes_codec;
 pub mod opacity;
 pub mod shading;
 pub mod slab;
+pub mod species;
 pub mod terrain;
 pub mod trim;
 

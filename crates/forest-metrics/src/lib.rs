@@ -9,6 +9,10 @@
 //!   (alpha ≥ 128; tree coverage when rendered over a transparent background), so faint
 //!   filtering fringes do not count; `None` when both images are fully opaque, since coverage
 //!   is then unknown.
+//!
+//! Colour is compared as stored (the project's renders over a transparent background are
+//! premultiplied), except where a pixel's alpha is 0: no compositing shows that colour, and
+//! images with straight alpha leave anything there, so it is taken as black in both images.
 
 use image::RgbaImage;
 
@@ -41,8 +45,19 @@ pub struct Metrics {
     pub coverage_iou: Option<f64>,
 }
 
+/// The image as compared: RGB black wherever alpha is 0 (see the module documentation).
+fn visible(img: &RgbaImage) -> RgbaImage {
+    let mut out = img.clone();
+    for p in out.pixels_mut() {
+        if p[3] == 0 {
+            *p = image::Rgba([0, 0, 0, 0]);
+        }
+    }
+    out
+}
+
 fn rgb(img: &RgbaImage) -> image::RgbImage {
-    image::DynamicImage::ImageRgba8(img.clone()).to_rgb8()
+    image::DynamicImage::ImageRgba8(visible(img)).to_rgb8()
 }
 
 /// Mean FLIP and the per-pixel error map (magma colours).
@@ -65,7 +80,7 @@ pub fn flip(
 pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Result<f64, MetricsError> {
     check(reference, test)?;
     let mut se = 0f64;
-    for (a, b) in reference.pixels().zip(test.pixels()) {
+    for (a, b) in visible(reference).pixels().zip(visible(test).pixels()) {
         for c in 0..3 {
             se += (f64::from(a[c]) - f64::from(b[c])).powi(2);
         }
@@ -81,7 +96,7 @@ pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Result<f64, MetricsError
 /// Mean SSIM of luma.
 pub fn ssim(reference: &RgbaImage, test: &RgbaImage) -> Result<f64, MetricsError> {
     check(reference, test)?;
-    let luma = |i: &RgbaImage| image::DynamicImage::ImageRgba8(i.clone()).to_luma8();
+    let luma = |i: &RgbaImage| image::DynamicImage::ImageRgba8(visible(i)).to_luma8();
     let s = image_compare::gray_similarity_structure(
         &image_compare::Algorithm::MSSIMSimple,
         &luma(reference),
@@ -151,6 +166,34 @@ mod tests {
         assert!((m.ssim - 1.0).abs() < 1e-9);
         assert_eq!(m.psnr, PSNR_CAP);
         assert_eq!(m.coverage_iou, None);
+    }
+
+    #[test]
+    fn colour_under_zero_alpha_does_not_count() {
+        // Straight-alpha images that differ only where nothing is covered.
+        let a = RgbaImage::from_fn(32, 32, |x, _| {
+            if x < 16 {
+                image::Rgba([200, 40, 90, 0])
+            } else {
+                image::Rgba([60, 120, 30, 255])
+            }
+        });
+        let b = RgbaImage::from_fn(32, 32, |x, _| {
+            if x < 16 {
+                image::Rgba([5, 250, 250, 0])
+            } else {
+                image::Rgba([60, 120, 30, 255])
+            }
+        });
+        let m = compare(&a, &b).unwrap();
+        assert_eq!(m.flip_mean, 0.0);
+        assert_eq!(m.psnr, PSNR_CAP);
+        assert!((m.ssim - 1.0).abs() < 1e-9);
+        assert_eq!(m.coverage_iou, Some(1.0));
+        // Where alpha is above 0 colour still counts.
+        let mut c = b.clone();
+        c.put_pixel(20, 20, image::Rgba([250, 0, 0, 255]));
+        assert!(compare(&a, &c).unwrap().flip_mean > 0.0);
     }
 
     #[test]

@@ -25,6 +25,10 @@ pub struct Camera {
     pub epsilon: f32,
 }
 
+/// The farthest an eye or target may be from the origin on any axis (metres): ten times
+/// [`forest_format::forest::MAX_COORDINATE`].
+pub const MAX_CAMERA_COORDINATE: f32 = 10.0 * forest_format::forest::MAX_COORDINATE;
+
 /// Why a camera cannot be used.
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[error("invalid camera: {0}")]
@@ -36,6 +40,14 @@ impl Camera {
         let bad = |s: String| Err(CameraError(s));
         if !(self.eye.is_finite() && self.target.is_finite()) {
             return bad("eye and target must be finite".into());
+        }
+        for (what, p) in [("eye", self.eye), ("target", self.target)] {
+            if p.abs().max_element() > MAX_CAMERA_COORDINATE {
+                return bad(format!(
+                    "{what} {p} lies beyond ±{MAX_CAMERA_COORDINATE:e} m (ten times the farthest \
+                     a forest may reach; single-precision view matrices fail farther out)"
+                ));
+            }
         }
         let f = self.target - self.eye;
         if f.length_squared() < 1e-12 {

@@ -62,6 +62,10 @@ pub struct BenchArgs {
     /// reference). Default: `assets/trees/NAME/FILE` for an atlas `NAME.atlas` baked from FILE.
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<PathBuf>,
+    /// Use --models that are not the files their atlases were baked from (each is named on
+    /// stderr).
+    #[arg(long)]
+    pub allow_other_models: bool,
     /// Results folder.
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
@@ -74,7 +78,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub redraw: bool,
     /// Frames measured per setting (the median is reported).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub frames: u32,
     /// Accuracy suite: measure only these views (comma-separated; default: all). Use with
     /// its own --out: the CSV, charts and report then hold these views alone.
@@ -99,6 +103,8 @@ pub struct Bench {
     pub species: Vec<SpeciesData>,
     /// OBJ models (empty when none could be found).
     pub models: Vec<PathBuf>,
+    /// `--allow-other-models`.
+    allow_other_models: bool,
     prepared: OnceCell<PreparedGeometry>,
     /// Results folder.
     pub out: PathBuf,
@@ -190,6 +196,7 @@ impl Bench {
             species_paths: args.species.clone(),
             species,
             models,
+            allow_other_models: args.allow_other_models,
             prepared: OnceCell::new(),
             out: args.out.clone(),
             quick: args.quick,
@@ -235,7 +242,8 @@ impl Bench {
                  pass --models (none found under assets/trees/)"
             );
         }
-        let p = crate::render::prepare_models(&self.models, &self.species)?;
+        let p =
+            crate::render::prepare_models(&self.models, &self.species, self.allow_other_models)?;
         Ok(self.prepared.get_or_init(|| p))
     }
 

@@ -109,6 +109,58 @@ impl HybridSwitch {
     pub const MIN_PIXELS: f32 = 0.05;
     /// Largest accepted [`HybridSwitch::finest_quad_pixels`].
     pub const MAX_PIXELS: f32 = 64.0;
+    /// Largest accepted [`HybridSwitch::crown_radii`]: the measurement's farthest rung lies
+    /// well inside it.
+    pub const MAX_CROWN_RADII: f32 = 1e4;
+    /// Largest viewport side it may have been measured at (pixels), as `render --size`.
+    pub const MAX_VIEWPORT: u32 = 16384;
+    /// Largest ε it may have been measured at (pixels).
+    pub const MAX_EPSILON: f32 = 1e4;
+
+    /// Every field in its range: the switch size in [`Self::MIN_PIXELS`,
+    /// `Self::MAX_PIXELS`], crown radii in (0, [`Self::MAX_CROWN_RADII`]], a viewport of 1 to
+    /// [`Self::MAX_VIEWPORT`] pixels a side, a field of view in (0°, 180°), ε in (0,
+    /// [`Self::MAX_EPSILON`]] and at least one camera. The error names the field.
+    pub fn check(&self) -> Result<(), String> {
+        let p = self.finest_quad_pixels;
+        if !(Self::MIN_PIXELS..=Self::MAX_PIXELS).contains(&p) {
+            return Err(format!(
+                "finest_quad_pixels = {p}, outside [{}, {}]",
+                Self::MIN_PIXELS,
+                Self::MAX_PIXELS
+            ));
+        }
+        let r = self.crown_radii;
+        if !(r > 0.0 && r <= Self::MAX_CROWN_RADII) {
+            return Err(format!(
+                "crown_radii = {r}, outside (0, {}]",
+                Self::MAX_CROWN_RADII
+            ));
+        }
+        if self
+            .viewport
+            .iter()
+            .any(|&v| !(1..=Self::MAX_VIEWPORT).contains(&v))
+        {
+            return Err(format!(
+                "viewport = {:?}, expected 1 to {} pixels a side",
+                self.viewport,
+                Self::MAX_VIEWPORT
+            ));
+        }
+        let f = self.fov_y_deg;
+        if !(f > 0.0 && f < 180.0) {
+            return Err(format!("fov_y_deg = {f}, outside (0, 180)"));
+        }
+        let e = self.epsilon;
+        if !(e > 0.0 && e <= Self::MAX_EPSILON) {
+            return Err(format!("epsilon = {e}, outside (0, {}]", Self::MAX_EPSILON));
+        }
+        if self.cameras == 0 {
+            return Err("cameras = 0, expected at least 1".into());
+        }
+        Ok(())
+    }
 }
 
 impl AtlasManifest {
@@ -224,6 +276,16 @@ impl AtlasManifest {
         if !(s.center.is_finite() && s.radius.is_finite() && s.radius > 0.0) {
             return bad(format!("bounding sphere {s:?} is not finite and positive"));
         }
+        let reach = s.center.abs().max_element() + s.radius;
+        if reach > crate::species::MAX_MODEL_COORDINATE {
+            return bad(format!(
+                "bounding sphere (centre {}, radius {:e}) reaches {reach:e} model units from the \
+                 origin, beyond the ±{:e} a model may have",
+                s.center,
+                s.radius,
+                crate::species::MAX_MODEL_COORDINATE
+            ));
+        }
         if self.layer_roots.len() != self.params.layers() as usize {
             return bad(format!(
                 "{} layer roots for {} layers",
@@ -246,14 +308,7 @@ impl AtlasManifest {
             ));
         }
         if let Some(h) = &self.hybrid_switch {
-            let p = h.finest_quad_pixels;
-            if !(HybridSwitch::MIN_PIXELS..=HybridSwitch::MAX_PIXELS).contains(&p) {
-                return bad(format!(
-                    "hybrid_switch.finest_quad_pixels = {p}, outside [{}, {}]",
-                    HybridSwitch::MIN_PIXELS,
-                    HybridSwitch::MAX_PIXELS
-                ));
-            }
+            h.check().or_else(|e| bad(format!("hybrid_switch.{e}")))?;
         }
         Ok(())
     }

@@ -329,6 +329,7 @@ impl Atlas {
                 "exists and is not an atlas folder: refusing to overwrite it",
             ));
         }
+        check_only_atlas_files(path)?;
         let name = path
             .file_name()
             .ok_or_else(|| FormatError::invalid(path, "not a folder name"))?
@@ -522,6 +523,55 @@ fn check_folder(path: &Path) -> Result<(), FormatError> {
 }
 
 /// Parse and check the manifest read from `mpath` (which errors name).
+/// Every file a bake may write into an atlas folder (both colour encodings').
+pub const ATLAS_FILES: [&str; 7] = [
+    MANIFEST_FILE,
+    "colour.jpg",
+    "colour.png",
+    ALPHA_FILE,
+    SURFACE_FILE,
+    OPACITY_FILE,
+    NODES_FILE,
+];
+
+/// The entries of atlas folder `path` that no bake writes (the user's own files, or
+/// folders), sorted; empty when `path` does not exist.
+pub fn foreign_entries(path: &Path) -> Vec<String> {
+    let Ok(dir) = std::fs::read_dir(path) else {
+        return Vec::new();
+    };
+    let mut out: Vec<String> = dir
+        .flatten()
+        .filter(|e| {
+            let name = e.file_name();
+            !(e.file_type().is_ok_and(|t| t.is_file())
+                && ATLAS_FILES.iter().any(|f| name == std::ffi::OsStr::new(f)))
+        })
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    out.sort();
+    out
+}
+
+/// An atlas folder is replaced whole when baked again: refused while it holds anything a
+/// bake did not write, which would be lost.
+pub fn check_only_atlas_files(path: &Path) -> Result<(), FormatError> {
+    let foreign = foreign_entries(path);
+    if foreign.is_empty() {
+        return Ok(());
+    }
+    Err(FormatError::invalid(
+        path,
+        format!(
+            "holds {}, which no bake writes: baking into it again would replace the folder \
+             and lose {}; move {} out, or bake to another folder",
+            foreign.join(", "),
+            if foreign.len() == 1 { "it" } else { "them" },
+            if foreign.len() == 1 { "it" } else { "them" },
+        ),
+    ))
+}
+
 fn parse_manifest(mpath: &Path, bytes: &[u8]) -> Result<AtlasManifest, FormatError> {
     // The version first: an older manifest has other fields, and the error must say why.
     #[derive(serde::Deserialize)]

@@ -1,0 +1,324 @@
+//! Bad inputs that once gave silent results or misleading messages: each now fails with one
+//! line naming the real cause, a non-zero exit, and every input byte for byte as it was.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+mod cli;
+
+use cli::{bake_small, forest, model, ok};
+
+/// Every file under `dir` and its bytes.
+fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(p.clone(), std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+/// The command fails with one line holding every one of `causes`, and leaves `dir` as it was.
+fn refused(args: &[&str], dir: &Path, causes: &[&str]) -> String {
+    let before = snapshot(dir);
+    let out: Output = forest(args);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let e = String::from_utf8_lossy(&out.stderr).into_owned();
+    let lines: Vec<&str> = e
+        .lines()
+        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{args:?}: one line: {e}");
+    for c in causes {
+        assert!(e.contains(c), "{args:?}: expected {c:?} in: {e}");
+    }
+    assert!(snapshot(dir) == before, "{args:?} changed the folder");
+    e
+}
+
+/// A copy of atlas `from` at `to` whose manifest has `edit` applied to its JSON.
+fn edited_atlas(from: &Path, to: &Path, edit: impl Fn(&mut serde_json::Value)) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+    let m = to.join("manifest.json");
+    let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&m).unwrap()).unwrap();
+    edit(&mut v);
+    std::fs::write(&m, serde_json::to_vec_pretty(&v).unwrap()).unwrap();
+}
+
+#[test]
+fn rebaking_keeps_the_users_files_and_outputs_in_files_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let atlas = d.join("bush.atlas");
+    bake_small("bush", &atlas, 32, 4);
+    std::fs::write(atlas.join("notes.txt"), "mine").unwrap();
+    let small = [
+        "--resolution",
+        "32",
+        "--directions",
+        "4",
+        "--spp",
+        "1",
+        "--no-hybrid-switch",
+    ];
+    let bush = model("bush");
+    let mut args = vec!["bake", &bush, "-o", atlas.to_str().unwrap()];
+    args.extend(small);
+    refused(&args, d, &["notes.txt", "no bake writes", "move it out"]);
+    // Without the user's file it bakes again over the old atlas.
+    std::fs::remove_file(atlas.join("notes.txt")).unwrap();
+    ok(&forest(&args));
+    // An output inside a file: the file is named as a file, not as missing.
+    std::fs::write(d.join("plain"), "x").unwrap();
+    let inside = d.join("plain/x.atlas");
+    let mut args = vec!["bake", &bush, "-o", inside.to_str().unwrap()];
+    args.extend(small);
+    refused(&args, d, &["plain is a file, not a folder"]);
+}
+
+#[test]
+fn species_are_checked_alike_by_scene_info_and_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    let good = d.join("bush.atlas");
+    bake_small("bush", &good, 32, 4);
+    // A hybrid-switch record out of range in each field it has, and a bounding sphere beyond
+    // any model's coordinates.
+    let cases: [(&str, serde_json::Value, &str); 6] = [
+        ("crown_radii", serde_json::json!(-2.0), "crown_radii = -2"),
+        ("viewport", serde_json::json!([0, 0]), "viewport = [0, 0]"),
+        ("fov_y_deg", serde_json::json!(7200.0), "fov_y_deg = 7200"),
+        ("epsilon", serde_json::json!(0.0), "epsilon = 0"),
+        ("cameras", serde_json::json!(0), "cameras = 0"),
+        (
+            "finest_quad_pixels",
+            serde_json::json!(1e9),
+            "finest_quad_pixels",
+        ),
+    ];
+    for (i, (field, value, cause)) in cases.into_iter().enumerate() {
+        let bad = d.join(format!("bad{i}.atlas"));
+        edited_atlas(&good, &bad, |m| {
+            m["hybrid_switch"] = serde_json::json!({
+                "finest_quad_pixels": 1.5, "crown_radii": 6.0, "viewport": [320, 240],
+                "fov_y_deg": 60.0, "epsilon": 16.0, "cameras": 4
+            });
+            m["hybrid_switch"][field] = value.clone();
+        });
+        let b = bad.display().to_string();
+        refused(&["info", &b], d, &["hybrid_switch.", cause]);
+        refused(
+            &["scene", "--trees", "5", "--species", &b, "-o", &p("x.json")],
+            d,
+            &["hybrid_switch.", cause],
+        );
+    }
+    let huge = d.join("huge.atlas");
+    edited_atlas(&good, &huge, |m| {
+        m["bounding_sphere"]["radius"] = serde_json::json!(1e38)
+    });
+    let h = huge.display().to_string();
+    refused(&["info", &h], d, &["bounding sphere", "beyond"]);
+    // scene loads every atlas whole, as render does: a broken colour file is refused there.
+    let broken = d.join("broken.atlas");
+    edited_atlas(&good, &broken, |_| {});
+    let colour = std::fs::read_dir(&broken)
+        .unwrap()
+        .flatten()
+        .find(|e| e.file_name().to_string_lossy().starts_with("colour."))
+        .unwrap()
+        .path();
+    std::fs::write(&colour, b"not an image").unwrap();
+    let b = broken.display().to_string();
+    refused(
+        &[
+            "scene",
+            "--trees",
+            "5",
+            "--model-sizes",
+            "--species",
+            &b,
+            "-o",
+            &p("x.json"),
+        ],
+        d,
+        &["broken.atlas"],
+    );
+    // Instances scaled past the physical range, in a forest written by hand.
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "3",
+        "--species",
+        &good.display().to_string(),
+        "-o",
+        &p("f.json"),
+    ]));
+    let mut f: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("f.json")).unwrap()).unwrap();
+    f["instances"][1]["scale"] = serde_json::json!(1e30);
+    std::fs::write(d.join("big.json"), serde_json::to_vec(&f).unwrap()).unwrap();
+    refused(
+        &[
+            "render",
+            &p("big.json"),
+            "-o",
+            &p("x.png"),
+            "--size",
+            "32x24",
+        ],
+        d,
+        &["instance 1", "scale 1e30", "outside"],
+    );
+    // A scale within range, but a tree as big as the forest's bound allows no more.
+    f["instances"][1]["scale"] = serde_json::json!(9000.0);
+    f["instances"][1]["position"] = serde_json::json!([9.99e6, 0.0, 0.0]);
+    std::fs::write(d.join("far.json"), serde_json::to_vec(&f).unwrap()).unwrap();
+    refused(
+        &[
+            "render",
+            &p("far.json"),
+            "-o",
+            &p("x.png"),
+            "--size",
+            "32x24",
+        ],
+        d,
+        &["instance 1", "beyond the ±1e7 m"],
+    );
+}
+
+#[test]
+fn models_must_be_their_atlases_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    bake_small("bush", &d.join("bush.atlas"), 32, 4);
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "3",
+        "--model-sizes",
+        "--species",
+        &p("bush.atlas"),
+        "-o",
+        &p("f.json"),
+    ]));
+    let render = |models: &str, extra: &[&str]| {
+        let mut a = vec![
+            "render".to_string(),
+            p("f.json"),
+            "-o".into(),
+            p("g.png"),
+            "--size".into(),
+            "32x24".into(),
+            "--view".into(),
+            "birds-eye".into(),
+            "--method".into(),
+            "geometry".into(),
+            "--models".into(),
+            models.to_string(),
+        ];
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let args = render(&model("aspen"), &[]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(
+        &args,
+        d,
+        &[
+            "aspen.obj",
+            "not the file its atlas was baked from",
+            "bush.obj",
+            "--allow-other-models",
+        ],
+    );
+    let args = render(&model("aspen"), &["--allow-other-models"]);
+    let out = forest(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    ok(&out);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("note: model"));
+    let args = render(&model("bush"), &[]);
+    ok(&forest(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+    ));
+}
+
+#[test]
+fn cameras_and_numbers_are_named_for_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    bake_small("bush", &d.join("bush.atlas"), 32, 4);
+    ok(&forest(&[
+        "scene",
+        "--trees",
+        "3",
+        "--species",
+        &p("bush.atlas"),
+        "-o",
+        &p("f.json"),
+    ]));
+    let render = |eye: &str| {
+        vec![
+            "render".to_string(),
+            p("f.json"),
+            "-o".into(),
+            p("x.png"),
+            "--size".into(),
+            "32x24".into(),
+            format!("--eye={eye}"),
+            "--target".into(),
+            "0,1,0".into(),
+        ]
+    };
+    let a = render("1e38,2,3");
+    refused(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        d,
+        &["eye", "beyond ±1e8 m"],
+    );
+    let a = render("nan,2,3");
+    refused(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        d,
+        &["NaN is not a finite number"],
+    );
+    let a = render("1,2");
+    refused(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        d,
+        &["expected three numbers", "got 2"],
+    );
+    let bush = model("bush");
+    refused(
+        &["bake", &bush, "-o", &p("n.atlas"), "--resolution", "-64"],
+        d,
+        &["'-64'", "--resolution"],
+    );
+    refused(
+        &[
+            "scene",
+            "--seed",
+            "-1",
+            "--species",
+            &p("bush.atlas"),
+            "-o",
+            &p("s.json"),
+        ],
+        d,
+        &["'-1'", "--seed"],
+    );
+}
