@@ -321,4 +321,29 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         d,
         &["'-1'", "--seed"],
     );
+    // Options whose values may start with a hyphen reach their own check.
+    let f = p("f.json");
+    for (option, value, cause) in [
+        ("--near", "-3", "a distance of 0 metres or more"),
+        ("--lod-distances", "-3,4,5", "must be positive"),
+    ] {
+        refused(
+            &[
+                "render",
+                &f,
+                "-o",
+                &p("x.png"),
+                "--view",
+                "inside",
+                "--method",
+                "lods",
+                "--models",
+                &bush,
+                option,
+                value,
+            ],
+            d,
+            &[cause],
+        );
+    }
 }

@@ -171,7 +171,7 @@ pub struct MethodArgs {
     #[arg(long)]
     pub no_contrast: bool,
     /// LODs: distances (m, per unit tree scale) where LOD 1, LOD 2 and billboards start.
-    #[arg(long, value_delimiter = ',', default_values_t = Lods::default().distances)]
+    #[arg(long, value_delimiter = ',', default_values_t = Lods::default().distances, allow_hyphen_values = true)]
     pub lod_distances: Vec<f32>,
     /// Quad stream: how a tree's 1–3 aspects combine: over (alpha-blended over each other,
     /// the paper's blend: coverage is their union), dither (each pixel shows one aspect,
@@ -199,7 +199,7 @@ pub struct MethodArgs {
     /// triangles, i.e. where its finest quads project wider than the crossover its bake
     /// measured (1.5 px for atlases baked without a GPU; it follows each tree's size and the
     /// view, not ε).
-    #[arg(long, default_value = "auto", value_parser = parse_near)]
+    #[arg(long, default_value = "auto", value_parser = parse_near, allow_hyphen_values = true)]
     pub near: Near,
     /// Hybrid: width of the transition band, as a fraction of the switch distance (a tree
     /// in it is drawn by both forms through complementary screen-door masks).

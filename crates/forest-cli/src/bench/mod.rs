@@ -247,9 +247,10 @@ impl Bench {
         Ok(self.prepared.get_or_init(|| p))
     }
 
-    /// A generated forest of the bench species: `trees` over a `side`-metre square.
+    /// A generated forest of the bench species: `trees` over a `side`-metre square, checked
+    /// with its species as `render` checks a forest file.
     pub fn forest(&self, trees: u32, side: f32, seed: u64) -> Result<Forest> {
-        generate(&GenerateParams {
+        let forest = generate(&GenerateParams {
             trees,
             species: self
                 .species_paths
@@ -261,7 +262,10 @@ impl Bench {
             seed,
             ..GenerateParams::default()
         })
-        .map_err(anyhow::Error::msg)
+        .map_err(anyhow::Error::msg)?;
+        let manifests: Vec<_> = self.species.iter().map(|s| &s.atlas.manifest).collect();
+        forest_format::species::check(&forest, &manifests, Path::new("the bench's forest"))?;
+        Ok(forest)
     }
 
     /// Every method's renderer for `forest` (the geometry ones when `geometry`).
