@@ -6,6 +6,26 @@
 //!            ─► number nodes level by level ─► Atlas::from_layers ─► Atlas::save (atomic)
 //! ```
 //! Everything is deterministic: the same input gives a byte-identical atlas.
+//!
+//! Baking a model (OBJ or glTF) into an atlas folder, as `forest bake` does:
+//!
+//! ```no_run
+//! use forest_format::BakeParams;
+//!
+//! let params = BakeParams { resolution: 128, ..BakeParams::default() };
+//! let out = forest_bake::bake_file(
+//!     std::path::Path::new("tree.glb"),
+//!     &params,
+//!     &|done, total| eprintln!("{done}/{total} rows"),
+//! )?;
+//! for note in &out.notes {
+//!     eprintln!("note: {note}");
+//! }
+//! out.atlas.save(std::path::Path::new("tree.atlas"))?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![deny(missing_docs)]
 
 pub mod contact_sheet;
 pub mod cutout;

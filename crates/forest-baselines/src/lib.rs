@@ -8,6 +8,42 @@
 //! - [`methods`]: every method behind one run-time switch.
 //!
 //! The paper's method itself lives in `forest-render`, which depends on nothing here.
+//!
+//! The supersampled reference of a forest, drawn from its species' own models (`no_run`: it
+//! needs a GPU adapter, lavapipe will do, and the files):
+//!
+//! ```no_run
+//! use forest_baselines::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
+//! use forest_format::forest::Forest;
+//! use forest_render::{Camera, GpuContext, RendererOptions, SpeciesData};
+//!
+//! let ctx = GpuContext::headless()?;
+//! let forest = Forest::load("f.forest".as_ref())?;
+//! let oak = SpeciesData::load("oak.atlas".as_ref())?;
+//! let mesh = forest_bake::Mesh::load("oak.obj".as_ref())?;
+//! let prepared = PreparedGeometry::new(&[GeometrySpecies::new(mesh, &oak.atlas.manifest)]);
+//! let (w, h) = (4 * 400, 4 * 300);
+//! let opts = RendererOptions { viewport: (w, h), ..Default::default() };
+//! let mut geometry = GeometryRenderer::with_targets(&ctx, &prepared, &forest, &opts)?;
+//! geometry.set_method(&ctx, MeshMethod::Reference)?;
+//! let camera = Camera {
+//!     eye: glam::Vec3::new(0.0, 1.7, -30.0),
+//!     target: glam::Vec3::new(0.0, 3.0, 0.0),
+//!     fov_y_deg: 60.0,
+//!     near: 0.1,
+//!     far: 5000.0,
+//!     viewport: (w, h),
+//!     epsilon: 16.0,
+//! };
+//! let target = forest_render::target::Target::new(&ctx, w, h);
+//! geometry.render_frame(&ctx, &camera, &target)?;
+//! // Box-filter the 4×4 samples down to 400×300 for the reference image.
+//! let image = image::imageops::thumbnail(&target.read(&ctx), 400, 300);
+//! image.save("reference.png")?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![deny(missing_docs)]
 
 pub mod geometry;
 pub mod gpu_types;

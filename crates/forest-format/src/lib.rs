@@ -11,6 +11,32 @@
 //! - [`forest`], [`generate`], [`terrain`]: forest files, the clumped-forest generator and the
 //!   height field the trees stand on;
 //! - [`camera_path`]: recorded camera paths for the viewer.
+//!
+//! A forest made and checked without a GPU or any file (the species are atlas names; `forest
+//! scene` writes the same with `Forest::save`), lit at eight in the morning:
+//!
+//! ```
+//! use forest_format::generate::{GenerateParams, generate};
+//! use forest_format::shading::Lighting;
+//!
+//! let forest = generate(&GenerateParams {
+//!     trees: 200,
+//!     species: vec!["oak.atlas".into(), "pine.atlas".into()],
+//!     area_per_tree: 40.0,
+//!     ..GenerateParams::default()
+//! })?;
+//! assert_eq!(forest.instances.len(), 200);
+//! forest.check(std::path::Path::new("example.forest"))?;
+//! // The one shading model: a leaf facing the morning sun is brighter than one facing away.
+//! let light = Lighting::at_hour(8.0, 65.0);
+//! let leaf = glam::Vec3::new(0.2, 0.4, 0.1);
+//! let lit = light.shade(leaf, light.sun_dir, 1.0, 1.0, 0.0);
+//! let away = light.shade(leaf, -light.sun_dir, 1.0, 1.0, 0.0);
+//! assert!(lit.length() > away.length());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![deny(missing_docs)]
 
 pub mod atlas;
 pub mod atomic;

@@ -12,6 +12,14 @@
 //!
 //! Loaders that read several files (an OBJ with its material library and texture; an atlas
 //! folder) take one input split into files at [`FILE_SEPARATOR`].
+//!
+//! ```
+//! let target = forest_fuzz::targets::target("forest_json").expect("a target of that name");
+//! // Errors are expected; a panic or an allocation past the bound would be the failure.
+//! assert!(!(target.run)(b"{\"species\": 7}"));
+//! ```
+
+#![deny(missing_docs)]
 
 pub mod alloc;
 pub mod mutate;

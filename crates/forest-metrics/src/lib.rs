@@ -13,6 +13,20 @@
 //! Colour is compared as stored (the project's renders over a transparent background are
 //! premultiplied), except where a pixel's alpha is 0: no compositing shows that colour, and
 //! images with straight alpha leave anything there, so it is taken as black in both images.
+//!
+//! ```
+//! use image::{Rgba, RgbaImage};
+//!
+//! let reference = RgbaImage::from_pixel(64, 48, Rgba([40, 90, 30, 255]));
+//! let mut test = reference.clone();
+//! test.put_pixel(10, 10, Rgba([200, 90, 30, 255]));
+//! let m = forest_metrics::compare(&reference, &test)?;
+//! assert!(m.flip_mean > 0.0 && m.flip_mean < 0.01);
+//! assert_eq!(forest_metrics::compare(&reference, &reference)?.flip_mean, 0.0);
+//! # Ok::<(), forest_metrics::MetricsError>(())
+//! ```
+
+#![deny(missing_docs)]
 
 use image::RgbaImage;
 

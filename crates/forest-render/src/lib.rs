@@ -4,10 +4,46 @@
 //! SpeciesData::load (atlases) + Forest ─► GpuScene (uploaded once) ─► QuadStream
 //! per frame: set_camera (the one upload) ─► encode: cull ─► refine × (l − 1) ─► draw
 //! ```
-//! [`reference`] computes passes 1 and 2 on the CPU over the same tables; tests require the
+//! [`reference`](mod@reference) computes passes 1 and 2 on the CPU over the same tables; tests require the
 //! GPU's stream to equal it quad for quad. The rival methods (full geometry, stochastic
 //! simplification, discrete LODs + billboards, the hybrid) live in the `forest-baselines`
 //! crate, which builds on this one.
+//!
+//! One frame of a forest, headless (`no_run`: it needs a GPU adapter, lavapipe will do, and a
+//! forest with its atlases; `examples/embed` draws into a host's own pass instead):
+//!
+//! ```no_run
+//! use forest_format::forest::Forest;
+//! use forest_render::{Camera, GpuContext, GpuScene, QuadStream, RendererOptions, SpeciesData};
+//! use glam::Vec3;
+//!
+//! let ctx = GpuContext::headless()?;
+//! let forest = Forest::load("f.forest".as_ref())?;
+//! let species = forest
+//!     .species
+//!     .iter()
+//!     .map(|s| SpeciesData::load(s.as_ref()))
+//!     .collect::<Result<Vec<_>, _>>()?;
+//! let scene = GpuScene::new(&ctx, &species, &forest)?;
+//! let opts = RendererOptions { viewport: (800, 600), ..Default::default() };
+//! let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
+//! let target = forest_render::target::Target::new(&ctx, 800, 600);
+//! let camera = Camera {
+//!     eye: Vec3::new(0.0, 1.7, -30.0),
+//!     target: Vec3::new(0.0, 3.0, 0.0),
+//!     fov_y_deg: 60.0,
+//!     near: 0.1,
+//!     far: 5000.0,
+//!     viewport: (800, 600),
+//!     epsilon: 16.0,
+//! };
+//! let stats = stream.render_fitted(&ctx, &camera, &target)?;
+//! println!("{} quads", stats.quads);
+//! target.read(&ctx).save("forest.png")?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![deny(missing_docs)]
 
 pub mod camera;
 pub mod capacity;

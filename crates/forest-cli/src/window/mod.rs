@@ -3,8 +3,8 @@
 //! method switch, debug views).
 //!
 //! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
-//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–6 pick a method, [ and
-//! ] halve and double ε, V cycles the debug views, H hides the HUD, F12 saves a screenshot, R
+//! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–6 pick a method, `[` and
+//! `]` halve and double ε, V cycles the debug views, H hides the HUD, F12 saves a screenshot, R
 //! starts and stops recording a camera path, P plays the `--path` back, Esc quits.
 //!
 //! On stdout the viewer says when its first frame is on screen and where each screenshot went

@@ -8,7 +8,7 @@
 //! - `alpha.png`: the coverage (alpha) mosaic, 8-bit, lossless;
 //! - `surface.png`: what the run-time light needs besides the albedo, as RGBA8, linear and
 //!   premultiplied by coverage like the colour: the octahedral code of the normal facing the
-//!   sampling ray (object space, [`crate::shading::oct_encode`]) in R and G, the sky
+//!   sampling ray (object space, [`crate::shading::hemi_oct_encode`]) in R and G, the sky
 //!   visibility in B and the translucency in A. The same tiling at [`SURFACE_SCALE`] times
 //!   fewer pixels a side, straight (each texel its block's coverage-weighted mean), lossless;
 //! - `opacity.png`: the opacity volume for self-shadowing under the run-time sun (see
