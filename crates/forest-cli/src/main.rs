@@ -41,28 +41,51 @@ pub(crate) fn gpu_context() -> Result<forest_render::GpuContext, forest_render::
 
 /// GPU forest rendering with dynamic quad streams.
 #[derive(Parser)]
-#[command(name = "forest", version, about, long_about = None)]
+#[command(
+    name = "forest",
+    version,
+    about,
+    long_about = None,
+    after_help = "Your own tree in three commands:\n  forest bake my-tree.glb -o my-tree.atlas\n  forest scene --trees 5000 --species my-tree.atlas -o my.forest --terrain hills\n  forest view my.forest --models my-tree.glb\n\nEach subcommand's --help lists its options with examples."
+)]
 enum Cli {
     /// Bake a tree model (OBJ + MTL + textures, or glTF 2.0) into a quad-stream atlas.
     ///
     /// Baking again into an existing atlas folder replaces it whole; a folder holding any
     /// file a bake does not write is refused, so nothing of yours in it is lost.
+    #[command(
+        after_help = "Examples:\n  forest bake assets/trees/oak/oak.obj -o oak.atlas\n  forest bake tree.glb -o tree.atlas --resolution 256 --contact-sheet tree.png --json"
+    )]
     Bake(bake::BakeArgs),
     /// Check an atlas and print its summary.
+    #[command(after_help = "Example:\n  forest info oak.atlas --json")]
     Info(bake::InfoArgs),
     /// Generate a forest of clumped trees with presorted orders.
+    #[command(
+        after_help = "Examples:\n  forest scene --trees 100000 --species oak.atlas,pine.atlas -o f.forest --terrain hills\n  forest scene --trees 200 --species oak.atlas --model-sizes -o small.json"
+    )]
     Scene(scene::SceneArgs),
     /// Render views of a forest to PNG, headless.
+    #[command(
+        after_help = "Examples:\n  forest render f.forest -o shot.png --view inside --view birds-eye --time 8\n  forest render f.forest -o ref.png --view inside --method reference --models oak.obj,pine.obj --supersample 4"
+    )]
     Render(render::RenderArgs),
     /// Run benchmark suites: CSV, charts (PNG + SVG) and, for `all`, REPORT.md.
+    #[command(
+        after_help = "Examples:\n  forest bench table1 --species oak.atlas,pine.atlas\n  forest bench all --species oak.atlas,pine.atlas --models oak.obj,pine.obj --quick --out results"
+    )]
     Bench(bench::BenchArgs),
     /// Accuracy of an image against a reference: mean FLIP, SSIM, PSNR, coverage IoU.
     ///
     /// Colour is compared as stored (renders over a transparent background are
     /// premultiplied), except under alpha 0, where it is taken as black in both images: no
     /// compositing shows it, and straight-alpha images leave anything there.
+    #[command(after_help = "Example:\n  forest compare ref.png shot.png --flip-map diff.png")]
     Compare(compare::CompareArgs),
     /// Walkthrough viewer (a window), or a camera path rendered headless to numbered PNGs.
+    #[command(
+        after_help = "Examples:\n  forest view                       (the bundled demo forest)\n  forest view f.forest --models oak.obj,pine.obj --method hybrid\n  forest view f.forest --path walk.json --frames out/frames"
+    )]
     View(view::ViewArgs),
 }
 

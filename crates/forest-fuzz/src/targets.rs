@@ -19,7 +19,7 @@ pub struct Target {
     pub run: fn(&[u8]) -> bool,
     /// Allocation bound (bytes live at once, on top of what was live before).
     pub bound: usize,
-    /// What the target covers, for the README's table.
+    /// What the target covers, for the fuzzing table in docs/robustness.md.
     pub covers: &'static str,
 }
 
