@@ -1,1 +1,3 @@
 //! Nothing here: the GPU tests live in `tests/`.
+
+#![deny(missing_docs)]
