@@ -314,7 +314,8 @@ fn node_matrix(node: &gltf::Node) -> Result<Mat4, String> {
             }
             if m.row(3) != glam::Vec4::W {
                 return Err(format!(
-                    "{at}: its matrix's last row is {:?}, not (0, 0, 0, 1) (glTF matrices                      are affine)",
+                    "{at}: its matrix's last row is {:?}, not (0, 0, 0, 1) (glTF matrices \
+                     are affine)",
                     m.row(3).to_array()
                 ));
             }
@@ -341,7 +342,8 @@ fn node_matrix(node: &gltf::Node) -> Result<Mat4, String> {
             let len = q.length();
             if (len - 1.0).abs() > QUATERNION_TOLERANCE {
                 return Err(format!(
-                    "{at}: its rotation {rotation:?} is not a unit quaternion (length {len};                      glTF requires 1)"
+                    "{at}: its rotation {rotation:?} is not a unit quaternion (length {len}; \
+                     glTF requires 1)"
                 ));
             }
             if scale.contains(&0.0) {
@@ -726,11 +728,12 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     let morphs = doc
         .meshes()
         .flat_map(|m| m.primitives())
-        .filter(|p| p.morph_targets().len() > 0);
-    if morphs.clone().count() > 0 {
+        .filter(|p| p.morph_targets().len() > 0)
+        .count();
+    if morphs > 0 {
         notes.push(format!(
             "morph targets of {} ignored: the base shape is baked",
-            count(morphs.count(), "primitive")
+            count(morphs, "primitive")
         ));
     }
     if coloured > 0 {
