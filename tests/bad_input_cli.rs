@@ -3,11 +3,10 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Output;
 
 mod cli;
 
-use cli::{bake_small, forest, model, ok};
+use cli::{bake_small, forest, model, ok, one_line_error};
 
 /// Every file under `dir` and its bytes.
 fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
@@ -29,14 +28,7 @@ fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 /// The command fails with one line holding every one of `causes`, and leaves `dir` as it was.
 fn refused(args: &[&str], dir: &Path, causes: &[&str]) -> String {
     let before = snapshot(dir);
-    let out: Output = forest(args);
-    assert!(!out.status.success(), "{args:?} succeeded");
-    let e = String::from_utf8_lossy(&out.stderr).into_owned();
-    let lines: Vec<&str> = e
-        .lines()
-        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
-        .collect();
-    assert_eq!(lines.len(), 1, "{args:?}: one line: {e}");
+    let e = one_line_error(&forest(args));
     for c in causes {
         assert!(e.contains(c), "{args:?}: expected {c:?} in: {e}");
     }
@@ -54,6 +46,34 @@ fn edited_atlas(from: &Path, to: &Path, edit: impl Fn(&mut serde_json::Value)) {
     let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&m).unwrap()).unwrap();
     edit(&mut v);
     std::fs::write(&m, serde_json::to_vec_pretty(&v).unwrap()).unwrap();
+}
+
+/// A small bush atlas `d/bush.atlas` and a forest of 3 of its trees, `d/f.json` (at the
+/// model's own size with `model_sizes`); returns the atlas's and the forest's paths.
+fn bush_forest(d: &Path, model_sizes: bool) -> (PathBuf, String) {
+    let atlas = d.join("bush.atlas");
+    bake_small("bush", &atlas, 32, 4);
+    let forest_file = d.join("f.json").display().to_string();
+    let atlas_arg = atlas.display().to_string();
+    let mut args = vec![
+        "scene",
+        "--trees",
+        "3",
+        "--species",
+        &atlas_arg,
+        "-o",
+        &forest_file,
+    ];
+    if model_sizes {
+        args.push("--model-sizes");
+    }
+    ok(&forest(&args));
+    (atlas, forest_file)
+}
+
+/// Borrowed views of owned arguments.
+fn strs(args: &[String]) -> Vec<&str> {
+    args.iter().map(String::as_str).collect()
 }
 
 #[test]
@@ -92,8 +112,7 @@ fn species_are_checked_alike_by_scene_info_and_render() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let p = |n: &str| d.join(n).display().to_string();
-    let good = d.join("bush.atlas");
-    bake_small("bush", &good, 32, 4);
+    let (good, forest_file) = bush_forest(d, false);
     // A hybrid-switch record out of range in each field it has, and a bounding sphere beyond
     // any model's coordinates.
     let cases: [(&str, serde_json::Value, &str); 6] = [
@@ -157,17 +176,8 @@ fn species_are_checked_alike_by_scene_info_and_render() {
         &["broken.atlas"],
     );
     // Instances scaled past the physical range, in a forest written by hand.
-    ok(&forest(&[
-        "scene",
-        "--trees",
-        "3",
-        "--species",
-        &good.display().to_string(),
-        "-o",
-        &p("f.json"),
-    ]));
     let mut f: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(d.join("f.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(&forest_file).unwrap()).unwrap();
     f["instances"][1]["scale"] = serde_json::json!(1e30);
     std::fs::write(d.join("big.json"), serde_json::to_vec(&f).unwrap()).unwrap();
     refused(
@@ -205,21 +215,11 @@ fn models_must_be_their_atlases_own() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let p = |n: &str| d.join(n).display().to_string();
-    bake_small("bush", &d.join("bush.atlas"), 32, 4);
-    ok(&forest(&[
-        "scene",
-        "--trees",
-        "3",
-        "--model-sizes",
-        "--species",
-        &p("bush.atlas"),
-        "-o",
-        &p("f.json"),
-    ]));
+    let (_, forest_file) = bush_forest(d, true);
     let render = |models: &str, extra: &[&str]| {
         let mut a = vec![
             "render".to_string(),
-            p("f.json"),
+            forest_file.clone(),
             "-o".into(),
             p("g.png"),
             "--size".into(),
@@ -235,9 +235,8 @@ fn models_must_be_their_atlases_own() {
         a
     };
     let args = render(&model("aspen"), &[]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     refused(
-        &args,
+        &strs(&args),
         d,
         &[
             "aspen.obj",
@@ -247,13 +246,11 @@ fn models_must_be_their_atlases_own() {
         ],
     );
     let args = render(&model("aspen"), &["--allow-other-models"]);
-    let out = forest(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let out = forest(&strs(&args));
     ok(&out);
     assert!(String::from_utf8_lossy(&out.stderr).contains("note: model"));
     let args = render(&model("bush"), &[]);
-    ok(&forest(
-        &args.iter().map(String::as_str).collect::<Vec<_>>(),
-    ));
+    ok(&forest(&strs(&args)));
 }
 
 #[test]
@@ -261,20 +258,11 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let p = |n: &str| d.join(n).display().to_string();
-    bake_small("bush", &d.join("bush.atlas"), 32, 4);
-    ok(&forest(&[
-        "scene",
-        "--trees",
-        "3",
-        "--species",
-        &p("bush.atlas"),
-        "-o",
-        &p("f.json"),
-    ]));
+    let (_, forest_file) = bush_forest(d, false);
     let render = |eye: &str| {
         vec![
             "render".to_string(),
-            p("f.json"),
+            forest_file.clone(),
             "-o".into(),
             p("x.png"),
             "--size".into(),
@@ -285,23 +273,11 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         ]
     };
     let a = render("1e38,2,3");
-    refused(
-        &a.iter().map(String::as_str).collect::<Vec<_>>(),
-        d,
-        &["eye", "beyond ±1e8 m"],
-    );
+    refused(&strs(&a), d, &["eye", "beyond ±1e8 m"]);
     let a = render("nan,2,3");
-    refused(
-        &a.iter().map(String::as_str).collect::<Vec<_>>(),
-        d,
-        &["NaN is not a finite number"],
-    );
+    refused(&strs(&a), d, &["NaN is not a finite number"]);
     let a = render("1,2");
-    refused(
-        &a.iter().map(String::as_str).collect::<Vec<_>>(),
-        d,
-        &["expected three numbers", "got 2"],
-    );
+    refused(&strs(&a), d, &["expected three numbers", "got 2"]);
     let bush = model("bush");
     refused(
         &["bake", &bush, "-o", &p("n.atlas"), "--resolution", "-64"],
@@ -322,7 +298,7 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         &["'-1'", "--seed"],
     );
     // Options whose values may start with a hyphen reach their own check.
-    let f = p("f.json");
+    let f = &forest_file;
     for (option, value, cause) in [
         ("--near", "-3", "a distance of 0 metres or more"),
         ("--lod-distances", "-3,4,5", "must be positive"),
@@ -330,7 +306,7 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         refused(
             &[
                 "render",
-                &f,
+                f,
                 "-o",
                 &p("x.png"),
                 "--view",

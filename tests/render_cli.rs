@@ -1,26 +1,10 @@
 //! End-to-end: `forest bake` → `forest scene` → `forest render`, and their bad inputs.
 
 use std::path::Path;
-use std::process::Output;
 
 mod cli;
 
-use cli::{bake_small, forest, model, ok};
-
-fn err(out: &Output) -> String {
-    assert!(
-        !out.status.success(),
-        "succeeded: {}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    let e = String::from_utf8_lossy(&out.stderr).into_owned();
-    let lines: Vec<&str> = e
-        .lines()
-        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
-        .collect();
-    assert_eq!(lines.len(), 1, "one line: {e}");
-    e
-}
+use cli::{bake_small, forest, model, ok, one_line_error as err};
 
 #[test]
 fn bake_scene_render_end_to_end() {

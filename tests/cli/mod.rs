@@ -49,3 +49,20 @@ pub fn bake_small(species: &str, atlas: &Path, resolution: u32, directions: u32)
         "--no-hybrid-switch",
     ]));
 }
+
+/// The stderr of a run that must fail, after checking that it did and that it said one line
+/// (beside the Vulkan loader's complaints about `XDG_RUNTIME_DIR`, which are not ours).
+pub fn one_line_error(out: &Output) -> String {
+    assert!(
+        !out.status.success(),
+        "succeeded: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let e = String::from_utf8_lossy(&out.stderr).into_owned();
+    let lines: Vec<&str> = e
+        .lines()
+        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
+        .collect();
+    assert_eq!(lines.len(), 1, "one line: {e}");
+    e
+}

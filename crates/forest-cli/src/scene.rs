@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use forest_format::AtlasManifest;
 use forest_format::generate::{GenerateParams, GroundRules, generate, species_height};
 use forest_format::terrain::{Terrain, TerrainParams};
 
@@ -100,8 +101,12 @@ fn parse_height(s: &str) -> Result<(String, f32, f32), String> {
 /// Scale ranges, one per species (empty: every model at its own size, ×0.8–1.25).
 type ScaleRanges = Vec<(f32, f32)>;
 
-/// Each species' scale range, and a line per species saying what was chosen.
-fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
+/// Each species' scale range, and a line per species saying what was chosen; `manifests` are
+/// the species' atlases' manifests, in `args.species` order.
+fn species_scales(
+    args: &SceneArgs,
+    manifests: &[AtlasManifest],
+) -> Result<(ScaleRanges, Vec<String>)> {
     let names: Vec<String> = args
         .species
         .iter()
@@ -126,7 +131,7 @@ fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
     }
     let mut scales = Vec::new();
     let mut lines = Vec::new();
-    for (path, name) in args.species.iter().zip(&names) {
+    for (manifest, name) in manifests.iter().zip(&names) {
         let given = args
             .heights
             .iter()
@@ -140,7 +145,7 @@ fn species_scales(args: &SceneArgs) -> Result<(ScaleRanges, Vec<String>)> {
             ));
             continue;
         };
-        let top = forest_format::atlas::Atlas::load_manifest(path)?.model_top();
+        let top = manifest.model_top();
         scales.push((lo / top, hi / top));
         lines.push(format!(
             "  {name}: {lo}-{hi} m tall (model {top:.2} m: scale {:.2}-{:.2})",
@@ -236,7 +241,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         manifests.push(atlas.manifest);
         species.push(stored_path(s, &args.output)?);
     }
-    let (species_scale, size_lines) = species_scales(args)?;
+    let (species_scale, size_lines) = species_scales(args, &manifests)?;
     // Millions of trees take seconds to place and sort: say so while it runs.
     let spinner = indicatif::ProgressBar::new_spinner();
     if args.trees >= 100_000 {

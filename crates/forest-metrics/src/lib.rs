@@ -59,19 +59,24 @@ pub struct Metrics {
     pub coverage_iou: Option<f64>,
 }
 
-/// The image as compared: RGB black wherever alpha is 0 (see the module documentation).
-fn visible(img: &RgbaImage) -> RgbaImage {
+/// The image as compared: RGB black wherever alpha is 0 (see the module documentation);
+/// borrowed when no colour hides under alpha 0 (premultiplied renders), copied otherwise.
+fn visible(img: &RgbaImage) -> std::borrow::Cow<'_, RgbaImage> {
+    let hidden = |p: &image::Rgba<u8>| p[3] == 0 && p.0 != [0, 0, 0, 0];
+    if !img.pixels().any(hidden) {
+        return std::borrow::Cow::Borrowed(img);
+    }
     let mut out = img.clone();
     for p in out.pixels_mut() {
         if p[3] == 0 {
             *p = image::Rgba([0, 0, 0, 0]);
         }
     }
-    out
+    std::borrow::Cow::Owned(out)
 }
 
 fn rgb(img: &RgbaImage) -> image::RgbImage {
-    image::DynamicImage::ImageRgba8(visible(img)).to_rgb8()
+    image::DynamicImage::ImageRgba8(visible(img).into_owned()).to_rgb8()
 }
 
 /// Mean FLIP and the per-pixel error map (magma colours).
@@ -110,7 +115,7 @@ pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Result<f64, MetricsError
 /// Mean SSIM of luma.
 pub fn ssim(reference: &RgbaImage, test: &RgbaImage) -> Result<f64, MetricsError> {
     check(reference, test)?;
-    let luma = |i: &RgbaImage| image::DynamicImage::ImageRgba8(visible(i)).to_luma8();
+    let luma = |i: &RgbaImage| image::DynamicImage::ImageRgba8(visible(i).into_owned()).to_luma8();
     let s = image_compare::gray_similarity_structure(
         &image_compare::Algorithm::MSSIMSimple,
         &luma(reference),
