@@ -42,45 +42,95 @@
 // Every species' opacity volume, stacked (forest_render::opacity), read through colour_sampler.
 @group(0) @binding(14) var opacity: texture_3d<f32>;
 
-struct VsOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) uv: vec2<f32>,
+// Everything quad_vertex works out for one corner of a quad; each pipeline passes on what
+// its fragment stage reads (QuadOut, CompositeOut). The two are kept apart because a CPU
+// rasteriser sets up and interpolates every output of every triangle: the composite's 16
+// extra floats on plain quads cost 17 % of the draw time.
+struct QuadVertex {
+    clip: vec4<f32>,
+    uv: vec2<f32>,
     // The quad's first layer (x), level (y), sampling direction (z) and the layers it
-    // composites, front first from x (w: a far tree's slabs; else 1). One location for four
-    // (the inter-stage variables are few).
-    @location(1) @interpolate(flat) ids: vec4<u32>,
-    @location(2) @interpolate(flat) alpha: f32,
+    // composites, front first from x (w: a far tree's slabs; else 1).
+    ids: vec4<u32>,
+    alpha: f32,
     // Share [lo, hi) of the blend (x, y), the instance (z) and the tree's quad share (w, see
     // quad_share: below WEIGHT_ONE in the hybrid's transition band).
-    @location(3) @interpolate(flat) share: vec4<u32>,
+    share: vec4<u32>,
     // A composited quad's parallax: the uv shift per unit of stack depth behind its plane,
     // along the view ray (0 for other quads).
-    @location(4) @interpolate(flat) parallax: vec2<f32>,
+    parallax: vec2<f32>,
     // Depths in the stack (0 front, 1 back) of the first three slabs' root planes (their
     // corners' mean), where their images are sampled (0.5, the quad's plane, for the others),
     // and in `w` the mip level a composited quad samples (one for the whole quad: the tree is
     // under ε pixels).
-    @location(5) @interpolate(flat) depths: vec4<f32>,
+    depths: vec4<f32>,
     // The quad's point (world, metres), for the haze.
-    @location(6) world: vec3<f32>,
+    world: vec3<f32>,
     // The sampling direction's frame turned into world space (the instance's rotation): the
     // axes the baked normal codes are relative to. Its third axis is right × up
     // (forest_format::slab::DirectionFrame), which rotations keep, so it is not passed: the
     // inter-stage variables are few (GLES 3.0 guarantees 15).
-    @location(7) @interpolate(flat) frame_right: vec3<f32>,
-    @location(8) @interpolate(flat) frame_up: vec3<f32>,
+    frame_right: vec3<f32>,
+    frame_up: vec3<f32>,
     // Transmittance towards the sun through the tree's own crown at the vertex (its opacity
-    // volume), interpolated over the quad.
-    @location(9) sun_vis: f32,
+    // volume): plain quads only.
+    sun_vis: f32,
     // For a composited quad, which marches per fragment: the points in object space on its
     // front slab's root plane and its second slab's, where the march starts (between them
     // by the slabs' shares of the pixel), the species, its bounding sphere, and the sun's
     // direction in object space with the species' opacity depth in w.
-    @location(10) obj_front: vec3<f32>,
-    @location(11) obj_back: vec3<f32>,
-    @location(12) @interpolate(flat) species: u32,
-    @location(13) @interpolate(flat) sphere: vec4<f32>,
-    @location(14) @interpolate(flat) sun_obj: vec4<f32>,
+    obj_front: vec3<f32>,
+    obj_back: vec3<f32>,
+    species: u32,
+    sphere: vec4<f32>,
+    sun_obj: vec4<f32>,
+}
+
+// A plain quad's inter-stage variables (QuadVertex's fields of the same names).
+struct QuadOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) ids: vec4<u32>,
+    @location(2) @interpolate(flat) alpha: f32,
+    @location(3) @interpolate(flat) share: vec4<u32>,
+    @location(4) world: vec3<f32>,
+    @location(5) @interpolate(flat) frame_right: vec3<f32>,
+    @location(6) @interpolate(flat) frame_up: vec3<f32>,
+    // Interpolated over the quad from its corners' marches.
+    @location(7) sun_vis: f32,
+}
+
+// A composited quad's inter-stage variables (QuadVertex's fields of the same names).
+struct CompositeOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) ids: vec4<u32>,
+    @location(2) @interpolate(flat) alpha: f32,
+    @location(3) @interpolate(flat) share: vec4<u32>,
+    @location(4) world: vec3<f32>,
+    @location(5) @interpolate(flat) frame_right: vec3<f32>,
+    @location(6) @interpolate(flat) frame_up: vec3<f32>,
+    @location(7) @interpolate(flat) parallax: vec2<f32>,
+    @location(8) @interpolate(flat) depths: vec4<f32>,
+    @location(9) obj_front: vec3<f32>,
+    @location(10) obj_back: vec3<f32>,
+    @location(11) @interpolate(flat) species: u32,
+    @location(12) @interpolate(flat) sphere: vec4<f32>,
+    @location(13) @interpolate(flat) sun_obj: vec4<f32>,
+}
+
+// What every quad's fragment needs besides its colour (see shade) and its lighting (see
+// lit_texel).
+struct Fragment {
+    clip: vec4<f32>,
+    uv: vec2<f32>,
+    ids: vec4<u32>,
+    alpha: f32,
+    share: vec4<u32>,
+    world: vec3<f32>,
+    frame_right: vec3<f32>,
+    frame_up: vec3<f32>,
+    sun_vis: f32,
 }
 
 // 1 inside a slab image, 0 outside (a shifted sample must not repeat the edge texels).
@@ -90,7 +140,7 @@ fn inside_image(uv: vec2<f32>) -> f32 {
 
 // Where slab k is sampled on a composited quad's plane (which lies at half the stack): at
 // its root plane's depth, shifted along the view ray; slabs after the third at the plane.
-fn slab_uv(in: VsOut, k: u32) -> vec2<f32> {
+fn slab_uv(in: CompositeOut, k: u32) -> vec2<f32> {
     var d = 0.5;
     if (k < 3u) { d = in.depths[k]; }
     return in.uv + in.parallax * (d - 0.5);
@@ -144,16 +194,21 @@ fn node_min_extent(sp: Species, f: Frame, inst: Instance, slab: u32, x: f32, y: 
 // under every other tree's quads: exact where it is behind them, as far trees almost always
 // are.
 @vertex
-fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
-    return quad_vertex(vi, kept_composites(state.composites, state.overflow_cull) + qi);
+fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
+    let v = quad_vertex(vi, kept_composites(state.composites, state.overflow_cull) + qi);
+    return QuadOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
+                   v.sun_vis);
 }
 
 @vertex
-fn vs_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> VsOut {
-    return quad_vertex(vi, qi);
+fn vs_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> CompositeOut {
+    let v = quad_vertex(vi, qi);
+    return CompositeOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right,
+                        v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back, v.species,
+                        v.sphere, v.sun_obj);
 }
 
-fn quad_vertex(vi: u32, qi: u32) -> VsOut {
+fn quad_vertex(vi: u32, qi: u32) -> QuadVertex {
     let q = quads[qi];
     let inst = instances[q.instance];
     let sp = species[inst.species];
@@ -246,7 +301,7 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
         w = to_world(inst, p);
     }
     let flags = stream_flags(camera);
-    var out: VsOut;
+    var out: QuadVertex;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.world = w;
     out.uv = vec2<f32>(u, v);
@@ -287,7 +342,7 @@ fn quad_vertex(vi: u32, qi: u32) -> VsOut {
 
 // The radiance of a texel (premultiplied albedo and coverage `c`, premultiplied surface `g`)
 // under the frame's light: premultiplied, linear.
-fn lit_texel(in: VsOut, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
+fn lit_texel(in: Fragment, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
     if (c.a <= 0.0) { return vec4<f32>(0.0); }
     let inv = 1.0 / c.a;
     let local = hemi_oct_decode(g.xy * inv);
@@ -322,14 +377,16 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 }
 
 @fragment
-fn fs_quad(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
     let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
     let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
-    return shade(in, lit_texel(in, c, g));
+    let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
+                     in.frame_up, in.sun_vis);
+    return shade(f, lit_texel(f, c, g));
 }
 
 @fragment
-fn fs_composite(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
     // The slabs "over" each other from the front (premultiplied), at the quad's mip level.
     // Albedo and surface attributes are composited with the same weights, then lit once.
     var c = vec4<f32>(0.0);
@@ -346,15 +403,16 @@ fn fs_composite(in: VsOut) -> @location(0) vec4<f32> {
     // The march starts where the pixel's coverage lies: on the front slab's plane, moved
     // towards the second's by the share the slabs behind the front one add.
     let p = mix(in.obj_front, in.obj_back, (c.a - front) / max(c.a, 1e-6));
-    var lit_in = in;
-    lit_in.sun_vis = sun_transmittance(opacity, colour_sampler, in.species, in.sphere,
-                                       in.sun_obj.w, p, in.sun_obj.xyz);
-    return shade(in, lit_texel(lit_in, c, g));
+    let vis = sun_transmittance(opacity, colour_sampler, in.species, in.sphere, in.sun_obj.w, p,
+                                in.sun_obj.xyz);
+    let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
+                     in.frame_up, vis);
+    return shade(f, lit_texel(f, c, g));
 }
 
 // A quad's fragment of lit colour `c` (premultiplied): the hybrid's and the dither's masks, the
 // debug views, the haze, the aspect's alpha.
-fn shade(in: VsOut, c: vec4<f32>) -> vec4<f32> {
+fn shade(in: Fragment, c: vec4<f32>) -> vec4<f32> {
     // Position inside the quad in quad widths and its screen derivative (before any branch).
     let g = in.uv * f32(1u << in.ids.y);
     let px = max(fwidth(g), vec2<f32>(1e-6));
