@@ -7,7 +7,8 @@
 // its normals, not the sun. Sky visibility is per vertex and per side, traced by the bake's
 // ray tracer (the values the slab images are baked with). Sun visibility comes from marching
 // the species' opacity volume towards the frame's sun (sun_transmittance): per vertex for
-// meshes, per fragment for billboards. Under stochastic simplification a
+// meshes, per fragment through the volume's coarse level for billboards
+// (sun_transmittance_coarse). Under stochastic simplification a
 // leaf vertex is moved towards its leaf's centre by the fade × area factor and the leaf's
 // albedo pulled towards the species' mean by √λ; at λ = 1 nothing is touched, so the image is
 // exactly the full geometry's.
@@ -192,7 +193,7 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     let local = hemi_oct_decode(g.xy);
     let n = normalize(local.x * in.right + local.y * in.up + local.z * in.back);
     // The billboard lies on the plane through the tree's centre: march from there.
-    let v = sun_transmittance(opacity, opacity_sampler, in.species, in.sphere, in.sun_obj.w,
-                              in.obj, in.sun_obj.xyz);
+    let v = sun_transmittance_coarse(opacity, opacity_sampler, in.species, in.sphere,
+                                     in.sun_obj.w, in.obj, in.sun_obj.xyz);
     return hazed(vec4<f32>(shade_light(t.rgb, n, v, g.z, g.w), 1.0), in.world);
 }

@@ -11,6 +11,11 @@
 //! apart). [`OpacityVolume::transmittance`] is the CPU mirror of `sun_transmittance` in the
 //! runtime's `common.wgsl`: [`MARCH_STEPS`] trilinear samples along the ray from
 //! [`START_VOXELS`] voxels off the surface to the cube's side.
+//!
+//! Forms that march per fragment (composited far quads, billboards) march the volume's mip
+//! level [`COARSE_LEVEL`] in [`COARSE_STEPS`] samples instead
+//! ([`OpacityVolume::coarse_transmittance`]): a far tree's pixels span many voxels, and on a
+//! CPU rasteriser the full march per fragment cost a tenth of the quad stream's draw time.
 
 use std::path::Path;
 
@@ -26,6 +31,12 @@ pub const VOLUME_RESOLUTION: u32 = 32;
 pub const MARCH_STEPS: u32 = 16;
 /// Voxels a ray travels before its first sample: a surface point does not shadow itself.
 pub const START_VOXELS: f32 = 0.5;
+/// Mip level of the volume that the per-fragment march reads (level `l` has
+/// `VOLUME_RESOLUTION >> l` voxels a side).
+pub const COARSE_LEVEL: u32 = 2;
+/// Samples of the per-fragment march along a ray towards the sun (about one level-
+/// [`COARSE_LEVEL`] voxel a step across the cube).
+pub const COARSE_STEPS: u32 = 6;
 /// Projection factor of leaf area onto a ray for randomly (spherically) oriented leaves.
 pub const LEAF_PROJECTION: f32 = 1.0;
 
@@ -107,7 +118,53 @@ impl OpacityVolume {
     pub fn transmittance(&self, sphere: &Sphere, p: Vec3, dir: Vec3) -> f32 {
         let side = 2.0 * sphere.radius;
         let u = (p - (sphere.center - Vec3::splat(sphere.radius))) / side;
-        march(u, dir, self.resolution, |x| self.sample(x))
+        march(u, dir, self.resolution, MARCH_STEPS, |x| self.sample(x))
+    }
+
+    /// The volume at half the resolution (`resolution` even): each voxel holds the mean
+    /// optical depth of the 2³ it covers, coded as [`Self::from_depths`] codes with the same
+    /// `max_depth` (so the code is the root mean square of theirs).
+    pub fn downsampled(&self) -> Self {
+        assert!(self.resolution >= 2 && self.resolution % 2 == 0);
+        let h = self.resolution / 2;
+        let mut codes = Vec::with_capacity((h as usize).pow(3));
+        for k in 0..h {
+            for j in 0..h {
+                for i in 0..h {
+                    let mut sum = 0.0f32;
+                    for c in 0..8u32 {
+                        let (a, b, d) = (2 * i + (c & 1), 2 * j + (c >> 1 & 1), 2 * k + (c >> 2));
+                        sum += self.unorm(a, b, d).powi(2);
+                    }
+                    codes.push(((sum / 8.0).sqrt() * 255.0).round() as u8);
+                }
+            }
+        }
+        Self {
+            resolution: h,
+            max_depth: self.max_depth,
+            codes,
+        }
+    }
+
+    /// Mip levels `0 ..= last` of the volume, finest first (each from the one before).
+    pub fn mips(&self, last: u32) -> Vec<Self> {
+        let mut levels = vec![self.clone()];
+        for _ in 0..last {
+            let next = levels[levels.len() - 1].downsampled();
+            levels.push(next);
+        }
+        levels
+    }
+
+    /// The per-fragment forms' transmittance (CPU mirror of `sun_transmittance_coarse` in
+    /// `common.wgsl`): [`COARSE_STEPS`] samples of `coarse`, this volume's mip level
+    /// [`COARSE_LEVEL`] ([`Self::mips`]), along the same ray as [`Self::transmittance`].
+    pub fn coarse_transmittance(coarse: &Self, sphere: &Sphere, p: Vec3, dir: Vec3) -> f32 {
+        let side = 2.0 * sphere.radius;
+        let u = (p - (sphere.center - Vec3::splat(sphere.radius))) / side;
+        let fine = coarse.resolution << COARSE_LEVEL;
+        march(u, dir, fine, COARSE_STEPS, |x| coarse.sample(x))
     }
 
     /// The volume as an 8-bit grey PNG: `resolution` wide, slice `k` at rows
@@ -165,17 +222,17 @@ impl OpacityVolume {
 }
 
 /// The march of [`OpacityVolume::transmittance`] from unit-cube point `u` along unit `dir`,
-/// with `depth(x)` the optical depth per voxel length at `x`: [`MARCH_STEPS`] midpoint samples
-/// over the part of the ray inside the cube, from [`START_VOXELS`] voxels on (or from where a
-/// ray from outside enters).
-pub fn march(u: Vec3, dir: Vec3, resolution: u32, depth: impl Fn(Vec3) -> f32) -> f32 {
+/// with `depth(x)` the optical depth per length of a voxel of a `resolution`-voxel grid at
+/// `x`: `steps` midpoint samples over the part of the ray inside the cube, from
+/// [`START_VOXELS`] of those voxels on (or from where a ray from outside enters).
+pub fn march(u: Vec3, dir: Vec3, resolution: u32, steps: u32, depth: impl Fn(Vec3) -> f32) -> f32 {
     let (enter, exit) = cube_span(u, dir);
     let start = (START_VOXELS / resolution as f32).max(enter);
     if exit <= start {
         return 1.0;
     }
-    let dt = (exit - start) / MARCH_STEPS as f32;
-    let sum: f32 = (0..MARCH_STEPS)
+    let dt = (exit - start) / steps as f32;
+    let sum: f32 = (0..steps)
         .map(|k| depth(u + dir * (start + (k as f32 + 0.5) * dt)))
         .sum();
     (-sum * dt * resolution as f32).exp()

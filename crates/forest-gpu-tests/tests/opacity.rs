@@ -1,11 +1,13 @@
-//! The GPU's march through the opacity volumes (`sun_transmittance` in common.wgsl) against
-//! its CPU mirror (`forest_format::opacity::OpacityVolume::transmittance`), on two stacked
+//! The GPU's marches through the opacity volumes (`sun_transmittance` and
+//! `sun_transmittance_coarse` in common.wgsl) against their CPU mirrors
+//! (`forest_format::opacity::OpacityVolume::transmittance` and `coarse_transmittance`, through
+//! the volumes' mip levels as `OpacityVolume::mips` makes them), on two stacked
 //! species, from points (inside the volumes' cubes and outside them) and towards suns drawn by
 //! a seeded hash.
 
 mod common;
 
-use forest_format::opacity::{OpacityVolume, VOLUME_RESOLUTION};
+use forest_format::opacity::{COARSE_LEVEL, OpacityVolume, VOLUME_RESOLUTION};
 use forest_format::slab::Sphere;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -39,6 +41,10 @@ fn volume(k: f32) -> OpacityVolume {
 fn the_gpu_march_matches_the_cpu_mirror() {
     let ctx = common::ctx();
     let volumes = [volume(1.0), volume(2.5)];
+    let coarse = [
+        volumes[0].mips(COARSE_LEVEL).pop().unwrap(),
+        volumes[1].mips(COARSE_LEVEL).pop().unwrap(),
+    ];
     let spheres = [
         Sphere {
             center: Vec3::new(0.0, 3.0, 0.0),
@@ -65,6 +71,7 @@ fn the_gpu_march_matches_the_cpu_mirror() {
         let el = (0.05 + 0.95 * h(4)).asin();
         let d = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
         expected.push(volumes[k].transmittance(s, p, d));
+        expected.push(OpacityVolume::coarse_transmittance(&coarse[k], s, p, d));
         input.push([
             p.x,
             p.y,
@@ -106,11 +113,12 @@ fn the_gpu_march_matches_the_cpu_mirror() {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= arrayLength(&out)) { return; }
+    if (2u * id.x >= arrayLength(&out)) { return; }
     let a = points[id.x][0];
     let b = points[id.x][1];
     let k = bitcast<u32>(a.w);
-    out[id.x] = sun_transmittance(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
+    out[2u * id.x] = sun_transmittance(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
+    out[2u * id.x + 1u] = sun_transmittance_coarse(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
 }
 "#
     );
@@ -144,7 +152,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         wgpu::BufferUsages::STORAGE,
     );
     let out = buffer(
-        &vec![0u8; POINTS * 4],
+        &vec![0u8; POINTS * 8],
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     );
     let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -181,19 +189,27 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         pass.dispatch_workgroups((POINTS as u32).div_ceil(64), 1, 1);
     }
     ctx.queue.submit([enc.finish()]);
-    let got: Vec<f32> = bytemuck::cast_slice(&ctx.read_buffer(&out, (POINTS * 4) as u64)).to_vec();
+    let got: Vec<f32> = bytemuck::cast_slice(&ctx.read_buffer(&out, (POINTS * 8) as u64)).to_vec();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     let mut worst = 0f32;
     for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
         // The rasteriser filters with 8-bit weights: a small tolerance.
-        assert!((g - e).abs() < 0.02, "point {i}: GPU {g}, CPU {e}");
+        let march = ["full", "coarse"][i % 2];
+        assert!(
+            (g - e).abs() < 0.02,
+            "point {}, {march} march: GPU {g}, CPU {e}",
+            i / 2
+        );
         worst = worst.max((g - e).abs());
     }
-    // The volumes shadow: not every answer is 1.
-    let shadowed = expected.iter().filter(|&&t| t < 0.5).count();
-    assert!(
-        shadowed > POINTS / 10,
-        "{shadowed} of {POINTS} points shadowed"
-    );
+    // The volumes shadow, both marches: not every answer is 1.
+    for m in 0..2 {
+        let shadowed = expected.iter().skip(m).step_by(2).filter(|&&t| t < 0.5).count();
+        assert!(
+            shadowed > POINTS / 10,
+            "march {m}: {shadowed} of {POINTS} points shadowed"
+        );
+    }
+    let shadowed = expected.iter().step_by(2).filter(|&&t| t < 0.5).count();
     eprintln!("worst |GPU − CPU| {worst:.5}, {shadowed} of {POINTS} points below 0.5");
 }

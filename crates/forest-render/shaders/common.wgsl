@@ -41,10 +41,13 @@ fn shade_light(a: vec3<f32>, n: vec3<f32>, v: f32, s: f32, tau: f32) -> vec3<f32
 }
 
 // The march towards the sun through a tree's opacity volume (mirrors
-// forest_format::opacity: VOLUME_RESOLUTION, MARCH_STEPS, START_VOXELS).
+// forest_format::opacity: VOLUME_RESOLUTION, MARCH_STEPS, START_VOXELS, COARSE_LEVEL,
+// COARSE_STEPS).
 const OPACITY_RES: f32 = 32.0;
 const OPACITY_STEPS: u32 = 16u;
 const OPACITY_START: f32 = 0.5;
+const OPACITY_COARSE_LEVEL: u32 = 2u;
+const OPACITY_COARSE_STEPS: u32 = 6u;
 
 // Distances along unit `d` from `u` to where the ray enters and leaves [0, 1]³
 // (opacity::cube_span).
@@ -71,19 +74,37 @@ fn cube_span(u: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
 // space. Sampled at level 0, so any stage may call it.
 fn sun_transmittance(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
                      max_depth: f32, p: vec3<f32>, sun: vec3<f32>) -> f32 {
+    return opacity_march(vol, samp, k, sphere, max_depth, p, sun, 0u, OPACITY_STEPS);
+}
+
+// sun_transmittance through the volume's mip level OPACITY_COARSE_LEVEL in
+// OPACITY_COARSE_STEPS samples, for forms that march per fragment (mirrors
+// OpacityVolume::coarse_transmittance).
+fn sun_transmittance_coarse(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
+                            max_depth: f32, p: vec3<f32>, sun: vec3<f32>) -> f32 {
+    return opacity_march(vol, samp, k, sphere, max_depth, p, sun, OPACITY_COARSE_LEVEL,
+                         OPACITY_COARSE_STEPS);
+}
+
+// The march of `steps` samples through mip level `level` (opacity::march). Optical depth is
+// per level-0 voxel length at every level. The slice count is level 0's, divided: lavapipe
+// returns level 0's depth for textureDimensions(vol, level) of a 3D texture.
+fn opacity_march(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
+                 max_depth: f32, p: vec3<f32>, sun: vec3<f32>, level: u32, steps: u32) -> f32 {
     if (max_depth <= 0.0) { return 1.0; }
     let u = (p - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
     let span = cube_span(u, sun);
     let start = max(OPACITY_START / OPACITY_RES, span.x);
     let exit = span.y;
     if (exit <= start) { return 1.0; }
-    let dt = (exit - start) / f32(OPACITY_STEPS);
-    let slices = f32(textureDimensions(vol).z);
+    let dt = (exit - start) / f32(steps);
+    let res = OPACITY_RES / f32(1u << level);
+    let slices = f32(textureDimensions(vol).z >> level);
     var sum = 0.0;
-    for (var i = 0u; i < OPACITY_STEPS; i++) {
+    for (var i = 0u; i < steps; i++) {
         let x = u + sun * (start + (f32(i) + 0.5) * dt);
-        let z = (f32(k) * OPACITY_RES + clamp(x.z * OPACITY_RES, 0.5, OPACITY_RES - 0.5)) / slices;
-        let s = textureSampleLevel(vol, samp, vec3<f32>(x.xy, z), 0.0).r;
+        let z = (f32(k) * res + clamp(x.z * res, 0.5, res - 0.5)) / slices;
+        let s = textureSampleLevel(vol, samp, vec3<f32>(x.xy, z), f32(level)).r;
         sum = sum + s * s;
     }
     return exp(-sum * max_depth * dt * OPACITY_RES);

@@ -1,9 +1,10 @@
 //! The species' opacity volumes on the GPU (see [`forest_format::opacity`]): one R8Unorm 3D
-//! texture, species after species along z (species `k` at slices `k·R .. (k+1)·R`), which
-//! `sun_transmittance` in `shaders/common.wgsl` marches towards the sun. Shared by the quad
-//! stream and the triangle methods.
+//! texture, species after species along z (species `k` at slices `k·R .. (k+1)·R`), with mip
+//! levels down to [`COARSE_LEVEL`] (species `k` at slices `k·(R >> l)` of level `l`), which
+//! `sun_transmittance` (level 0) and `sun_transmittance_coarse` in `shaders/common.wgsl` march
+//! towards the sun. Shared by the quad stream and the triangle methods.
 
-use forest_format::opacity::{OpacityVolume, VOLUME_RESOLUTION};
+use forest_format::opacity::{COARSE_LEVEL, OpacityVolume, VOLUME_RESOLUTION};
 use wgpu::util::DeviceExt;
 
 use crate::context::RenderError;
@@ -45,15 +46,24 @@ pub fn opacity_texture(
             hint: ": split the forest into scenes of fewer species",
         });
     }
-    let mut data = Vec::with_capacity((r as usize).pow(2) * depth as usize);
     for v in volumes {
         assert_eq!(
             v.resolution, r,
             "atlas loading checks the volume resolution"
         );
-        data.extend_from_slice(&v.codes);
     }
-    data.resize((r as usize).pow(2) * depth as usize, 0);
+    let mips: Vec<Vec<OpacityVolume>> = volumes.iter().map(|v| v.mips(COARSE_LEVEL)).collect();
+    // Level after level (wgpu's order for one 3D layer), each species after species; an empty
+    // scene's one volume stays zero.
+    let mut data = Vec::new();
+    for l in 0..=COARSE_LEVEL {
+        let side = (r >> l) as usize;
+        let start = data.len();
+        for m in &mips {
+            data.extend_from_slice(&m[l as usize].codes);
+        }
+        data.resize(start + side * side * (depth as usize >> l), 0);
+    }
     let texture = device.create_texture_with_data(
         queue,
         &wgpu::TextureDescriptor {
@@ -63,7 +73,7 @@ pub fn opacity_texture(
                 height: r,
                 depth_or_array_layers: depth as u32,
             },
-            mip_level_count: 1,
+            mip_level_count: COARSE_LEVEL + 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D3,
             format: wgpu::TextureFormat::R8Unorm,
@@ -78,7 +88,9 @@ pub fn opacity_texture(
 
 #[cfg(test)]
 mod tests {
-    use forest_format::opacity::{MARCH_STEPS, START_VOXELS, VOLUME_RESOLUTION};
+    use forest_format::opacity::{
+        COARSE_LEVEL, COARSE_STEPS, MARCH_STEPS, START_VOXELS, VOLUME_RESOLUTION,
+    };
 
     /// The WGSL march's constants are the CPU mirror's.
     #[test]
@@ -87,6 +99,8 @@ mod tests {
         for line in [
             format!("const OPACITY_RES: f32 = {:.1};", VOLUME_RESOLUTION as f32),
             format!("const OPACITY_STEPS: u32 = {MARCH_STEPS}u;"),
+            format!("const OPACITY_COARSE_LEVEL: u32 = {COARSE_LEVEL}u;"),
+            format!("const OPACITY_COARSE_STEPS: u32 = {COARSE_STEPS}u;"),
             format!("const OPACITY_START: f32 = {START_VOXELS:?};"),
         ] {
             assert!(src.contains(&line), "common.wgsl lacks `{line}`");
