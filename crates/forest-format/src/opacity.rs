@@ -37,6 +37,29 @@ pub const COARSE_LEVEL: u32 = 2;
 /// Samples of the per-fragment march along a ray towards the sun (about one level-
 /// [`COARSE_LEVEL`] voxel a step across the cube).
 pub const COARSE_STEPS: u32 = 6;
+/// Samples of the march through mip level 1.
+pub const MID_STEPS: u32 = 8;
+/// Quads of hierarchy levels up to this one march level [`COARSE_LEVEL`] at their corners
+/// (see [`quad_march`]).
+pub const COARSE_QUAD_LEVEL: u32 = 2;
+/// Quads of hierarchy levels above [`COARSE_QUAD_LEVEL`] and up to this one march level 1.
+pub const MID_QUAD_LEVEL: u32 = 4;
+
+/// The march a plain quad's corners take, by the quad's hierarchy level: the volume's mip
+/// level and the samples along the ray (mirrors `quad_march` in `common.wgsl`). A quad
+/// interpolates its corners' transmittance, so detail finer than the quad is lost anyway: a
+/// coarse quad (level ≤ [`COARSE_QUAD_LEVEL`], at least 8 level-0 voxels wide) reads the
+/// coarse level, which also smooths what its far-apart corners see; a fine one the full volume.
+pub const fn quad_march(quad_level: u32) -> (u32, u32) {
+    if quad_level <= COARSE_QUAD_LEVEL {
+        (COARSE_LEVEL, COARSE_STEPS)
+    } else if quad_level <= MID_QUAD_LEVEL {
+        (1, MID_STEPS)
+    } else {
+        (0, MARCH_STEPS)
+    }
+}
+
 /// Projection factor of leaf area onto a ray for randomly (spherically) oriented leaves.
 pub const LEAF_PROJECTION: f32 = 1.0;
 
@@ -161,10 +184,23 @@ impl OpacityVolume {
     /// `common.wgsl`): [`COARSE_STEPS`] samples of `coarse`, this volume's mip level
     /// [`COARSE_LEVEL`] ([`Self::mips`]), along the same ray as [`Self::transmittance`].
     pub fn coarse_transmittance(coarse: &Self, sphere: &Sphere, p: Vec3, dir: Vec3) -> f32 {
+        Self::level_transmittance(coarse, COARSE_LEVEL, COARSE_STEPS, sphere, p, dir)
+    }
+
+    /// The march of `steps` samples through `mip`, a volume's mip level `level`
+    /// ([`Self::mips`]), along the same ray as [`Self::transmittance`] (CPU mirror of
+    /// `opacity_march` in `common.wgsl`); optical depth stays per level-0 voxel length.
+    pub fn level_transmittance(
+        mip: &Self,
+        level: u32,
+        steps: u32,
+        sphere: &Sphere,
+        p: Vec3,
+        dir: Vec3,
+    ) -> f32 {
         let side = 2.0 * sphere.radius;
         let u = (p - (sphere.center - Vec3::splat(sphere.radius))) / side;
-        let fine = coarse.resolution << COARSE_LEVEL;
-        march(u, dir, fine, COARSE_STEPS, |x| coarse.sample(x))
+        march(u, dir, mip.resolution << level, steps, |x| mip.sample(x))
     }
 
     /// The volume as an 8-bit grey PNG: `resolution` wide, slice `k` at rows

@@ -1,13 +1,14 @@
-//! The GPU's marches through the opacity volumes (`sun_transmittance` and
-//! `sun_transmittance_coarse` in common.wgsl) against their CPU mirrors
-//! (`forest_format::opacity::OpacityVolume::transmittance` and `coarse_transmittance`, through
+//! The GPU's marches through the opacity volumes (`sun_transmittance`,
+//! `sun_transmittance_coarse`, and `opacity_march` at each quad level's `quad_march` in
+//! common.wgsl) against their CPU mirrors (`forest_format::opacity::OpacityVolume::transmittance`,
+//! `coarse_transmittance` and `level_transmittance` at `quad_march`, through
 //! the volumes' mip levels as `OpacityVolume::mips` makes them), on two stacked
 //! species, from points (inside the volumes' cubes and outside them) and towards suns drawn by
 //! a seeded hash.
 
 mod common;
 
-use forest_format::opacity::{COARSE_LEVEL, OpacityVolume, VOLUME_RESOLUTION};
+use forest_format::opacity::{COARSE_LEVEL, OpacityVolume, VOLUME_RESOLUTION, quad_march};
 use forest_format::slab::Sphere;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -41,10 +42,7 @@ fn volume(k: f32) -> OpacityVolume {
 fn the_gpu_march_matches_the_cpu_mirror() {
     let ctx = common::ctx();
     let volumes = [volume(1.0), volume(2.5)];
-    let coarse = [
-        volumes[0].mips(COARSE_LEVEL).pop().unwrap(),
-        volumes[1].mips(COARSE_LEVEL).pop().unwrap(),
-    ];
+    let mips = [volumes[0].mips(COARSE_LEVEL), volumes[1].mips(COARSE_LEVEL)];
     let spheres = [
         Sphere {
             center: Vec3::new(0.0, 3.0, 0.0),
@@ -71,7 +69,14 @@ fn the_gpu_march_matches_the_cpu_mirror() {
         let el = (0.05 + 0.95 * h(4)).asin();
         let d = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
         expected.push(volumes[k].transmittance(s, p, d));
-        expected.push(OpacityVolume::coarse_transmittance(&coarse[k], s, p, d));
+        let coarse = &mips[k][COARSE_LEVEL as usize];
+        expected.push(OpacityVolume::coarse_transmittance(coarse, s, p, d));
+        // A plain quad's march, at hierarchy level i mod 8.
+        let (level, steps) = quad_march(i as u32 % 8);
+        let mip = &mips[k][level as usize];
+        expected.push(OpacityVolume::level_transmittance(
+            mip, level, steps, s, p, d,
+        ));
         input.push([
             p.x,
             p.y,
@@ -113,12 +118,14 @@ fn the_gpu_march_matches_the_cpu_mirror() {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (2u * id.x >= arrayLength(&out)) { return; }
+    if (3u * id.x >= arrayLength(&out)) { return; }
     let a = points[id.x][0];
     let b = points[id.x][1];
     let k = bitcast<u32>(a.w);
-    out[2u * id.x] = sun_transmittance(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
-    out[2u * id.x + 1u] = sun_transmittance_coarse(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
+    out[3u * id.x] = sun_transmittance(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
+    out[3u * id.x + 1u] = sun_transmittance_coarse(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz);
+    let m = quad_march(id.x % 8u);
+    out[3u * id.x + 2u] = opacity_march(vol, samp, k, spheres[k], b.w, a.xyz, b.xyz, m.x, m.y);
 }
 "#
     );
@@ -152,7 +159,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         wgpu::BufferUsages::STORAGE,
     );
     let out = buffer(
-        &vec![0u8; POINTS * 8],
+        &vec![0u8; POINTS * 12],
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     );
     let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -189,27 +196,32 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         pass.dispatch_workgroups((POINTS as u32).div_ceil(64), 1, 1);
     }
     ctx.queue.submit([enc.finish()]);
-    let got: Vec<f32> = bytemuck::cast_slice(&ctx.read_buffer(&out, (POINTS * 8) as u64)).to_vec();
+    let got: Vec<f32> = bytemuck::cast_slice(&ctx.read_buffer(&out, (POINTS * 12) as u64)).to_vec();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     let mut worst = 0f32;
     for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
         // The rasteriser filters with 8-bit weights: a small tolerance.
-        let march = ["full", "coarse"][i % 2];
+        let march = ["full", "coarse", "quad level's"][i % 3];
         assert!(
             (g - e).abs() < 0.02,
             "point {}, {march} march: GPU {g}, CPU {e}",
-            i / 2
+            i / 3
         );
         worst = worst.max((g - e).abs());
     }
-    // The volumes shadow, both marches: not every answer is 1.
-    for m in 0..2 {
-        let shadowed = expected.iter().skip(m).step_by(2).filter(|&&t| t < 0.5).count();
+    // The volumes shadow, every march: not every answer is 1.
+    for m in 0..3 {
+        let shadowed = expected
+            .iter()
+            .skip(m)
+            .step_by(3)
+            .filter(|&&t| t < 0.5)
+            .count();
         assert!(
             shadowed > POINTS / 10,
             "march {m}: {shadowed} of {POINTS} points shadowed"
         );
     }
-    let shadowed = expected.iter().step_by(2).filter(|&&t| t < 0.5).count();
+    let shadowed = expected.iter().step_by(3).filter(|&&t| t < 0.5).count();
     eprintln!("worst |GPU − CPU| {worst:.5}, {shadowed} of {POINTS} points below 0.5");
 }

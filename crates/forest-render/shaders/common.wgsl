@@ -42,12 +42,25 @@ fn shade_light(a: vec3<f32>, n: vec3<f32>, v: f32, s: f32, tau: f32) -> vec3<f32
 
 // The march towards the sun through a tree's opacity volume (mirrors
 // forest_format::opacity: VOLUME_RESOLUTION, MARCH_STEPS, START_VOXELS, COARSE_LEVEL,
-// COARSE_STEPS).
+// COARSE_STEPS, MID_STEPS, COARSE_QUAD_LEVEL, MID_QUAD_LEVEL).
 const OPACITY_RES: f32 = 32.0;
 const OPACITY_STEPS: u32 = 16u;
 const OPACITY_START: f32 = 0.5;
 const OPACITY_COARSE_LEVEL: u32 = 2u;
 const OPACITY_COARSE_STEPS: u32 = 6u;
+const OPACITY_MID_STEPS: u32 = 8u;
+const OPACITY_COARSE_QUAD_LEVEL: u32 = 2u;
+const OPACITY_MID_QUAD_LEVEL: u32 = 4u;
+
+// The mip level (x) and samples (y) a plain quad's corners march, by the quad's hierarchy
+// level (mirrors forest_format::opacity::quad_march).
+fn quad_march(quad_level: u32) -> vec2<u32> {
+    if (quad_level <= OPACITY_COARSE_QUAD_LEVEL) {
+        return vec2<u32>(OPACITY_COARSE_LEVEL, OPACITY_COARSE_STEPS);
+    }
+    if (quad_level <= OPACITY_MID_QUAD_LEVEL) { return vec2<u32>(1u, OPACITY_MID_STEPS); }
+    return vec2<u32>(0u, OPACITY_STEPS);
+}
 
 // Distances along unit `d` from `u` to where the ray enters and leaves [0, 1]³
 // (opacity::cube_span).

@@ -1,8 +1,9 @@
 // Pass 3, draw: the environment (environment.wgsl), then every quad of the final stream becomes 4 vertices (a triangle strip, one
 // instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
 // the sampling frame of its direction and slab (object space), then the instance transform.
-// Each vertex marches the tree's opacity volume towards the sun (sun_transmittance): the
-// crown's self-shadowing under the frame's sun; a composited quad, which spans a whole far
+// Each vertex marches the tree's opacity volume towards the sun (opacity_march, at the mip
+// level that suits the quad's size: quad_march): the crown's self-shadowing under the frame's
+// sun; a composited quad, which spans a whole far
 // tree, marches per fragment from where its coverage lies, through the volume's coarse mip
 // level in fewer steps (sun_transmittance_coarse).
 // Textured from the colour array (premultiplied albedo, sRGB-decoded by the format) and the
@@ -331,13 +332,16 @@ fn quad_vertex(vi: u32, qi: u32) -> QuadVertex {
     // A plain quad marches at its corners and interpolates. Coarse quads smear the crown's
     // shadow so (a far view: FLIP 0.164 against the reference, 0.124 marching per fragment),
     // but a march per fragment in fs_quad, even behind a branch no fragment takes, cost a CPU
-    // rasteriser 2.4 times the draw time; per vertex costs 1.15 times. A composited quad,
-    // which spans a whole far tree, marches per fragment (fs_composite), through the coarse
-    // level: the full march there cost a tenth of the draw time.
+    // rasteriser 2.4 times the draw time; per vertex costs 1.15 times. The march reads the
+    // volume's mip level that suits the quad's size (quad_march): on coarse quads the coarse
+    // level lowered a far view's FLIP by a tenth. A composited quad, which spans a whole far
+    // tree, marches per fragment (fs_composite), through the coarse level: the full march
+    // there cost a tenth of the draw time.
     out.sun_vis = 1.0;
     if (!composite) {
-        out.sun_vis = sun_transmittance(opacity, colour_sampler, inst.species, sp.sphere,
-                                        sp.opacity_depth, p, sun_obj);
+        let m = quad_march(level);
+        out.sun_vis = opacity_march(opacity, colour_sampler, inst.species, sp.sphere,
+                                    sp.opacity_depth, p, sun_obj, m.x, m.y);
     }
     return out;
 }

@@ -89,7 +89,8 @@ pub fn opacity_texture(
 #[cfg(test)]
 mod tests {
     use forest_format::opacity::{
-        COARSE_LEVEL, COARSE_STEPS, MARCH_STEPS, START_VOXELS, VOLUME_RESOLUTION,
+        COARSE_LEVEL, COARSE_QUAD_LEVEL, COARSE_STEPS, MARCH_STEPS, MID_QUAD_LEVEL, MID_STEPS,
+        START_VOXELS, VOLUME_RESOLUTION,
     };
 
     /// The WGSL march's constants are the CPU mirror's.
@@ -101,6 +102,9 @@ mod tests {
             format!("const OPACITY_STEPS: u32 = {MARCH_STEPS}u;"),
             format!("const OPACITY_COARSE_LEVEL: u32 = {COARSE_LEVEL}u;"),
             format!("const OPACITY_COARSE_STEPS: u32 = {COARSE_STEPS}u;"),
+            format!("const OPACITY_MID_STEPS: u32 = {MID_STEPS}u;"),
+            format!("const OPACITY_COARSE_QUAD_LEVEL: u32 = {COARSE_QUAD_LEVEL}u;"),
+            format!("const OPACITY_MID_QUAD_LEVEL: u32 = {MID_QUAD_LEVEL}u;"),
             format!("const OPACITY_START: f32 = {START_VOXELS:?};"),
         ] {
             assert!(src.contains(&line), "common.wgsl lacks `{line}`");
