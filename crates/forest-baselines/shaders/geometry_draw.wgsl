@@ -144,6 +144,9 @@ struct BillboardOut {
     @location(9) @interpolate(flat) species: u32,
     // xyz: the sun's direction in object space; w: the species' opacity depth.
     @location(10) @interpolate(flat) sun_obj: vec4<f32>,
+    // Unit direction from the eye through the tree's centre, in object space: the view ray
+    // that median_depth_point follows through the crown.
+    @location(11) @interpolate(flat) view_obj: vec3<f32>,
 }
 
 // A camera-facing quad over the tree's bounding sphere showing the billboard image whose
@@ -181,6 +184,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.sphere = sp.sphere;
     out.species = inst.species;
     out.sun_obj = vec4<f32>(to_object_dir(inst, camera.sun.xyz), sp.opacity_depth);
+    out.view_obj = to_object_dir(inst, f);
     return out;
 }
 
@@ -192,8 +196,14 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     if (t.a < 0.5) { discard; }
     let local = hemi_oct_decode(g.xy);
     let n = normalize(local.x * in.right + local.y * in.up + local.z * in.back);
-    // The billboard lies on the plane through the tree's centre: march from there.
+    // The billboard lies on the plane through the tree's centre, but its texels show the
+    // crown's first surfaces: march towards the sun from where the view ray has spent half its
+    // light in the crown (median_depth_point). Marched from the plane, the shadowed side of a
+    // crown seen against a low sun was lit through (1.28 times the reference's luminance;
+    // 1.07 times from the median depth).
+    let start = median_depth_point(opacity, opacity_sampler, in.species, in.sphere,
+                                   in.sun_obj.w, in.obj, in.view_obj);
     let v = sun_transmittance_coarse(opacity, opacity_sampler, in.species, in.sphere,
-                                     in.sun_obj.w, in.obj, in.sun_obj.xyz);
+                                     in.sun_obj.w, start, in.sun_obj.xyz);
     return hazed(vec4<f32>(shade_light(t.rgb, n, v, g.z, g.w), 1.0), in.world);
 }

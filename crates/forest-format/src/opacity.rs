@@ -148,7 +148,7 @@ impl OpacityVolume {
     /// optical depth of the 2³ it covers, coded as [`Self::from_depths`] codes with the same
     /// `max_depth` (so the code is the root mean square of theirs).
     pub fn downsampled(&self) -> Self {
-        assert!(self.resolution >= 2 && self.resolution % 2 == 0);
+        assert!(self.resolution >= 2 && self.resolution.is_multiple_of(2));
         let h = self.resolution / 2;
         let mut codes = Vec::with_capacity((h as usize).pow(3));
         for k in 0..h {

@@ -111,17 +111,51 @@ fn opacity_march(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
     let exit = span.y;
     if (exit <= start) { return 1.0; }
     let dt = (exit - start) / f32(steps);
-    let res = OPACITY_RES / f32(1u << level);
-    let slices = f32(textureDimensions(vol).z >> level);
     var sum = 0.0;
     for (var i = 0u; i < steps; i++) {
-        let x = u + sun * (start + (f32(i) + 0.5) * dt);
-        let z = (f32(k) * res + clamp(x.z * res, 0.5, res - 0.5)) / slices;
-        let s = textureSampleLevel(vol, samp, vec3<f32>(x.xy, z), f32(level)).r;
+        let s = opacity_code(vol, samp, k, u + sun * (start + (f32(i) + 0.5) * dt), level);
         sum = sum + s * s;
     }
     return exp(-sum * max_depth * dt * OPACITY_RES);
 }
+
+// The volume's code of species `k` at cube coordinates `x` ([0, 1]³), mip level `level`
+// (trilinear; z clamped within the species' slices).
+fn opacity_code(vol: texture_3d<f32>, samp: sampler, k: u32, x: vec3<f32>, level: u32) -> f32 {
+    let res = OPACITY_RES / f32(1u << level);
+    let slices = f32(textureDimensions(vol).z >> level);
+    let z = (f32(k) * res + clamp(x.z * res, 0.5, res - 0.5)) / slices;
+    return textureSampleLevel(vol, samp, vec3<f32>(x.xy, z), f32(level)).r;
+}
+
+// Where a view ray meets a tree whose image has no depth (a billboard, whose texels show
+// the crown's first surfaces): along unit `d` (object space, away from the eye) from the
+// bounding sphere's front through `p`, the point at which the opacity volume has stopped half
+// the ray's light (its median depth), or `p` where it stops less. Coarse level,
+// OPACITY_COARSE_STEPS samples across the sphere's diameter.
+fn median_depth_point(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
+                      max_depth: f32, p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
+    if (max_depth <= 0.0) { return p; }
+    let front = p - d * sphere.w;
+    let u = (front - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
+    // The diameter is one cube side: 1 in cube units.
+    let dt = 1.0 / f32(OPACITY_COARSE_STEPS);
+    let per_step = max_depth * dt * OPACITY_RES;
+    var tau = 0.0;
+    for (var i = 0u; i < OPACITY_COARSE_STEPS; i++) {
+        let s = opacity_code(vol, samp, k, u + d * ((f32(i) + 0.5) * dt), OPACITY_COARSE_LEVEL);
+        let step = s * s * per_step;
+        if (tau + step >= LN_2) {
+            // Half the light is spent within this step: linearly in its optical depth.
+            let f = (LN_2 - tau) / max(step, 1e-6);
+            return front + d * (2.0 * sphere.w * (f32(i) + f) * dt);
+        }
+        tau = tau + step;
+    }
+    return p;
+}
+
+const LN_2: f32 = 0.6931472;
 
 // Object direction -> world direction (the instance's rotation about +Y).
 fn to_world_dir(inst: Instance, d: vec3<f32>) -> vec3<f32> {

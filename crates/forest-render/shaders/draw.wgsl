@@ -340,8 +340,14 @@ fn quad_vertex(vi: u32, qi: u32) -> QuadVertex {
     out.sun_vis = 1.0;
     if (!composite) {
         let m = quad_march(level);
+        // From the corner's Gauss point: the quad's 2×2 Gauss–Legendre nodes, ±1/√3 of the
+        // half box about its middle, on the node's plane.
+        let ag = mix(0.5 * (box_lo + box_hi), a, 0.57735027);
+        let tg = mix(mix(d.x, d.y, ag.x), mix(d.z, d.w, ag.x), ag.y);
+        let pg = slab_point(sp, f, slab, (f32(qx) + ag.x) * size, (f32(quad_y(q)) + ag.y) * size,
+                            tg);
         out.sun_vis = opacity_march(opacity, colour_sampler, inst.species, sp.sphere,
-                                    sp.opacity_depth, p, sun_obj, m.x, m.y);
+                                    sp.opacity_depth, pg, sun_obj, m.x, m.y);
     }
     return out;
 }
