@@ -203,6 +203,28 @@ impl OpacityVolume {
         march(u, dir, mip.resolution << level, steps, |x| mip.sample(x))
     }
 
+    /// Where a view ray meets a tree whose image has no depth (CPU mirror of
+    /// `median_depth_point` in `common.wgsl`): along unit `dir` from the bounding sphere's
+    /// front through `p` (object space), the point at which `coarse`, this volume's mip level
+    /// [`COARSE_LEVEL`], has stopped half the ray's light, linearly within the step of
+    /// [`COARSE_STEPS`] across the diameter where that happens; `p` where it stops less.
+    pub fn median_depth_point(coarse: &Self, sphere: &Sphere, p: Vec3, dir: Vec3) -> Vec3 {
+        let front = p - dir * sphere.radius;
+        let u = (front - (sphere.center - Vec3::splat(sphere.radius))) / (2.0 * sphere.radius);
+        let dt = 1.0 / COARSE_STEPS as f32;
+        let fine = (coarse.resolution << COARSE_LEVEL) as f32;
+        let mut tau = 0.0;
+        for i in 0..COARSE_STEPS {
+            let step = coarse.sample(u + dir * ((i as f32 + 0.5) * dt)) * dt * fine;
+            if tau + step >= std::f32::consts::LN_2 {
+                let f = (std::f32::consts::LN_2 - tau) / step.max(1e-6);
+                return front + dir * (2.0 * sphere.radius * (i as f32 + f) * dt);
+            }
+            tau += step;
+        }
+        p
+    }
+
     /// The volume as an 8-bit grey PNG: `resolution` wide, slice `k` at rows
     /// `k·resolution ..`.
     pub fn encode_png(&self) -> Vec<u8> {
