@@ -1,9 +1,9 @@
 // Pass 3, draw: the environment (environment.wgsl), then every quad of the final stream becomes 4 vertices (a triangle strip, one
 // instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
 // the sampling frame of its direction and slab (object space), then the instance transform.
-// Each vertex marches the tree's opacity volume towards the sun (opacity_march, at the mip
-// level that suits the quad's size: quad_march): the crown's self-shadowing under the frame's
-// sun; a composited quad, which spans a whole far
+// Each vertex marches the tree's opacity volume towards the sun (opacity_march, from the
+// corner's Gauss point, at the mip level that suits the quad's size: quad_march): the crown's
+// self-shadowing under the frame's sun; a composited quad, which spans a whole far
 // tree, marches per fragment from where its coverage lies, through the volume's coarse mip
 // level in fewer steps (sun_transmittance_coarse).
 // Textured from the colour array (premultiplied albedo, sRGB-decoded by the format) and the
