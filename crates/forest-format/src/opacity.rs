@@ -15,7 +15,8 @@
 //! Forms that march per fragment (composited far quads, billboards) march the volume's mip
 //! level [`COARSE_LEVEL`] in [`COARSE_STEPS`] samples instead
 //! ([`OpacityVolume::coarse_transmittance`]): a far tree's pixels span many voxels, and on a
-//! CPU rasteriser the full march per fragment cost a tenth of the quad stream's draw time.
+//! CPU rasteriser the full march per fragment cost a tenth of the quad stream's draw time. A
+//! plain quad's corners march the level that suits the quad's size ([`quad_march`]).
 
 use std::path::Path;
 
@@ -139,9 +140,7 @@ impl OpacityVolume {
     /// Transmittance from object-space point `p` towards unit direction `dir` through the
     /// tree whose bounding sphere the volume frames, in `[0, 1]`.
     pub fn transmittance(&self, sphere: &Sphere, p: Vec3, dir: Vec3) -> f32 {
-        let side = 2.0 * sphere.radius;
-        let u = (p - (sphere.center - Vec3::splat(sphere.radius))) / side;
-        march(u, dir, self.resolution, MARCH_STEPS, |x| self.sample(x))
+        Self::level_transmittance(self, 0, MARCH_STEPS, sphere, p, dir)
     }
 
     /// The volume at half the resolution (`resolution` even): each voxel holds the mean
@@ -198,9 +197,13 @@ impl OpacityVolume {
         p: Vec3,
         dir: Vec3,
     ) -> f32 {
-        let side = 2.0 * sphere.radius;
-        let u = (p - (sphere.center - Vec3::splat(sphere.radius))) / side;
-        march(u, dir, mip.resolution << level, steps, |x| mip.sample(x))
+        march(
+            cube_point(sphere, p),
+            dir,
+            mip.resolution << level,
+            steps,
+            |x| mip.sample(x),
+        )
     }
 
     /// Where a view ray meets a tree whose image has no depth (CPU mirror of
@@ -210,7 +213,7 @@ impl OpacityVolume {
     /// [`COARSE_STEPS`] across the diameter where that happens; `p` where it stops less.
     pub fn median_depth_point(coarse: &Self, sphere: &Sphere, p: Vec3, dir: Vec3) -> Vec3 {
         let front = p - dir * sphere.radius;
-        let u = (front - (sphere.center - Vec3::splat(sphere.radius))) / (2.0 * sphere.radius);
+        let u = cube_point(sphere, front);
         let dt = 1.0 / COARSE_STEPS as f32;
         let fine = (coarse.resolution << COARSE_LEVEL) as f32;
         let mut tau = 0.0;
@@ -277,6 +280,12 @@ impl OpacityVolume {
             codes: img.into_raw(),
         })
     }
+}
+
+/// Object-space point `p` in the unit cube a volume spans around `sphere` (its bounding
+/// cube: `[0, 1]³` inside).
+fn cube_point(sphere: &Sphere, p: Vec3) -> Vec3 {
+    (p - (sphere.center - Vec3::splat(sphere.radius))) / (2.0 * sphere.radius)
 }
 
 /// The march of [`OpacityVolume::transmittance`] from unit-cube point `u` along unit `dir`,

@@ -75,7 +75,7 @@ fn halves(img: &image::RgbaImage, cam: &Camera, centre: Vec3) -> (f32, f32) {
         }
         let right = x as f32 + 0.5 > cx;
         let side = usize::from(right != plus_right);
-        sum[side] += 0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2]);
+        sum[side] += luminance(p);
         n[side] += 1;
     }
     (sum[0] / n[0].max(1) as f32, sum[1] / n[1].max(1) as f32)
@@ -188,11 +188,16 @@ fn a_low_sun_matches_the_reference_and_baked_light_does_not() {
     );
 }
 
+/// Rec. 709 luminance of a pixel's sRGB codes (0–255).
+fn luminance(p: &image::Rgba<u8>) -> f32 {
+    0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
+}
+
 /// Mean luminance (0–255, of the sRGB codes) of an image's covered pixels.
 fn covered_luminance(img: &image::RgbaImage) -> f32 {
     let (mut sum, mut n) = (0f32, 0u32);
     for p in img.pixels().filter(|p| p[3] >= 128) {
-        sum += 0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2]);
+        sum += luminance(p);
         n += 1;
     }
     sum / n.max(1) as f32

@@ -208,7 +208,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let got: Vec<f32> = bytemuck::cast_slice(&ctx.read_buffer(&out, (POINTS * 24) as u64)).to_vec();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     let mut worst = 0f32;
-    let mut moved = 0;
     let mut worst_point = 0f32;
     for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
         let (point, j) = (i / 6, i % 6);
@@ -247,12 +246,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             "march {m}: {shadowed} of {POINTS} points shadowed"
         );
     }
-    for (k, row) in input.iter().enumerate() {
-        let e = &expected[6 * k + 3..6 * k + 6];
-        if (Vec3::new(row[0], row[1], row[2]) - Vec3::from_slice(e)).length() > 1e-3 {
-            moved += 1;
-        }
-    }
+    let moved = input
+        .iter()
+        .enumerate()
+        .filter(|(k, row)| {
+            let e = &expected[6 * k + 3..6 * k + 6];
+            (Vec3::new(row[0], row[1], row[2]) - Vec3::from_slice(e)).length() > 1e-3
+        })
+        .count();
     assert!(
         moved > POINTS / 10,
         "{moved} of {POINTS} rays met the crown"

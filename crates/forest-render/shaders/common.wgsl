@@ -99,13 +99,18 @@ fn sun_transmittance_coarse(vol: texture_3d<f32>, samp: sampler, k: u32, sphere:
                          OPACITY_COARSE_STEPS);
 }
 
+// Object-space point `p` in the unit cube a volume spans around `sphere` (xyz centre, w
+// radius): [0, 1]³ inside (opacity::cube_point).
+fn opacity_cube_point(sphere: vec4<f32>, p: vec3<f32>) -> vec3<f32> {
+    return (p - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
+}
+
 // The march of `steps` samples through mip level `level` (opacity::march). Optical depth is
-// per level-0 voxel length at every level. The slice count is level 0's, divided: lavapipe
-// returns level 0's depth for textureDimensions(vol, level) of a 3D texture.
+// per level-0 voxel length at every level.
 fn opacity_march(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
                  max_depth: f32, p: vec3<f32>, sun: vec3<f32>, level: u32, steps: u32) -> f32 {
     if (max_depth <= 0.0) { return 1.0; }
-    let u = (p - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
+    let u = opacity_cube_point(sphere, p);
     let span = cube_span(u, sun);
     let start = max(OPACITY_START / OPACITY_RES, span.x);
     let exit = span.y;
@@ -120,13 +125,16 @@ fn opacity_march(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<f32>,
 }
 
 // The volume's code of species `k` at cube coordinates `x` ([0, 1]³), mip level `level`
-// (trilinear; z clamped within the species' slices).
+// (trilinear; z clamped within the species' slices). The slice count is level 0's, divided:
+// lavapipe returns level 0's depth for textureDimensions(vol, level) of a 3D texture.
 fn opacity_code(vol: texture_3d<f32>, samp: sampler, k: u32, x: vec3<f32>, level: u32) -> f32 {
     let res = OPACITY_RES / f32(1u << level);
     let slices = f32(textureDimensions(vol).z >> level);
     let z = (f32(k) * res + clamp(x.z * res, 0.5, res - 0.5)) / slices;
     return textureSampleLevel(vol, samp, vec3<f32>(x.xy, z), f32(level)).r;
 }
+
+const LN_2: f32 = 0.6931472;
 
 // Where a view ray meets a tree whose image has no depth (a billboard, whose texels show
 // the crown's first surfaces): along unit `d` (object space, away from the eye) from the
@@ -137,7 +145,7 @@ fn median_depth_point(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<
                       max_depth: f32, p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     if (max_depth <= 0.0) { return p; }
     let front = p - d * sphere.w;
-    let u = (front - (sphere.xyz - vec3<f32>(sphere.w))) / (2.0 * sphere.w);
+    let u = opacity_cube_point(sphere, front);
     // The diameter is one cube side: 1 in cube units.
     let dt = 1.0 / f32(OPACITY_COARSE_STEPS);
     let per_step = max_depth * dt * OPACITY_RES;
@@ -154,8 +162,6 @@ fn median_depth_point(vol: texture_3d<f32>, samp: sampler, k: u32, sphere: vec4<
     }
     return p;
 }
-
-const LN_2: f32 = 0.6931472;
 
 // Object direction -> world direction (the instance's rotation about +Y).
 fn to_world_dir(inst: Instance, d: vec3<f32>) -> vec3<f32> {
