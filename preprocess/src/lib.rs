@@ -350,11 +350,12 @@ pub fn reference_vertices(mesh: &Mesh, sky: &[sky::TriangleSky]) -> Vec<RefVerte
 /// An upper estimate of a bake's peak memory (bytes) for a model of `model_bytes` bytes of
 /// OBJ text, built from what the bake holds at once and checked against measured peaks
 /// (`forest bake --json` reports both; 1.1–1.5× the measured peak on the bundled models at
-/// 128–1024 px): 52 B per layer pixel (the tracer's per-row slab images and the assembled
-/// ones, RGBA8 + f32 depth each, the atlas's mosaics, decoded copies and codec buffers), the
+/// 128–1024 px): 52 B per layer pixel (the tracer's tiles and the assembled slab images,
+/// RGBA8 + f32 depth each, the atlas's mosaics, decoded copies and codec buffers), the
 /// quad-tree moments of the layers built at once (`threads` of them, 72 B per finest quad and
 /// a third more for the coarser levels), about 10 B per byte of OBJ text for the mesh and its
-/// BVH, and 16 MiB for the program itself.
+/// BVH and 2 B more for one direction's piece footprints and tile bins (21 B per piece), and
+/// 16 MiB for the program itself.
 pub fn peak_bytes_estimate(
     params: &forest_format::BakeParams,
     model_bytes: u64,
@@ -364,5 +365,5 @@ pub fn peak_bytes_estimate(
     let layer_pixels = u64::from(params.layers()) * r * r;
     let finest = (r / u64::from(params.min_quad.max(1))).pow(2);
     let trees = threads.max(1).min(u64::from(params.layers())) * finest * 72 * 4 / 3;
-    52 * layer_pixels + trees + 10 * model_bytes + (16 << 20)
+    52 * layer_pixels + trees + 12 * model_bytes + (16 << 20)
 }

@@ -56,26 +56,35 @@ pub fn triangle_sky(scene: &Scene) -> Vec<TriangleSky> {
             for (side, normal) in [front, -front].into_iter().enumerate() {
                 let (mut seen, mut weight) = ([0f32; 3], [0f32; 3]);
                 let (mut seen_all, mut weight_all) = ([0f32; 3], [0f32; 3]);
-                for s in 0..n {
-                    let h = hash(ti as u32 ^ hash(s * 2 + side as u32));
-                    let u = ((s % SIDE) as f32 + unit(h)) / SIDE as f32;
-                    let v = ((s / SIDE) as f32 + unit(hash(h))) / SIDE as f32;
-                    let r = u.sqrt();
-                    let b = [1.0 - r, r * (1.0 - v), r * v];
-                    let p = t.p[0] * b[0] + t.p[1] * b[1] + t.p[2] * b[2];
-                    let uv = t.uv[0] * b[0] + t.uv[1] * b[1] + t.uv[2] * b[2];
-                    // The direction's stratum is a shuffle of the point's, so that directions
-                    // and points are both stratified but not correlated.
-                    let k = (s * 7 + 3) % n;
-                    let h2 = hash(h ^ 0x68e3_1da4);
-                    let du = Vec2::new(
-                        ((k % SIDE) as f32 + unit(h2)) / SIDE as f32,
-                        ((k / SIDE) as f32 + unit(hash(h2))) / SIDE as f32,
-                    );
-                    let dir = cosine_direction(normal, du);
+                let samples: Vec<([f32; 3], Vec3, Vec3, bool)> = (0..n)
+                    .map(|s| {
+                        let h = hash(ti as u32 ^ hash(s * 2 + side as u32));
+                        let u = ((s % SIDE) as f32 + unit(h)) / SIDE as f32;
+                        let v = ((s / SIDE) as f32 + unit(hash(h))) / SIDE as f32;
+                        let r = u.sqrt();
+                        let b = [1.0 - r, r * (1.0 - v), r * v];
+                        let p = t.p[0] * b[0] + t.p[1] * b[1] + t.p[2] * b[2];
+                        let uv = t.uv[0] * b[0] + t.uv[1] * b[1] + t.uv[2] * b[2];
+                        // The direction's stratum is a shuffle of the point's, so that
+                        // directions and points are both stratified but not correlated.
+                        let k = (s * 7 + 3) % n;
+                        let h2 = hash(h ^ 0x68e3_1da4);
+                        let du = Vec2::new(
+                            ((k % SIDE) as f32 + unit(h2)) / SIDE as f32,
+                            ((k / SIDE) as f32 + unit(hash(h2))) / SIDE as f32,
+                        );
+                        let opaque =
+                            !tested || mesh.alpha(t.material, uv) >= crate::mesh::ALPHA_CUTOFF;
+                        (b, p, cosine_direction(normal, du), opaque)
+                    })
+                    .collect();
+                // Transparent points count only where a vertex has no opaque one: trace them
+                // only then.
+                let all = (0..3)
+                    .any(|c| samples.iter().filter(|x| x.3).map(|x| x.0[c]).sum::<f32>() <= 0.0);
+                for &(b, p, dir, opaque) in samples.iter().filter(|x| all || x.3) {
                     let sky = !scene.occluded(p + normal * eps, dir, eps, f32::INFINITY, ti as u32);
                     let sky = f32::from(u8::from(sky));
-                    let opaque = !tested || mesh.alpha(t.material, uv) >= crate::mesh::ALPHA_CUTOFF;
                     for c in 0..3 {
                         seen_all[c] += b[c] * sky;
                         weight_all[c] += b[c];

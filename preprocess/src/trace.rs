@@ -59,18 +59,26 @@ impl Piece {
     }
 }
 
+/// Below this `|det| / (|e1|·|e2|)` (the sine of the angle between the ray and the
+/// triangle's plane, times the sine of the triangle's corner), a triangle counts as seen
+/// edge-on and is missed.
+pub const EDGE_ON: f32 = 1e-5;
+
 /// Möller–Trumbore: `(t, b1, b2)` when the ray hits the triangle within `[tmin, tmax]`.
 pub fn intersect(tri: &Tri, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<(f32, Vec2)> {
     intersect_piece(&Piece::new(tri, 0), o, d, tmin, tmax)
 }
 
 /// [`intersect`] on a piece's precomputed edges.
-#[inline]
+#[inline(always)]
 fn intersect_piece(t: &Piece, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<(f32, Vec2)> {
     let (e1, e2) = (t.e1, t.e2);
     let pv = d.cross(e2);
     let det = e1.dot(pv);
-    if det.abs() < 1e-20 {
+    // Seen edge-on (the ray within 1e-5 rad of the triangle's plane, or a degenerate
+    // triangle), the determinant is rounding noise and so would be the barycentrics: such a
+    // triangle covers no area, so it is missed.
+    if det * det <= EDGE_ON * EDGE_ON * e1.length_squared() * e2.length_squared() {
         return None;
     }
     let inv = 1.0 / det;
@@ -190,23 +198,57 @@ impl<'a> Scene<'a> {
         self.mesh.alpha(t.material, uv) >= ALPHA_CUTOFF
     }
 
+    /// Number of pieces the BVH holds: what [`Self::piece_points`] and
+    /// [`Self::piece_intersect`] index, in the BVH's leaf order (neighbours in space are
+    /// near in this order).
+    pub fn piece_count(&self) -> usize {
+        self.pieces.len()
+    }
+
+    /// Object-space corners of piece `id` (`id < piece_count()`).
+    pub fn piece_points(&self, id: usize) -> [Vec3; 3] {
+        let p = &self.pieces[id];
+        [p.p0, p.p0 + p.e1, p.p0 + p.e2]
+    }
+
+    /// The ray test of piece `id` alone, as [`Self::closest`] runs it: distance and the
+    /// piece's barycentrics when `o + t·d` crosses it with `t ∈ [tmin, tmax]`, before the
+    /// alpha test ([`Self::solid_hit`]).
+    #[inline]
+    pub fn piece_intersect(
+        &self,
+        id: usize,
+        o: Vec3,
+        d: Vec3,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(f32, Vec2)> {
+        intersect_piece(&self.pieces[id], o, d, tmin, tmax)
+    }
+
+    /// The hit on piece `id` at distance `t` and piece barycentrics `b`
+    /// ([`Self::piece_intersect`]) if its triangle is solid there (alpha test).
+    #[inline]
+    pub fn solid_hit(&self, id: usize, t: f32, b: Vec2) -> Option<Hit> {
+        let tri = self.pieces[id].tri;
+        let bary = self.triangle_bary(id, b);
+        self.solid(tri, bary).then_some(Hit { t, tri, bary })
+    }
+
     /// Closest alpha-tested hit along `o + t·d` (unit `d`) with `t ∈ [tmin, tmax]`.
     pub fn closest(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
         let ray = bvh_ray(o, d, tmin, tmax);
         let mut hit = RayHit::none();
         let mut last = (0u32, Vec2::ZERO);
         let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| {
-            let piece = &self.pieces[id];
-            match intersect_piece(piece, o, d, r.tmin, r.tmax) {
-                Some((t, b)) if t < r.tmax => {
-                    let b = self.triangle_bary(id, b);
-                    if self.solid(piece.tri, b) {
-                        last = (piece.tri, b);
+            match self.piece_intersect(id, o, d, r.tmin, r.tmax) {
+                Some((t, b)) if t < r.tmax => match self.solid_hit(id, t, b) {
+                    Some(h) => {
+                        last = (h.tri, h.bary);
                         t
-                    } else {
-                        f32::INFINITY
                     }
-                }
+                    None => f32::INFINITY,
+                },
                 _ => f32::INFINITY,
             }
         });

@@ -172,6 +172,49 @@ fn texel_normals_of_tilted_cards_match_the_geometry() {
 }
 
 #[test]
+fn the_piece_search_finds_the_ray_tracers_hits() {
+    // Visiting each piece's samples must give the slab images that tracing every sample's ray
+    // through the BVH gives: same hits, so byte-identical colour and surface and equal depth.
+    // Alpha-tested leaves (oak), several slabs, the zenith and nadir (axis-aligned views), and
+    // a sample count that shrinks the tiles.
+    let trees = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/trees");
+    for (model, slabs, resolution, spp) in [("oak/oak.obj", 2, 64, 4), ("bush/bush.obj", 3, 32, 64)]
+    {
+        let mesh = Mesh::load(&trees.join(model)).unwrap();
+        let scene = Scene::new(&mesh);
+        let sky = forest_bake::sky::triangle_sky(&scene);
+        let frames: Vec<_> = forest_format::directions::sampling_directions(3, 2)
+            .into_iter()
+            .map(DirectionFrame::new)
+            .collect();
+        let setup = ldi::SlabSetup {
+            sphere: forest_bake::bounding_sphere(&mesh),
+            frames: &frames,
+            slabs,
+            resolution,
+            spp,
+        };
+        assert!(ldi::tile_side(resolution, spp, slabs) < resolution);
+        let by = |search| ldi::trace_layers_by(search, &scene, &sky, &setup, &|_, _| {});
+        let (pieces, rays) = (by(ldi::HitSearch::Pieces), by(ldi::HitSearch::Rays));
+        let covered = rays.rgba.chunks_exact(4).filter(|p| p[3] > 0).count();
+        assert!(
+            covered > rays.rgba.len() / 4 / 20,
+            "{model}: {covered} covered texels"
+        );
+        let differ = pieces
+            .rgba
+            .chunks_exact(4)
+            .zip(rays.rgba.chunks_exact(4))
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "{model}: {differ} texels' colour differs");
+        assert!(pieces.surface == rays.surface, "{model}: surface differs");
+        assert!(pieces.depth == rays.depth, "{model}: depth differs");
+    }
+}
+
+#[test]
 fn sky_visibility_is_zero_inside_a_closed_box_and_one_outside() {
     // A cube: each face's inner side sees only the cube, its outer side the whole sky.
     let dir = tempfile::tempdir().unwrap();

@@ -223,7 +223,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
 
     let bar = crate::progress::bar(
         format!("tracing {}", args.model.display()),
-        "rows",
+        "tiles",
         args.json,
     );
     let progress = |done: u64, total: u64| {
