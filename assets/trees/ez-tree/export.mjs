@@ -36,6 +36,14 @@
 //                      with the preset's leaf size (4.5 units): the same
 //                      triangles, each leaf card about five times the area, the
 //                      bake's worst case (rays cross many transparent cards).
+//   --preset NAME --seed N
+//                      With --heavy: the same overrides on another ez-tree
+//                      preset and seed, written to DIR/<first word of NAME,
+//                      lower case>-heavy/ (or -dense/ with --dense): a
+//                      production-size tree of another kind, for checking the
+//                      bake on trees it was not tuned on. Example:
+//   node export.mjs --heavy --dense --preset 'Ash Large' --seed 777 --out /tmp/heavy
+//                      ->  /tmp/heavy/ash-dense/ (256 477 triangles)
 //
 // The output is deterministic: ez-tree uses its own seeded RNG, all numbers are
 // rounded to a fixed number of decimals, and the textures are re-encoded with
@@ -111,7 +119,7 @@ const NRM_DECIMALS = 4;
 const UV_DECIMALS = 4;
 
 function parseArgs(argv) {
-  const args = { textureSize: 512, out: null, heavy: false, dense: false };
+  const args = { textureSize: 512, out: null, heavy: false, dense: false, preset: null, seed: null };
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === '--texture-size') {
       args.textureSize = Number(argv[++i]);
@@ -125,11 +133,21 @@ function parseArgs(argv) {
       args.heavy = true;
     } else if (argv[i] === '--dense') {
       args.dense = true;
+    } else if (argv[i] === '--preset') {
+      args.preset = argv[++i];
+      if (!args.preset) throw new Error('--preset expects an ez-tree preset name');
+    } else if (argv[i] === '--seed') {
+      args.seed = Number(argv[++i]);
+      if (!Number.isInteger(args.seed) || args.seed < 0) {
+        throw new Error('--seed expects a non-negative integer');
+      }
     } else {
       throw new Error(`unknown argument ${argv[i]}`);
     }
   }
   if (args.dense && !args.heavy) throw new Error('--dense goes with --heavy');
+  if ((args.preset === null) !== (args.seed === null)) throw new Error('--preset and --seed go together');
+  if (args.preset !== null && !args.heavy) throw new Error('--preset goes with --heavy');
   return args;
 }
 const ARGS = parseArgs(process.argv.slice(2));
@@ -140,7 +158,15 @@ const OUT_ROOT = ARGS.out === null ? TREES : resolve(ARGS.out);
 if (ARGS.heavy && (ARGS.out === null || OUT_ROOT === TREES)) {
   throw new Error('--heavy needs --out DIR, not assets/trees itself (the heavy tree is not a bundled model)');
 }
-const HEAVY = ARGS.dense ? HEAVY_DENSE : HEAVY_SMALL_LEAVES;
+const HEAVY_BASE = ARGS.dense ? HEAVY_DENSE : HEAVY_SMALL_LEAVES;
+const HEAVY = ARGS.preset === null
+  ? HEAVY_BASE
+  : {
+      ...HEAVY_BASE,
+      name: `${ARGS.preset.split(' ')[0].toLowerCase()}-${ARGS.dense ? 'dense' : 'heavy'}`,
+      preset: ARGS.preset,
+      seed: ARGS.seed,
+    };
 const LIST = ARGS.heavy ? [HEAVY] : SPECIES;
 const PKG_DIR = join(HERE, 'node_modules', '@dgreenheck', 'ez-tree');
 const PKG = JSON.parse(readFileSync(join(PKG_DIR, 'package.json'), 'utf8'));
