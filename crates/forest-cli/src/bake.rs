@@ -181,7 +181,11 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     // Refuse what cannot fit before tracing for minutes and then failing an allocation.
     let model_bytes = std::fs::metadata(&args.model).map(|m| m.len()).unwrap_or(0);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u64);
-    let need = forest_bake::peak_bytes_estimate(&params, model_bytes, threads);
+    let mut need = forest_bake::peak_bytes_estimate(&params, model_bytes, threads);
+    if !args.no_hybrid_switch {
+        // The atlas stays in memory while the switch is measured.
+        need += crate::switch::peak_bytes_estimate(model_bytes);
+    }
     let limit = match args.memory_limit {
         Some(g) if g.is_finite() && g > 0.0 => Some((g * f64::from(1u32 << 30)) as u64),
         Some(g) => bail!("memory limit {g} GiB must be positive"),
