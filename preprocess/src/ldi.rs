@@ -109,10 +109,10 @@ pub enum HitSearch {
 }
 
 /// Largest tile side (pixels) the slab images are traced in.
-const MAX_TILE: u32 = 32;
+pub const MAX_TILE: u32 = 32;
 
 /// Bytes of per-sample hit records one tile may hold.
-const TILE_BYTES: u32 = 1 << 20;
+pub const TILE_BYTES: u32 = 1 << 20;
 
 /// Side in pixels of the square tiles traced as one task: [`MAX_TILE`] or less, a power of
 /// two no larger than the image, so that a tile's `(t, piece)` record per sample and slab
