@@ -111,7 +111,8 @@ pub enum HitSearch {
 /// Largest tile side (pixels) the slab images are traced in.
 pub const MAX_TILE: u32 = 32;
 
-/// Bytes of per-sample hit records one tile may hold.
+/// Bytes of per-sample `(t, piece)` records one tile may hold (its hits, 24 B per sample and
+/// slab, and its rays, 20 B per sample, come on top).
 pub const TILE_BYTES: u32 = 1 << 20;
 
 /// Side in pixels of the square tiles traced as one task: [`MAX_TILE`] or less, a power of
@@ -136,7 +137,8 @@ pub fn trace_layers(
     trace_layers_by(HitSearch::Pieces, scene, sky, setup, progress)
 }
 
-/// [`trace_layers`] with the hit search chosen.
+/// [`trace_layers`] with the hit search chosen. The resolution must be a power of two, as
+/// [`forest_format::BakeParams::validate`] requires, so that the tiles cover the image.
 pub fn trace_layers_by(
     search: HitSearch,
     scene: &Scene,
@@ -151,6 +153,10 @@ pub fn trace_layers_by(
         spp,
         ..
     } = *setup;
+    assert!(
+        resolution.is_power_of_two(),
+        "slab image resolution {resolution} is not a power of two"
+    );
     let r = resolution as usize;
     let layers = frames.len() as u32 * slabs;
     let side = tile_side(resolution, spp, slabs);
@@ -255,7 +261,7 @@ struct PieceBins {
     /// (`x0 > x1`) where the piece lies off the image.
     rects: Vec<[f32; 4]>,
     /// Tile `i`'s pieces are `ids[start[i]..start[i + 1]]`.
-    start: Vec<u32>,
+    start: Vec<usize>,
     ids: Vec<u32>,
 }
 
@@ -279,7 +285,7 @@ impl PieceBins {
             let t = |c: f32| ((c.max(0.0) as u32).min(setup.resolution - 1) / side) as usize;
             t(lo)..=t(hi)
         };
-        let mut start = vec![0u32; (per_row * per_row) as usize + 1];
+        let mut start = vec![0usize; (per_row * per_row) as usize + 1];
         for r in rects.iter().filter(|r| r[0] <= r[2]) {
             for ty in span(r[1], r[3]) {
                 for tx in span(r[0], r[2]) {
@@ -291,12 +297,12 @@ impl PieceBins {
             start[i] += start[i - 1];
         }
         let mut fill = start.clone();
-        let mut ids = vec![0u32; *start.last().unwrap_or(&0) as usize];
+        let mut ids = vec![0u32; *start.last().unwrap_or(&0)];
         for (id, r) in rects.iter().enumerate().filter(|(_, r)| r[0] <= r[2]) {
             for ty in span(r[1], r[3]) {
                 for tx in span(r[0], r[2]) {
                     let f = &mut fill[ty * per_row as usize + tx];
-                    ids[*f as usize] = id as u32;
+                    ids[*f] = id as u32;
                     *f += 1;
                 }
             }
@@ -306,7 +312,7 @@ impl PieceBins {
 
     /// Tile `i`'s pieces with their footprints, in piece order.
     fn tile(&self, i: usize) -> impl Iterator<Item = (usize, [f32; 4])> + '_ {
-        self.ids[self.start[i] as usize..self.start[i + 1] as usize]
+        self.ids[self.start[i]..self.start[i + 1]]
             .iter()
             .map(|&id| (id as usize, self.rects[id as usize]))
     }
@@ -330,7 +336,8 @@ struct Footprint {
     /// How far the footprint is widened (pixels).
     margin: f32,
     /// Edge functions `e_i(q) = a_i·q + c_i`, positive inside, scaled so that `|a_i| = 1`
-    /// (signed distance in pixels); `None` for an ill-conditioned piece.
+    /// (signed distance in pixels) and offset by each edge's widening; `None` for an
+    /// ill-conditioned piece.
     edges: Option<[(Vec2, f32); 3]>,
     /// `t(q) = g·q + t0` over the footprint's plane, with its error bound, for a
     /// well-conditioned piece.
@@ -347,25 +354,33 @@ impl Footprint {
             p[i] = Vec2::new(u * res, v * res);
             t[i] = d * diameter;
         }
-        // The ray test's conditioning, `|e1|·|e2| / |det|`: its barycentrics err by about
-        // 1e-7 times this, so the footprint is widened by 1e-5 times it (a hundredfold
-        // safety), in units of the piece's longest edge.
+        // The ray test's conditioning, `|e1|·|e2| / |det|`. Its barycentrics err by about 1e-7
+        // times this relative to the piece and, as the ray's origin lies up to a diameter away
+        // on the sphere's front plane, by about 1e-7 times this times the resolution in pixels:
+        // the footprint is widened by ten to a hundred times both.
         let (e1, e2) = (points[1] - points[0], points[2] - points[0]);
-        let det = e1.cross(e2).dot(frame.dir).abs();
-        let cond = (e1.length() * e2.length() / det).min(1.0 / crate::trace::EDGE_ON);
+        let signed_det = e1.cross(e2).dot(frame.dir);
+        let cond = (e1.length() * e2.length() / signed_det.abs()).min(1.0 / crate::trace::EDGE_ON);
         let longest = (0..3)
             .map(|i| (p[(i + 1) % 3] - p[i]).length())
             .fold(0.0f32, f32::max);
-        let margin = MARGIN + 1e-5 * cond * longest;
+        let margin = MARGIN + 1e-5 * cond * longest + 1e-6 * cond * res;
         let well = cond.is_finite() && cond < ILL_CONDITIONED;
         let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
-        let sign = if area < 0.0 { -1.0 } else { 1.0 };
+        // The orientation from the object-space determinant, which a sliver's rounded pixel
+        // corners can flip: (right, up, dir) is right-handed and pixel y runs down `up`.
+        let sign = if signed_det > 0.0 { -1.0 } else { 1.0 };
+        // The corners' own rounding (their coordinates reach the resolution), which turns a
+        // short edge's normal: its effect grows with the distance along that edge.
+        let rounding = 1e-6 * res;
         let edges = well.then(|| {
             [0, 1, 2].map(|i| {
                 let (a, b) = (p[i], p[(i + 1) % 3]);
                 let e = b - a;
-                let n = Vec2::new(-e.y, e.x) * (sign / e.length().max(1e-30));
-                (n, -n.dot(a))
+                let len = e.length().max(1e-30);
+                let n = Vec2::new(-e.y, e.x) * (sign / len);
+                let m = margin + rounding * (1.0 + 2.0 * longest / len);
+                (n, m - n.dot(a))
             })
         });
         let depth = well.then(|| {
@@ -428,7 +443,7 @@ impl Footprint {
     #[inline]
     fn may_cover(&self, q: Vec2) -> bool {
         self.edges
-            .is_none_or(|e| e.iter().all(|&(n, c)| n.dot(q) + c >= -self.margin))
+            .is_none_or(|e| e.iter().all(|&(n, c)| n.dot(q) + c >= 0.0))
     }
 
     /// Bounds on the ray test's distance at sample position `q`, for a well-conditioned piece.
@@ -551,7 +566,8 @@ fn tile_hits_by_rays(
                 if s + 1 >= slabs as usize {
                     break;
                 }
-                tmin = diameter * (s + 1) as f32 / slabs as f32;
+                // Past the slab's end, and past this hit should rounding put that end before it.
+                tmin = (diameter * (s + 1) as f32 / slabs as f32).max(hit.t.next_up());
             }
         }
     }
