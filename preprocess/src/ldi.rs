@@ -111,16 +111,19 @@ pub enum HitSearch {
 /// Largest tile side (pixels) the slab images are traced in.
 pub const MAX_TILE: u32 = 32;
 
-/// Bytes of per-sample `(t, piece)` records one tile may hold (its hits, 24 B per sample and
-/// slab, and its rays, 20 B per sample, come on top).
+/// Bytes of per-sample hit records one tile may hold (its rays, 20 B per sample, come on
+/// top).
 pub const TILE_BYTES: u32 = 1 << 20;
 
 /// Side in pixels of the square tiles traced as one task: [`MAX_TILE`] or less, a power of
-/// two no larger than the image, so that a tile's `(t, piece)` record per sample and slab
-/// (8 B each) stays within [`TILE_BYTES`].
+/// two no larger than the image, so that a tile's hit record per sample and slab (an
+/// `Option<Hit>`) stays within [`TILE_BYTES`].
 pub fn tile_side(resolution: u32, spp: u32, slabs: u32) -> u32 {
+    let record = std::mem::size_of::<Option<crate::trace::Hit>>() as u64;
     let mut side = MAX_TILE.min(resolution);
-    while side > 1 && u64::from(side * side) * u64::from(spp * slabs) * 8 > u64::from(TILE_BYTES) {
+    while side > 1
+        && u64::from(side * side) * u64::from(spp * slabs) * record > u64::from(TILE_BYTES)
+    {
         side /= 2;
     }
     side
@@ -478,7 +481,9 @@ fn tile_hits_by_pieces(
             sample_ray(setup, frame, tile.direction, x, y, k as u32)
         })
         .collect();
-    let mut best = vec![(f32::INFINITY, u32::MAX); side * side * spp * slabs];
+    // The nearest solid hit so far per sample and slab: a z-buffer per slab.
+    let mut best: TileHits = vec![None; side * side * spp * slabs];
+    let nearest = |h: &Option<crate::trace::Hit>| h.map_or(f32::INFINITY, |h| h.t);
     let ty1 = (tile.y0 + tile.side - 1) as f32;
     let res = setup.resolution as f32;
     for (id, r) in pieces {
@@ -511,7 +516,7 @@ fn tile_hits_by_pieces(
                     if let Some((lo, hi)) = foot.depth_bounds(at) {
                         let s = slab_of(lo, diameter, setup.slabs);
                         if s == slab_of(hi, diameter, setup.slabs)
-                            && lo >= best[(p * spp + k) * slabs + s].0
+                            && lo >= nearest(&best[(p * spp + k) * slabs + s])
                         {
                             continue;
                         }
@@ -520,24 +525,16 @@ fn tile_hits_by_pieces(
                         continue;
                     };
                     let cell = &mut best[(p * spp + k) * slabs + slab_of(t, diameter, setup.slabs)];
-                    if t < cell.0 && scene.solid_hit(id, t, b).is_some() {
-                        *cell = (t, id as u32);
+                    if t < nearest(cell)
+                        && let Some(hit) = scene.solid_hit(id, t, b)
+                    {
+                        *cell = Some(hit);
                     }
                 }
             }
         }
     }
-    best.iter()
-        .enumerate()
-        .map(|(i, &(_, id))| {
-            if id == u32::MAX {
-                return None;
-            }
-            let (o, _) = rays[i / slabs];
-            let (t, b) = scene.piece_intersect(id as usize, o, dir, 0.0, diameter)?;
-            scene.solid_hit(id as usize, t, b)
-        })
-        .collect()
+    best
 }
 
 /// [`HitSearch::Rays`] for one tile.

@@ -270,7 +270,7 @@ impl<'a> Scene<'a> {
                 return f32::INFINITY;
             }
             match intersect_piece(piece, o, d, r.tmin, r.tmax) {
-                Some((t, b)) if self.solid(piece.tri, self.triangle_bary(id, b)) => t,
+                Some((t, b)) if self.solid_hit(id, t, b).is_some() => t,
                 _ => f32::INFINITY,
             }
         })
