@@ -94,27 +94,46 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
         );
     }
     // The work columns, appended to Table 1, the path and the accuracy tables, with counts
-    // wherever the adapter has pipeline statistics; the work-against-accuracy charts.
+    // wherever the adapter has pipeline statistics, and the exact fragment counts of every
+    // row; the work-against-accuracy charts.
     let work = "dispatches,draws,vertex_invocations,primitives_rasterised,fragment_invocations,\
-                compute_invocations,gpu_mb,covered_pixels,fragments_per_covered_pixel,work_source";
+                compute_invocations,gpu_mb,covered_pixels,fragments_per_covered_pixel,work_source,\
+                exact_fragments_per_covered_pixel,exact_median,exact_p95,\
+                quad_lanes_per_covered_pixel,transparent_share,hidden_share";
     for f in ["table1.csv", "path.csv", "accuracy.csv"] {
         let text = std::fs::read_to_string(results.join(f)).unwrap();
         let head = text.lines().next().unwrap();
         assert!(head.ends_with(work), "{f}: {head}");
         for row in text.lines().skip(1) {
-            // The work cells are the last ten (earlier cells may hold quoted commas).
+            // The work cells are the last 16 (earlier cells may hold quoted commas).
             let cells: Vec<&str> = row.split(',').collect();
-            let k = cells.len() - 10;
+            let k = cells.len() - 16;
             let dispatches: u32 = cells[k].parse().unwrap_or_else(|_| panic!("{f}: {row}"));
             assert!(dispatches > 0, "{f}: {row}");
+            let covered: u64 = cells[k + 7].parse().unwrap();
             if cells[k + 9] == "pipeline statistics" {
                 let per_pixel = cells[k + 8];
-                let covered: u64 = cells[k + 7].parse().unwrap();
                 assert!(
                     covered == 0 || per_pixel.parse::<f64>().unwrap() >= 1.0,
                     "{f}: a covered pixel is shaded at least once: {row}"
                 );
             }
+            let exact: Vec<f64> = cells[k + 10..]
+                .iter()
+                .map(|c| c.parse().unwrap_or_else(|_| panic!("{f}: {row}")))
+                .collect();
+            let [mean, median, p95, lanes, transparent, hidden] = exact[..] else {
+                unreachable!()
+            };
+            if covered > 0 {
+                assert!(mean >= 1.0 && median >= 1.0 && p95 >= median, "{f}: {row}");
+                assert!(lanes >= mean, "{f}: a GPU runs whole 2×2 quads: {row}");
+            }
+            assert!(
+                (0.0..=1.0).contains(&transparent) && (0.0..=1.0).contains(&hidden),
+                "{f}: {row}"
+            );
+            assert!(transparent + hidden <= 1.0 + 1e-3, "{f}: {row}");
         }
     }
     // Every table counts the same way: the adapter has pipeline statistics for all or none.
@@ -124,7 +143,7 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
             let text = std::fs::read_to_string(results.join(f)).unwrap();
             text.lines()
                 .skip(1)
-                .map(|l| l.rsplit(',').next().unwrap().to_string())
+                .map(|l| l.split(',').rev().nth(6).unwrap().to_string())
                 .collect::<Vec<_>>()
         })
         .collect();

@@ -101,6 +101,60 @@ fn bake_scene_render_end_to_end() {
     assert_eq!(v["method"], "hybrid");
     assert!(v["geometry_trees"].as_u64().unwrap() > 0, "{v}");
     assert_eq!(v["quads"], 0, "every tree nearer than 1 km: {v}");
+    assert!(v.get("fragments").is_none(), "counted only when asked: {v}");
+    // Exact fragment counts and the overdraw view, for a quad method and a geometry one.
+    for method in ["quads", "lods"] {
+        let out = p(&format!("overdraw-{method}.png"));
+        let text = ok(&forest(&[
+            "render",
+            &p("small.json"),
+            "-o",
+            &out,
+            "--eye",
+            "0,2,30",
+            "--target",
+            "0,2,0",
+            "--size",
+            "64x48",
+            "--method",
+            method,
+            "--debug-view",
+            "overdraw",
+            "--json",
+            "--models",
+            &format!("{},{}", model("bush"), model("aspen")),
+        ]));
+        let v: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+        let f = &v["fragments"];
+        assert!(f["covered_pixels"].as_u64().unwrap() > 0, "{v}");
+        let mean = f["per_covered_mean"].as_f64().unwrap();
+        assert!(
+            mean >= 1.0 && f["quad_lanes_per_covered"].as_f64().unwrap() >= mean,
+            "{v}"
+        );
+        assert!(v["work"]["draws"].as_u64().unwrap() > 0, "{v}");
+        // The legend's band-0 swatch is black, its band-8 swatch white.
+        let img = image::open(&out).unwrap().to_rgba8();
+        let side = forest_render::passes::overdraw::legend_side(64);
+        assert_eq!(img.get_pixel(side / 2, 48 - 2 * side).0, [0, 0, 0, 255]);
+        assert_eq!(
+            img.get_pixel(8 * side + side / 2, 48 - 2 * side).0,
+            [255; 4]
+        );
+    }
+    let e = err(&forest(&[
+        "render",
+        &p("small.json"),
+        "-o",
+        &p("x.png"),
+        "--view",
+        "inside",
+        "--debug-view",
+        "overdraw",
+        "--supersample",
+        "2",
+    ]));
+    assert!(e.contains("without --supersample"), "{e}");
     let e = err(&forest(&[
         "render",
         &p("small.json"),

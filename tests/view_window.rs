@@ -258,6 +258,14 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     x.xdotool(&["key", "F12"]);
     let saved = v.wait_for("screenshot-001.png", 60);
     assert!(saved.contains("(impostor, debug view levels)"), "{saved}");
+    // V on through weights and wireframe to the overdraw view, which every method has: the
+    // heat map with its legend (checked below).
+    for _ in 0..3 {
+        x.xdotool(&["key", "v"]);
+    }
+    x.xdotool(&["key", "F12"]);
+    let saved = v.wait_for("screenshot-002.png", 60);
+    assert!(saved.contains("(impostor, debug view overdraw)"), "{saved}");
     // R records a path while walking sideways; R again saves it.
     x.xdotool(&["key", "r"]);
     x.xdotool(&["keydown", "d"]);
@@ -303,6 +311,31 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         std::thread::sleep(Duration::from_millis(100));
     };
     assert!(status.success(), "the viewer exited with {status}");
+
+    // The overdraw screenshot: the legend's swatches along the bottom edge, in the bands'
+    // colours.
+    let shot2 = image::open(shots.join("screenshot-002.png"))
+        .unwrap()
+        .to_rgba8();
+    let side = forest_render::passes::overdraw::legend_side(320);
+    for (b, c) in forest_render::passes::overdraw::OVERDRAW_COLOURS
+        .iter()
+        .enumerate()
+    {
+        let p = shot2.get_pixel(b as u32 * side + side / 2, 240 - 2 * side);
+        let want = c.map(|v| {
+            let s = if v <= 0.003_130_8 {
+                12.92 * v
+            } else {
+                1.055 * v.powf(1.0 / 2.4) - 0.055
+            };
+            (s * 255.0).round() as u8
+        });
+        assert!(
+            (0..3).all(|k| p[k].abs_diff(want[k]) <= 1),
+            "legend swatch {b}: {p:?}, want {want:?}"
+        );
+    }
 
     // The first screenshot is the path's last key, and looks like the stored reference.
     let (eye0, target0) = key_of(&shots.join("screenshot-000.json"));

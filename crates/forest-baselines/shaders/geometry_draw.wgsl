@@ -103,6 +103,7 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
 
 @fragment
 fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
+    count_enter(in.clip);
     if (quads_own(in.clip.xy, in.form)) { discard; }
     let m = materials[in.material];
     var albedo = m.kd.rgb;
@@ -123,7 +124,10 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
         sky = in.sky.y;
     }
     let c = shade_light(albedo, n, in.sun_vis, sky, m.kd.a);
-    return hazed(vec4<f32>(c, 1.0), in.world);
+    let out = hazed(vec4<f32>(c, 1.0), in.world);
+    count_shown(in.clip, out.a);
+    count_depth(in.clip);
+    return out;
 }
 
 struct BillboardOut {
@@ -190,6 +194,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
 
 @fragment
 fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
+    count_enter(in.clip);
     if (quads_own(in.clip.xy, in.form)) { discard; }
     let t = textureSample(billboards, tex_sampler, in.uv, in.layer);
     let g = textureSample(billboard_surface, tex_sampler, in.uv, in.layer);
@@ -205,5 +210,8 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
                                    in.sun_obj.w, in.obj, in.view_obj);
     let v = sun_transmittance_coarse(opacity, opacity_sampler, in.species, in.sphere,
                                      in.sun_obj.w, start, in.sun_obj.xyz);
-    return hazed(vec4<f32>(shade_light(t.rgb, n, v, g.z, g.w), 1.0), in.world);
+    let out = hazed(vec4<f32>(shade_light(t.rgb, n, v, g.z, g.w), 1.0), in.world);
+    count_shown(in.clip, out.a);
+    count_depth(in.clip);
+    return out;
 }

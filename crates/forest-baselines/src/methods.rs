@@ -113,6 +113,43 @@ impl ForestRenderer {
         }
     }
 
+    /// Count every method's tree fragments into `counter` from the next frame on, or stop
+    /// counting (`None`); see `forest_render::fragments`.
+    pub fn set_fragment_counter(
+        &mut self,
+        device: &wgpu::Device,
+        counter: Option<&forest_render::fragments::FragmentCounter>,
+    ) {
+        self.stream.set_fragment_counter(device, counter);
+        if let Some(g) = &mut self.geometry {
+            g.set_fragment_counter(device, counter);
+        }
+    }
+
+    /// The exact fragment counts of the current method's frame from `camera` into `target`
+    /// (drawn twice: see `FragmentCounter::count_frame`). Counting is on only for these two
+    /// frames.
+    pub fn count_fragments(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        target: &Target,
+    ) -> Result<forest_render::fragments::FragmentCounts, RenderError> {
+        let counter = forest_render::fragments::FragmentCounter::new(
+            &ctx.device,
+            target.size.0,
+            target.size.1,
+            self.stream.options_built().reverse_z,
+        )?;
+        forest_render::fragments::count_fragments(
+            ctx,
+            &counter,
+            self,
+            Self::set_fragment_counter,
+            |r| Ok(r.render_frame(ctx, camera, target)?),
+        )
+    }
+
     /// Whether frames gather pipeline statistics.
     pub fn pipeline_statistics(&self) -> bool {
         self.stream.pipeline_statistics()

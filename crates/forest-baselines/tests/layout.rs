@@ -88,9 +88,11 @@ fn geometry_structs_match_the_host() {
 
 #[test]
 fn shaders_validate() {
+    use forest_baselines::shaders::{GEOMETRY_CULL_WGSL, GEOMETRY_DRAW_WGSL};
     for src in [
-        forest_baselines::shaders::GEOMETRY_DRAW_WGSL.concat(),
-        forest_baselines::shaders::GEOMETRY_CULL_WGSL.concat(),
+        GEOMETRY_DRAW_WGSL.concat(),
+        forest_render::passes::counting_source(&GEOMETRY_DRAW_WGSL),
+        GEOMETRY_CULL_WGSL.concat(),
     ] {
         layout_check::validated(&src);
     }
@@ -111,6 +113,17 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
         &draw,
         &layout_check::layout_bindings(0, &draw_entries()),
         |_| true,
+    );
+    // The counting variant adds the counters as group 1.
+    let mut counted = layout_check::layout_bindings(0, &draw_entries());
+    counted.extend(layout_check::layout_bindings(
+        1,
+        &forest_render::fragments::layout_entries(),
+    ));
+    layout_check::check_layout(
+        &forest_render::passes::counting_source(&GEOMETRY_DRAW_WGSL),
+        &counted,
+        |e| e == "fs_geo" || e == "fs_billboard" || e.starts_with("vs_"),
     );
     assert_eq!(
         layout_check::wgsl_const(&cull, "BANDS"),

@@ -10,7 +10,9 @@ use forest_baselines::geometry::{
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
+use forest_render::fragments::{FragmentCounter, FragmentCounts, FragmentSummary};
 use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOptions};
+use forest_render::passes::overdraw::OverdrawPass;
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
@@ -65,6 +67,26 @@ pub struct RenderArgs {
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub supersample: u32,
+    /// Count every tree fragment exactly (each view is drawn twice more) and report the
+    /// fragments per covered pixel, the 2×2-quad lanes and the hidden and transparent shares.
+    #[arg(long)]
+    pub fragments: bool,
+    /// What the PNG shows: the image (`off`), or `overdraw`, a heat map of the fragments
+    /// shaded per pixel with a legend (implies --fragments; not with --supersample).
+    #[arg(long, default_value = "off", value_parser = ["off", "overdraw"])]
+    pub debug_view: String,
+}
+
+impl RenderArgs {
+    /// Whether the views are counted.
+    fn counts_fragments(&self) -> bool {
+        self.fragments || self.overdraw()
+    }
+
+    /// Whether the PNG is the overdraw view.
+    fn overdraw(&self) -> bool {
+        self.debug_view == "overdraw"
+    }
 }
 
 /// The light every method shades with (shared by `forest render`, `forest view` and the
@@ -550,6 +572,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !(1..=8).contains(&args.supersample) {
         bail!("supersample = {}: must be 1 to 8", args.supersample);
     }
+    if args.overdraw() && args.supersample > 1 {
+        bail!("--debug-view overdraw counts the pixels it shows: render it without --supersample");
+    }
     let mesh_method = args.m.checked_method(forest.species.len())?;
     let ctx = crate::gpu_context()?;
     if let Method::Hybrid(h) = args.m.chosen(mesh_method)? {
@@ -563,7 +588,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     render_views(args, &ctx, &cameras, |cam, target| {
         let stats = stream.render_fitted(&ctx, cam, target)?;
         let t = stats.times.unwrap_or_default();
+        let counted = count(
+            args,
+            &ctx,
+            target,
+            &mut stream,
+            QuadStream::set_fragment_counter,
+            |s| s.render_frame(&ctx, cam, target),
+        )?;
         Ok(ViewReport {
+            counted,
             json: serde_json::json!({
                 "visible_trees": stats.visible_trees, "quads": stats.quads,
                 "composited_quads": stats.composites,
@@ -591,10 +625,60 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 /// What one rendered view reports: its figures for `--json` (merged with the view's name,
-/// output, camera and adapter) and, without it, the middle of its line of text.
+/// output, camera and adapter) and, without it, the middle of its line of text; with
+/// `--fragments`, its exact counts and the counter that holds them.
 struct ViewReport {
     json: serde_json::Value,
     line: String,
+    counted: Option<(FragmentCounter, FragmentCounts)>,
+}
+
+/// With `--fragments` (or the overdraw view), the exact fragment counts of the view's frame:
+/// `renderer` attached to a counter of the target's size by `attach` and drawn twice more by
+/// `draw`.
+fn count<R, E>(
+    args: &RenderArgs,
+    ctx: &GpuContext,
+    target: &Target,
+    renderer: &mut R,
+    attach: fn(&mut R, &wgpu::Device, Option<&FragmentCounter>),
+    draw: impl FnMut(&mut R) -> Result<(), E>,
+) -> Result<Option<(FragmentCounter, FragmentCounts)>>
+where
+    anyhow::Error: From<E>,
+{
+    if !args.counts_fragments() {
+        return Ok(None);
+    }
+    let (w, h) = target.size;
+    let counter = FragmentCounter::new(&ctx.device, w, h, target_options(args).reverse_z)?;
+    let counts = forest_render::fragments::count_fragments(ctx, &counter, renderer, attach, draw)?;
+    Ok(Some((counter, counts)))
+}
+
+/// A counted frame's figures for `--json`.
+fn fragments_json(s: &FragmentSummary) -> serde_json::Value {
+    serde_json::json!({
+        "covered_pixels": s.covered_pixels, "fragments": s.fragments,
+        "per_covered_mean": s.per_covered_mean, "per_covered_median": s.per_covered_median,
+        "per_covered_p95": s.per_covered_p95,
+        "quad_lanes_per_covered": s.quad_lanes_per_covered,
+        "transparent_share": s.transparent_share, "hidden_share": s.hidden_share,
+    })
+}
+
+/// A counted frame's figures in words.
+fn fragments_line(s: &FragmentSummary) -> String {
+    format!(
+        "; {:.1} fragments per covered pixel (median {}, 95th percentile {}), {:.1} 2×2-quad lanes, {:.0} % transparent, {:.0} % hidden, over {} covered pixels",
+        s.per_covered_mean,
+        s.per_covered_median,
+        s.per_covered_p95,
+        s.quad_lanes_per_covered,
+        100.0 * s.transparent_share,
+        100.0 * s.hidden_share,
+        s.covered_pixels,
+    )
 }
 
 /// Render every camera through `frame` into one target of the rendered viewport (the
@@ -611,7 +695,17 @@ fn render_views(
     for (name, cam) in cameras {
         let mut cam = *cam;
         cam.viewport = (sw, sh);
-        let report = frame(&cam, &target)?;
+        let mut report = frame(&cam, &target)?;
+        if let Some((counter, counts)) = &report.counted {
+            if args.overdraw() {
+                overdraw_view(ctx, &target, counter);
+            }
+            let s = counts.summary();
+            report.line += &fragments_line(&s);
+            if let serde_json::Value::Object(o) = &mut report.json {
+                o.insert("fragments".into(), fragments_json(&s));
+            }
+        }
         let out = finish_view(ctx, &target, args, name, cameras.len())?;
         if args.json {
             let mut json = serde_json::json!({
@@ -635,6 +729,15 @@ fn render_views(
         }
     }
     Ok(())
+}
+
+/// Draw the overdraw view of `counter`'s counts over `target`, with its legend.
+fn overdraw_view(ctx: &GpuContext, target: &Target, counter: &FragmentCounter) {
+    let view = OverdrawPass::new(&ctx.device, target.format);
+    let binding = view.bind(&ctx.device, counter, true);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    view.encode(&mut enc, &target.colour_view, &binding);
+    ctx.queue.submit([enc.finish()]);
 }
 
 /// A frame's work for `--json`: dispatches, draws and bytes as recorded; the pipeline
@@ -696,7 +799,16 @@ fn render_hybrid(
         let t = stats.times.unwrap_or_default();
         let quads: u32 = stats.per_level.iter().sum();
         let triangles = stats.primitives - u64::from(quads);
+        let counted = count(
+            args,
+            ctx,
+            target,
+            &mut r,
+            ForestRenderer::set_fragment_counter,
+            |r| r.render_frame(ctx, cam, target),
+        )?;
         Ok(ViewReport {
+            counted,
             json: serde_json::json!({
                 "method": "hybrid",
                 "visible_trees": stats.visible_trees,
@@ -857,16 +969,27 @@ fn render_geometry(
     let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
     let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
+    geo.set_pipeline_statistics(args.json);
     render_views(args, ctx, cameras, |cam, target| {
         geo.render_frame(ctx, cam, target)?;
         let stats = geo.read_stats(ctx);
         let t = stats.times.unwrap_or_default();
+        let counted = count(
+            args,
+            ctx,
+            target,
+            &mut geo,
+            GeometryRenderer::set_fragment_counter,
+            |g| g.render_frame(ctx, cam, target),
+        )?;
         Ok(ViewReport {
+            counted,
             json: serde_json::json!({
                 "method": args.m.method,
                 "visible_trees": stats.visible_trees, "triangles": stats.triangles,
                 "billboards": stats.billboards, "per_band": stats.per_band,
                 "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
+                "work": work_json(&stats.work),
             }),
             line: format!(
                 "{} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms",

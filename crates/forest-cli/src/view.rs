@@ -40,8 +40,9 @@ pub struct ViewArgs {
     /// screenshot-NNN.json).
     #[arg(long, default_value = ".")]
     pub screenshots: PathBuf,
-    /// Debug view of the quad-stream methods: off, levels (quads coloured by level), weights
-    /// (by sampling direction, blended by aspect weight), wireframe (quad outlines).
+    /// Debug view: off; of the quad-stream methods levels (quads coloured by level), weights
+    /// (by sampling direction, blended by aspect weight), wireframe (quad outlines); of every
+    /// method overdraw (a heat map of the fragments shaded per pixel, counted exactly).
     #[arg(long, default_value = "off", value_parser = parse_debug_view)]
     pub debug_view: DebugView,
     /// Image size WIDTHxHEIGHT.
@@ -60,7 +61,7 @@ fn parse_debug_view(s: &str) -> Result<DebugView, String> {
     DebugView::ALL
         .into_iter()
         .find(|v| v.name().split(' ').next() == Some(s))
-        .ok_or_else(|| format!("{s:?}: expected off, levels, weights or wireframe"))
+        .ok_or_else(|| format!("{s:?}: expected off, levels, weights, wireframe or overdraw"))
 }
 
 /// The quad stream of `forest` for a colour format, sized for `viewport` and ε `min_epsilon`

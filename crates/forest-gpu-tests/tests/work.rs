@@ -19,38 +19,9 @@ const RECT_WGSL: &str = "
 @fragment fn fs() -> @location(0) vec4<f32> { return vec4<f32>(1.0); }
 ";
 
-/// Pixels shaded when fragments are shaded in aligned `b`×`b` blocks: the blocks that each of
-/// the rectangle's two triangles (strip order: corners (8,4) (40,4) (8,20), then (40,4)
-/// (8,20) (40,20)) covers with a pixel centre, summed over the triangles, times `b²`. No pixel
-/// centre lies on the shared diagonal (x + 2y = 46.5 there).
+/// Pixels shaded in aligned `b`×`b` blocks by [`RECT_WGSL`]'s rectangle.
 fn shaded_in_blocks(b: i32) -> u64 {
-    let inside = |p: [f32; 2], t: [[f32; 2]; 3]| {
-        let e = |a: [f32; 2], b: [f32; 2]| {
-            (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
-        };
-        let (d0, d1, d2) = (e(t[0], t[1]), e(t[1], t[2]), e(t[2], t[0]));
-        (d0 >= 0.0 && d1 >= 0.0 && d2 >= 0.0) || (d0 <= 0.0 && d1 <= 0.0 && d2 <= 0.0)
-    };
-    let tris = [
-        [[8.0, 4.0], [40.0, 4.0], [8.0, 20.0]],
-        [[40.0, 4.0], [8.0, 20.0], [40.0, 20.0]],
-    ];
-    let mut blocks = 0;
-    for t in tris {
-        for qy in 0..32 / b {
-            for qx in 0..64 / b {
-                let hit = (0..b * b).any(|k| {
-                    let (x, y) = (qx * b + k % b, qy * b + k / b);
-                    // Strictly inside the rectangle's pixel range, then the triangle.
-                    (8..40).contains(&x)
-                        && (4..20).contains(&y)
-                        && inside([x as f32 + 0.5, y as f32 + 0.5], t)
-                });
-                blocks += u64::from(hit);
-            }
-        }
-    }
-    blocks * (b * b) as u64
+    common::rectangle_shaded_in_blocks([8, 4, 40, 20], (64, 32), b)
 }
 
 #[test]
@@ -76,32 +47,7 @@ fn a_rectangle_of_known_size_shades_its_pixels() {
             bind_group_layouts: &[],
             immediate_size: 0,
         });
-    let pipeline = ctx
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("rectangle"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleStrip,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(TARGET_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+    let pipeline = common::strip_pipeline(&ctx, &module, &layout, None);
     let target = Target::new(&ctx, 64, 32);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     for q in [work::CULL, work::REFINE] {
@@ -110,22 +56,7 @@ fn a_rectangle_of_known_size_shades_its_pixels() {
         pass.end_pipeline_statistics_query();
     }
     {
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: None,
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.colour_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = common::cleared_pass(&mut enc, &target.colour_view);
         pass.set_pipeline(&pipeline);
         pass.begin_pipeline_statistics_query(&queries.set, work::DRAW);
         pass.draw(0..4, 0..1);

@@ -390,15 +390,19 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 
 @fragment
 fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
+    count_enter(in.clip);
     let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
     let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
                      in.frame_up, in.sun_vis);
-    return shade(f, lit_texel(f, c, g));
+    let out = shade(f, lit_texel(f, c, g));
+    count_shown(in.clip, out.a);
+    return out;
 }
 
 @fragment
 fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
+    count_enter(in.clip);
     // The slabs "over" each other from the front (premultiplied), at the quad's mip level.
     // Albedo and surface attributes are composited with the same weights, then lit once.
     var c = vec4<f32>(0.0);
@@ -419,7 +423,9 @@ fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
                                        in.sun_obj.w, p, in.sun_obj.xyz);
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
                      in.frame_up, vis);
-    return shade(f, lit_texel(f, c, g));
+    let out = shade(f, lit_texel(f, c, g));
+    count_shown(in.clip, out.a);
+    return out;
 }
 
 // A quad's fragment of lit colour `c` (premultiplied): the hybrid's and the dither's masks, the

@@ -50,6 +50,7 @@ pub mod capacity;
 pub mod context;
 pub mod error;
 pub mod forms;
+pub mod fragments;
 pub mod frame;
 pub mod gpu_types;
 pub mod opacity;

@@ -96,16 +96,30 @@ pub enum DebugView {
     Weights,
     /// The textured quads with their outlines drawn over them.
     Wireframe,
+    /// A heat map of the tree fragments shaded per pixel, for every method: the host counts
+    /// the frame ([`crate::fragments`]) and draws [`crate::passes::overdraw`] over it; the
+    /// stream itself draws as [`DebugView::Off`].
+    Overdraw,
 }
 
 impl DebugView {
     /// Every view, in the order the viewer cycles through them.
-    pub const ALL: [DebugView; 4] = [
+    pub const ALL: [DebugView; 5] = [
         DebugView::Off,
         DebugView::Levels,
         DebugView::Weights,
         DebugView::Wireframe,
+        DebugView::Overdraw,
     ];
+
+    /// The number the draw pass reads (the camera uniform's `viewport.z`); the host-drawn
+    /// overdraw view is 0, the stream's own colours.
+    pub fn shader_value(self) -> u32 {
+        match self {
+            DebugView::Overdraw => 0,
+            v => v as u32,
+        }
+    }
 
     /// Short name for menus and file names.
     pub fn name(self) -> &'static str {
@@ -114,6 +128,7 @@ impl DebugView {
             DebugView::Levels => "levels",
             DebugView::Weights => "blend weights",
             DebugView::Wireframe => "wireframe",
+            DebugView::Overdraw => "overdraw",
         }
     }
 }

@@ -75,6 +75,8 @@ fn readback<'a>(
 
 /// The quad stream of one view over a shared scene.
 pub struct QuadStream {
+    /// The counting quad pipelines and the counters' bind group, while counting fragments.
+    fragment_counts: Option<(crate::passes::draw::CountingDraw, wgpu::BindGroup)>,
     /// The uploaded scene (shared, immutable).
     pub scene: Arc<GpuScene>,
     /// Buffer sizes.
@@ -205,6 +207,7 @@ impl QuadStream {
         )?;
         let levels = scene.tables.max_levels;
         Ok(Self {
+            fragment_counts: None,
             iterations: if opts.refine {
                 levels.saturating_sub(1)
             } else {
@@ -651,7 +654,7 @@ impl QuadStream {
     }
 
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
-        g.viewport[2] = self.debug as u32 as f32;
+        g.viewport[2] = self.debug.shader_value() as f32;
         g.viewport[3] = self.options.flags() as f32;
         g.forms = self.forms;
         g.set_light(&self.light);
@@ -784,6 +787,21 @@ impl QuadStream {
         self.recorded.0.store(dispatches, Ordering::Relaxed);
     }
 
+    /// Count fragments into `counter` from the next frame on ([`crate::fragments`]), or stop
+    /// counting (`None`).
+    pub fn set_fragment_counter(
+        &mut self,
+        device: &wgpu::Device,
+        counter: Option<&crate::fragments::FragmentCounter>,
+    ) {
+        self.fragment_counts = counter.map(|c| {
+            (
+                self.passes.draw.counting(device, &self.opts),
+                c.bind_group().clone(),
+            )
+        });
+    }
+
     /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
     /// or an earlier encoder of the submission): back to front, blended, depth-tested, no
     /// depth written.
@@ -811,7 +829,10 @@ impl QuadStream {
             &self.sized.args,
             (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,
-            self.counting().map(|q| &q.set),
+            crate::passes::draw::Measured {
+                statistics: self.counting().map(|q| &q.set),
+                counted: self.fragment_counts.as_ref().map(|(d, b)| (d, b)),
+            },
         );
         self.recorded.1.store(draws, Ordering::Relaxed);
     }

@@ -45,8 +45,81 @@ fn draw_structs_match_the_host() {
 }
 
 #[test]
+fn counting_params_match_the_host() {
+    use forest_render::fragments::CountParams;
+    let counted = forest_render::passes::counting_source(&forest_render::passes::DRAW_WGSL);
+    check(
+        &counted,
+        &[(
+            "CountParams",
+            size_of::<CountParams>(),
+            vec![
+                ("width", offset_of!(CountParams, width)),
+                ("height", offset_of!(CountParams, height)),
+                ("phase", offset_of!(CountParams, phase)),
+                ("reverse_z", offset_of!(CountParams, reverse_z)),
+            ],
+        )],
+    );
+    assert_eq!(
+        layout_check::wgsl_const(&counted, "COUNT_STRIDE"),
+        forest_render::fragments::COUNT_STRIDE as f64
+    );
+}
+
+#[test]
+fn the_overdraw_view_matches_the_host() {
+    use forest_render::passes::overdraw::{OVERDRAW_COLOURS, OVERDRAW_WGSL, OverdrawParams};
+    check(
+        OVERDRAW_WGSL,
+        &[(
+            "OverdrawParams",
+            size_of::<OverdrawParams>(),
+            vec![
+                ("width", offset_of!(OverdrawParams, width)),
+                ("height", offset_of!(OverdrawParams, height)),
+                ("legend", offset_of!(OverdrawParams, legend)),
+                ("_pad", offset_of!(OverdrawParams, _pad)),
+            ],
+        )],
+    );
+    layout_check::check_layout(
+        OVERDRAW_WGSL,
+        &layout_check::layout_bindings(0, &forest_render::passes::overdraw::layout_entries()),
+        |_| true,
+    );
+    assert_eq!(
+        layout_check::wgsl_const(OVERDRAW_WGSL, "COUNT_STRIDE"),
+        forest_render::fragments::COUNT_STRIDE as f64
+    );
+    assert_eq!(
+        layout_check::wgsl_const(OVERDRAW_WGSL, "LABELLED_SIDE"),
+        f64::from(forest_render::passes::overdraw::LABELLED_SIDE)
+    );
+    assert_eq!(
+        layout_check::wgsl_const(OVERDRAW_WGSL, "BANDS"),
+        OVERDRAW_COLOURS.len() as f64
+    );
+    // The colour table, as the WGSL writes it.
+    let wgsl: String = OVERDRAW_WGSL
+        .split("const OVERDRAW_COLOURS")
+        .nth(1)
+        .and_then(|t| t.split(");").next())
+        .expect("OVERDRAW_COLOURS in the WGSL")
+        .to_string();
+    let numbers: Vec<f32> = wgsl
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter(|t| t.contains('.'))
+        .map(|t| t.parse().unwrap())
+        .collect();
+    assert_eq!(numbers, OVERDRAW_COLOURS.concat());
+}
+
+#[test]
 fn shaders_validate() {
-    for src in [compute_source(), draw_source()] {
+    layout_check::validated(forest_render::passes::overdraw::OVERDRAW_WGSL);
+    let counted = forest_render::passes::counting_source(&forest_render::passes::DRAW_WGSL);
+    for src in [compute_source(), draw_source(), counted] {
         layout_check::validated(&src);
     }
 }
@@ -69,6 +142,17 @@ fn bind_group_layouts_match_the_wgsl() {
         &draw_source(),
         &layout_check::layout_bindings(0, &bind_entries()),
         |_| true,
+    );
+    // The counting variant of the quad draws adds the counters as group 1.
+    let mut counted = layout_check::layout_bindings(0, &bind_entries());
+    counted.extend(layout_check::layout_bindings(
+        1,
+        &forest_render::fragments::layout_entries(),
+    ));
+    layout_check::check_layout(
+        &forest_render::passes::counting_source(&forest_render::passes::DRAW_WGSL),
+        &counted,
+        |e| ["vs_quad", "fs_quad", "vs_composite", "fs_composite"].contains(&e),
     );
 }
 

@@ -10,6 +10,7 @@ use forest_render::context::{GpuContext, RenderError};
 use forest_render::gpu_types::GpuCamera;
 use forest_render::options::RendererOptions;
 use forest_render::options::{Atmosphere, Background};
+use forest_render::passes::draw::draw_pipeline;
 use forest_render::stats::PassTimes;
 use forest_render::target::Target;
 use forest_render::work::{self, FrameWork, StatisticsQueries};
@@ -42,6 +43,13 @@ pub struct GeometryRenderer {
     billboard: wgpu::RenderPipeline,
     environment: wgpu::RenderPipeline,
     terrain_pipeline: wgpu::RenderPipeline,
+    /// The layout of the draw's group 0 and the targets' options, for the counting
+    /// pipelines built on demand ([`Self::set_fragment_counter`]).
+    draw_layout: wgpu::BindGroupLayout,
+    targets: RendererOptions,
+    /// The counting geometry and billboard pipelines and the counters' bind group, while
+    /// counting fragments.
+    fragment_counts: Option<([wgpu::RenderPipeline; 2], wgpu::BindGroup)>,
     terrain: forest_render::terrain::GpuTerrain,
     atmosphere: Atmosphere,
     compute_bg: wgpu::BindGroup,
@@ -91,7 +99,7 @@ impl GeometryRenderer {
         forest: &Forest,
         opts: &RendererOptions,
     ) -> Result<Self, RenderError> {
-        let (format, background) = (opts.format, opts.background);
+        let background = opts.background;
         let PreparedGeometry {
             vertices,
             geo_species,
@@ -301,54 +309,29 @@ impl GeometryRenderer {
             bind_group_layouts: &[Some(&draw_layout)],
             immediate_size: 0,
         });
-        let render_pipeline =
-            |vs: &str, fs: &str, topology, layout: Option<&wgpu::PipelineLayout>| {
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(vs),
-                    layout,
-                    vertex: wgpu::VertexState {
-                        module: &draw_module,
-                        entry_point: Some(vs),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: wgpu::PrimitiveState {
-                        topology,
-                        cull_mode: None,
-                        ..Default::default()
-                    },
-                    depth_stencil: Some(opts.depth_stencil(true)),
-                    multisample: opts.multisample(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &draw_module,
-                        entry_point: Some(fs),
-                        compilation_options: Default::default(),
-                        targets: &[Some(wgpu::ColorTargetState {
-                            format,
-                            blend: None,
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            };
+        let render_pipeline = |vs: &str, fs: &str, topology, layout: &wgpu::PipelineLayout| {
+            draw_pipeline(
+                device,
+                opts,
+                layout,
+                &draw_module,
+                topology,
+                [vs, fs],
+                None,
+                true,
+            )
+        };
         use wgpu::PrimitiveTopology as T;
-        let draw = render_pipeline("vs_geo", "fs_geo", T::TriangleList, Some(&draw_pl));
-        let billboard = render_pipeline(
-            "vs_billboard",
-            "fs_billboard",
-            T::TriangleList,
-            Some(&draw_pl),
-        );
+        let draw = render_pipeline("vs_geo", "fs_geo", T::TriangleList, &draw_pl);
+        let billboard = render_pipeline("vs_billboard", "fs_billboard", T::TriangleList, &draw_pl);
         let environment = render_pipeline(
             "vs_environment",
             "fs_environment",
             T::TriangleList,
-            Some(&draw_pl),
+            &draw_pl,
         );
         let terrain_pipeline =
-            render_pipeline("vs_terrain", "fs_terrain", T::TriangleList, Some(&draw_pl));
+            render_pipeline("vs_terrain", "fs_terrain", T::TriangleList, &draw_pl);
         let terrain = forest_render::terrain::GpuTerrain::new(device, forest.terrain.as_ref())?;
         gpu_bytes.set(gpu_bytes.get() + terrain.bytes());
         let environment_buf = init(
@@ -428,6 +411,9 @@ impl GeometryRenderer {
             billboard,
             environment,
             terrain_pipeline,
+            draw_layout,
+            targets: opts.clone(),
+            fragment_counts: None,
             terrain,
             atmosphere: opts.atmosphere,
             compute_bg,
@@ -609,6 +595,49 @@ impl GeometryRenderer {
         }
     }
 
+    /// Count the trees' fragments into `counter` from the next frame on
+    /// (`forest_render::fragments`), or stop counting (`None`). The counting pipelines are
+    /// built here; the frame's own pipelines are untouched.
+    pub fn set_fragment_counter(
+        &mut self,
+        device: &wgpu::Device,
+        counter: Option<&forest_render::fragments::FragmentCounter>,
+    ) {
+        self.fragment_counts = counter.map(|c| {
+            let counts = forest_render::fragments::bind_layout(device);
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("counted geometry draw"),
+                bind_group_layouts: &[Some(&self.draw_layout), Some(&counts)],
+                immediate_size: 0,
+            });
+            let source =
+                forest_render::passes::counting_source(&crate::shaders::GEOMETRY_DRAW_WGSL);
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("counted geometry draw"),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            let pipeline = |entries| {
+                draw_pipeline(
+                    device,
+                    &self.targets,
+                    &layout,
+                    &module,
+                    wgpu::PrimitiveTopology::TriangleList,
+                    entries,
+                    None,
+                    true,
+                )
+            };
+            (
+                [
+                    pipeline(["vs_geo", "fs_geo"]),
+                    pipeline(["vs_billboard", "fs_billboard"]),
+                ],
+                c.bind_group().clone(),
+            )
+        });
+    }
+
     /// Record the draw into a render pass after [`Self::encode_compute`]: the environment (sky
     /// and ground, when `ground` and the background is the sky), then the bands nearest first.
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
@@ -624,13 +653,20 @@ impl GeometryRenderer {
         if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
         }
+        let [draw, billboard] = match &self.fragment_counts {
+            Some(([draw, billboard], counts)) => {
+                pass.set_bind_group(1, counts, &[]);
+                [draw, billboard]
+            }
+            None => [&self.draw, &self.billboard],
+        };
         let first_billboard = self.method.first_billboard_band();
         for band in 0..BANDS {
             if band == 0 {
-                pass.set_pipeline(&self.draw);
+                pass.set_pipeline(draw);
             }
             if band == first_billboard {
-                pass.set_pipeline(&self.billboard);
+                pass.set_pipeline(billboard);
             }
             for s in 0..self.species {
                 pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);

@@ -281,7 +281,11 @@ pub fn run(b: &Bench) -> Result<Section> {
                 // transparent, so the image's alpha is the coverage.
                 let img = target.read(&b.ctx);
                 let m = forest_metrics::compare(reference, &img)?;
-                work.push((s.work.clone(), super::covered(&img)));
+                work.push(super::ViewWork {
+                    work: s.work.clone(),
+                    covered: super::covered(&img),
+                    counts: b.count(&mut r, &c, &target)?,
+                });
                 frame_ms += t;
                 flip += f64::from(m.flip_mean);
                 ssim += m.ssim;
@@ -419,23 +423,36 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
             charts.push(stem);
         }
     }
-    // Fragments shaded per covered pixel in the walkthrough: each method's median setting.
+    // Fragments shaded per covered pixel in the walkthrough, each method's first setting:
+    // lavapipe's stamps, and the exact counts (invocations, 2×2-quad lanes, the shares that
+    // showed nothing or were hidden) where the table has them.
     let overdraw = {
-        let k = COLUMNS.len() + 8;
-        let mut out = Vec::new();
+        let k = COLUMNS.len();
+        let num = |row: &[String], i: usize| row.get(k + i).and_then(|c| c.parse::<f64>().ok());
+        let mut out: Vec<String> = Vec::new();
+        let mut seen: Vec<&str> = Vec::new();
         for row in table.rows.iter().filter(|r| r[2] == "walkthrough") {
-            if let Some(f) = row.get(k).and_then(|c| c.parse::<f64>().ok())
-                && !out
-                    .iter()
-                    .any(|(m, _, _): &(String, String, f64)| *m == row[0])
-            {
-                out.push((row[0].clone(), row[1].clone(), f));
+            let Some(stamps) = num(row, 8) else { continue };
+            if seen.contains(&row[0].as_str()) {
+                continue;
             }
+            seen.push(&row[0]);
+            let exact = match (num(row, 10), num(row, 13), num(row, 14), num(row, 15)) {
+                (Some(f), Some(q), Some(t), Some(h)) => format!(
+                    "; exactly {f:.1} fragments ({:.1}× the limit of one), {q:.1} 2×2-quad \
+                     lanes, {:.0} % transparent, {:.0} % hidden",
+                    f,
+                    100.0 * t,
+                    100.0 * h
+                ),
+                _ => String::new(),
+            };
+            out.push(format!(
+                "{} ({}) {stamps:.2} stamp fragments{exact}",
+                row[0], row[1]
+            ));
         }
-        out.iter()
-            .map(|(m, p, f)| format!("{m} ({p}) {f:.2}"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        out.join("; ")
     };
     // The hybrid against the quad stream in the walkthrough, at the same ε.
     let walk_rows: Vec<&Vec<String>> = table
@@ -475,8 +492,10 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
          {walk_ratio}.\n\nThe work charts put the same settings against the shader \
          invocations a frame asks of a GPU (pipeline-statistics queries), which a CPU \
          rasteriser's times distort: it charges triangles far more than a GPU does. Fragments \
-         shaded per covered pixel in the walkthrough (first setting of each method; lavapipe \
-         counts fragments per 4×4 stamp): {overdraw}.\n\n{}",
+         shaded per covered pixel in the walkthrough (first setting of each method; lavapipe's \
+         pipeline statistics count fragments per 4×4 stamp; the exact counts are tree \
+         fragment invocations, helper lanes excluded, per pixel covered by a shown fragment, \
+         and the 2×2-quad lanes a GPU would run): {overdraw}.\n\n{}",
         viewport.0,
         viewport.1,
         summary
@@ -502,9 +521,14 @@ pub fn redraw(b: &Bench) -> Result<Section> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
     // Files written before the work columns were added have the first columns only.
-    let mut table = Table::new(&columns());
+    // Or before the exact fragment counts: the first ten work columns.
+    let all = columns();
+    let before_exact = &all[..COLUMNS.len() + 10];
+    let mut table = Table::new(&all);
     if header == COLUMNS {
         table = Table::new(&COLUMNS);
+    } else if header == before_exact {
+        table = Table::new(before_exact);
     } else if header != table.header {
         anyhow::bail!("{}: unexpected columns {header:?}", path.display());
     }

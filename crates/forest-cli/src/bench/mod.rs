@@ -24,6 +24,7 @@ use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::forest::Forest;
 use forest_format::generate::{GenerateParams, generate};
+use forest_render::fragments::{FragmentCounts, FragmentSummary};
 use forest_render::options::{Background, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::stats::PassTimes;
@@ -357,28 +358,50 @@ impl Bench {
         ))
     }
 
-    /// The work `method` asks of the GPU for `cam` and the pixels it covers: one more frame,
-    /// over a transparent background (its alpha is the coverage) and with pipeline
-    /// statistics on; the renderer's background and statistics are restored after. Timed
-    /// frames ([`Self::measure`]) run as the renderer is set (statistics off unless a suite
-    /// turned them on).
+    /// The work `method` asks of the GPU for `cam`, the pixels it covers and its exact
+    /// fragment counts: one more frame, over a transparent background (its alpha is the
+    /// coverage) and with pipeline statistics on, then that frame counted
+    /// ([`ForestRenderer::count_fragments`]: two more); the renderer's background and
+    /// statistics are restored after. Timed frames ([`Self::measure`]) run as the renderer is
+    /// set (statistics off unless a suite turned them on).
     pub fn work(
         &self,
         r: &mut ForestRenderer,
         method: Method,
         cam: &Camera,
         target: &Target,
-    ) -> Result<(FrameWork, u64)> {
+    ) -> Result<ViewWork> {
         let (background, counting) = (r.background(), r.pipeline_statistics());
         r.set_method(&self.ctx, method)?;
         r.set_background(Background::Transparent);
         r.set_pipeline_statistics(true);
-        let drawn = r.render_fitted(&self.ctx, cam, target);
+        let drawn = r.render_fitted(&self.ctx, cam, target).and_then(|stats| {
+            let covered = covered(&target.read(&self.ctx));
+            let counts = r.count_fragments(&self.ctx, cam, target)?;
+            Ok((stats, covered, counts))
+        });
         r.set_background(background);
         r.set_pipeline_statistics(counting);
-        let stats = drawn?;
+        let (stats, covered, counts) = drawn?;
         self.ctx.check_errors()?;
-        Ok((stats.work, covered(&target.read(&self.ctx))))
+        Ok(ViewWork {
+            work: stats.work,
+            covered,
+            counts,
+        })
+    }
+
+    /// The exact fragment counts of `r`'s current method for `cam`, drawn as the renderer is
+    /// set (two frames; see [`ForestRenderer::count_fragments`]).
+    pub fn count(
+        &self,
+        r: &mut ForestRenderer,
+        cam: &Camera,
+        target: &Target,
+    ) -> Result<FragmentCounts> {
+        let counts = r.count_fragments(&self.ctx, cam, target)?;
+        self.ctx.check_errors()?;
+        Ok(counts)
     }
 
     /// Frames to measure for a method: one for full geometry and stochastic simplification on
@@ -411,13 +434,27 @@ impl Bench {
     }
 }
 
+/// What one view's frame asked of the GPU ([`Bench::work`]).
+pub struct ViewWork {
+    /// Recorded commands and pipeline statistics.
+    pub work: FrameWork,
+    /// Pixels the trees cover (alpha of the method's transparent render).
+    pub covered: u64,
+    /// Exact per-pixel fragment counts ([`forest_render::fragments`]).
+    pub counts: FragmentCounts,
+}
+
 /// Columns of the work a frame asked of the GPU, appended to the suites' tables (see
 /// [`forest_render::work`]): recorded dispatches and draws; vertex and fragment shader
 /// invocations, rasterised primitives and compute invocations from pipeline-statistics
 /// queries (empty where the adapter has none; lavapipe counts fragments per 4×4 stamp, GPUs
 /// per 2×2 quad); MB of buffers and textures the frame can touch; the pixels the trees cover
-/// (alpha of the method's transparent render) and fragments shaded per covered pixel.
-pub const WORK_COLUMNS: [&str; 10] = [
+/// (alpha of the method's transparent render) and stamp fragments per covered pixel. Then the
+/// exact counts ([`forest_render::fragments`]): tree fragment invocations per covered pixel
+/// (mean, median, 95th percentile over covered pixels), the 2×2-quad lanes a GPU would run
+/// per covered pixel, and the shares of invocations that showed nothing (transparent) or were
+/// shown behind an opaque fragment (hidden).
+pub const WORK_COLUMNS: [&str; 16] = [
     "dispatches",
     "draws",
     "vertex_invocations",
@@ -428,20 +465,27 @@ pub const WORK_COLUMNS: [&str; 10] = [
     "covered_pixels",
     "fragments_per_covered_pixel",
     "work_source",
+    "exact_fragments_per_covered_pixel",
+    "exact_median",
+    "exact_p95",
+    "quad_lanes_per_covered_pixel",
+    "transparent_share",
+    "hidden_share",
 ];
 
-/// The [`WORK_COLUMNS`] cells of frames' work, each with the pixels it covered: means over
-/// the frames (one frame: its counts), fragments per covered pixel as a ratio of sums.
-pub fn work_cells(frames: &[(FrameWork, u64)]) -> Vec<String> {
-    let n = frames.len().max(1) as u64;
-    let mean = |f: &dyn Fn(&FrameWork) -> u64| frames.iter().map(|(w, _)| f(w)).sum::<u64>() / n;
-    let stats: Option<Vec<_>> = frames.iter().map(|(w, _)| w.total()).collect();
+/// The [`WORK_COLUMNS`] cells of views' work: means over the views (one view: its counts),
+/// fragments per covered pixel as a ratio of sums, the exact counts of all views' pixels
+/// pooled ([`FragmentSummary::pooled`]).
+pub fn work_cells(views: &[ViewWork]) -> Vec<String> {
+    let n = views.len().max(1) as u64;
+    let mean = |f: &dyn Fn(&FrameWork) -> u64| views.iter().map(|v| f(&v.work)).sum::<u64>() / n;
+    let stats: Option<Vec<_>> = views.iter().map(|v| v.work.total()).collect();
     let stat = |f: fn(&forest_render::work::PassWork) -> u64| {
         stats.as_ref().map_or(String::new(), |t| {
             (t.iter().map(f).sum::<u64>() / n).to_string()
         })
     };
-    let covered: u64 = frames.iter().map(|(_, c)| c).sum();
+    let covered: u64 = views.iter().map(|v| v.covered).sum();
     let per_pixel = stats
         .as_ref()
         .filter(|_| covered > 0)
@@ -449,6 +493,8 @@ pub fn work_cells(frames: &[(FrameWork, u64)]) -> Vec<String> {
             let fragments: u64 = t.iter().map(|t| t.fragment_invocations).sum();
             format!("{:.3}", fragments as f64 / covered as f64)
         });
+    let counts: Vec<FragmentCounts> = views.iter().map(|v| v.counts.clone()).collect();
+    let exact = FragmentSummary::pooled(&counts);
     vec![
         mean(&|w| u64::from(w.dispatches)).to_string(),
         mean(&|w| u64::from(w.draws)).to_string(),
@@ -464,6 +510,12 @@ pub fn work_cells(frames: &[(FrameWork, u64)]) -> Vec<String> {
         } else {
             "recorded commands".into()
         },
+        format!("{:.3}", exact.per_covered_mean),
+        exact.per_covered_median.to_string(),
+        exact.per_covered_p95.to_string(),
+        format!("{:.3}", exact.quad_lanes_per_covered),
+        format!("{:.4}", exact.transparent_share),
+        format!("{:.4}", exact.hidden_share),
     ]
 }
 

@@ -128,8 +128,9 @@ pub fn run(b: &Bench) -> Result<Section> {
             let c = |k: usize| r.get(10 + k).map_or("", String::as_str);
             format!(
                 "{} trees, {}: {} dispatches, {} vertex and {} fragment invocations for {} \
-                 covered pixels ({} fragments per covered pixel), {} compute invocations, \
-                 {} MB",
+                 covered pixels ({} stamp fragments per covered pixel; exactly {} fragment \
+                 invocations, median {}, 95th percentile {}, and {} 2×2-quad lanes; {} of \
+                 them transparent and {} hidden), {} compute invocations, {} MB",
                 r[0],
                 r[1],
                 c(0),
@@ -137,6 +138,12 @@ pub fn run(b: &Bench) -> Result<Section> {
                 c(4),
                 c(7),
                 c(8),
+                c(10),
+                c(11),
+                c(12),
+                c(13),
+                c(14),
+                c(15),
                 c(5),
                 c(6)
             )

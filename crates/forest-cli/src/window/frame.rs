@@ -57,7 +57,25 @@ impl Viewer {
                 g.renderer.set_light(light)?;
             }
             g.renderer.set_pipeline_statistics(self.count_work);
-            g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
+            if self.debug == DebugView::Overdraw {
+                // The counted frame's two draws (forest_render::fragments), then the heat
+                // map over the second.
+                super::overdraw(&mut g)?;
+                let o = g.overdraw.as_ref().expect("made above");
+                o.counter.begin(&g.ctx);
+                let mut first = g.ctx.device.create_command_encoder(&Default::default());
+                g.renderer
+                    .encode(&g.ctx, &cam, &mut first, &view, &g.depth)?;
+                g.ctx.queue.submit([first.finish()]);
+                let o = g.overdraw.as_ref().expect("made above");
+                o.counter
+                    .set_phase(&g.ctx.queue, forest_render::fragments::Phase::Hidden);
+                g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
+                let o = g.overdraw.as_ref().expect("made above");
+                o.pass.encode(&mut enc, &view, &o.binding);
+            } else {
+                g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
+            }
             let raw = g.egui_state.take_egui_input(&g.window);
             let ui_ctx = g.egui.clone();
             let mut choice = (None, None);
@@ -86,23 +104,7 @@ impl Viewer {
                 &screen,
             );
             {
-                let mut pass = enc
-                    .begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("hud"),
-                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                            view: &view,
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load: wgpu::LoadOp::Load,
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })],
-                        depth_stencil_attachment: None,
-                        timestamp_writes: None,
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    })
+                let mut pass = forest_render::target::begin_overlay_pass(&mut enc, "hud", &view)
                     .forget_lifetime();
                 g.egui_renderer.render(&mut pass, &jobs, &screen);
             }

@@ -107,7 +107,7 @@ impl Viewer {
                         method = Some(i);
                     }
                 }
-                ui.label("debug view (quad-stream methods):");
+                ui.label("debug view (levels, weights, wireframe: quad-stream methods):");
                 ui.horizontal(|ui| {
                     for v in DebugView::ALL {
                         if ui.radio(v == self.debug, v.name()).clicked() {

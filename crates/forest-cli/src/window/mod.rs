@@ -76,6 +76,16 @@ struct Gfx {
     egui: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
+    /// The overdraw view's counters (of the surface's size, attached to the renderer) and
+    /// pass, while it is shown; made again after a resize.
+    overdraw: Option<Overdraw>,
+}
+
+/// What the overdraw view draws with.
+struct Overdraw {
+    counter: forest_render::fragments::FragmentCounter,
+    pass: forest_render::passes::overdraw::OverdrawPass,
+    binding: forest_render::passes::overdraw::OverdrawBinding,
 }
 
 /// What a viewer starts with.
@@ -327,6 +337,7 @@ impl Viewer {
             egui,
             egui_state,
             egui_renderer,
+            overdraw: None,
         });
         Ok(())
     }
@@ -355,6 +366,8 @@ impl Viewer {
             return Ok(());
         };
         // The stream's own buffers grow; the scene on the GPU is kept as it is.
+        // Counting pipelines are made again for the stream's new passes.
+        detach_overdraw(g);
         match g.renderer.stream.resize_for(&g.ctx.device, wish.0, wish.1) {
             Ok(()) => {
                 let quads = g.renderer.stream.capacity.quads;
@@ -382,6 +395,9 @@ impl Viewer {
         self.debug = v;
         if let Some(g) = &mut self.gfx {
             g.renderer.stream.set_debug_view(v);
+            if v != DebugView::Overdraw {
+                detach_overdraw(g);
+            }
         }
     }
 
@@ -454,6 +470,37 @@ impl Viewer {
     }
 }
 
+/// Stop counting fragments: the overdraw view's counters are dropped.
+fn detach_overdraw(g: &mut Gfx) {
+    if g.overdraw.take().is_some() {
+        g.renderer.set_fragment_counter(&g.ctx.device, None);
+    }
+}
+
+/// Make the overdraw view's counters for the surface's size and attach them to the renderer,
+/// when missing.
+fn overdraw(g: &mut Gfx) -> Result<()> {
+    if g.overdraw.is_none() {
+        let counter = forest_render::fragments::FragmentCounter::new(
+            &g.ctx.device,
+            g.config.width,
+            g.config.height,
+            g.renderer.stream.options_built().reverse_z,
+        )?;
+        let pass =
+            forest_render::passes::overdraw::OverdrawPass::new(&g.ctx.device, g.config.format);
+        let binding = pass.bind(&g.ctx.device, &counter, true);
+        g.renderer
+            .set_fragment_counter(&g.ctx.device, Some(&counter));
+        g.overdraw = Some(Overdraw {
+            counter,
+            pass,
+            binding,
+        });
+    }
+    Ok(())
+}
+
 /// A renderer of `stream` and `geometry` showing `method` and `debug`.
 fn assemble(
     ctx: &GpuContext,
@@ -515,6 +562,7 @@ impl ApplicationHandler for Viewer {
                     g.config.height = size.height.max(1);
                     g.surface.configure(&g.ctx.device, &g.config);
                     g.depth = depth_view(&g.ctx, &g.config);
+                    detach_overdraw(g);
                 }
                 Ok(())
             }

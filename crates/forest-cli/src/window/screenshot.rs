@@ -21,6 +21,19 @@ impl Viewer {
             g.config.format,
         )?;
         g.renderer.render_fitted(&g.ctx, &cam, &target)?;
+        if self.debug == forest_render::DebugView::Overdraw {
+            // The view counted as the window counts it, the heat map over it.
+            if g.overdraw.as_ref().map(|o| o.counter.size()) != Some(cam.viewport) {
+                super::detach_overdraw(g);
+            }
+            super::overdraw(g)?;
+            let o = g.overdraw.as_ref().expect("made above");
+            o.counter
+                .count_frame(&g.ctx, || g.renderer.render_frame(&g.ctx, &cam, &target))?;
+            let mut enc = g.ctx.device.create_command_encoder(&Default::default());
+            o.pass.encode(&mut enc, &target.colour_view, &o.binding);
+            g.ctx.queue.submit([enc.finish()]);
+        }
         let img = target.read(&g.ctx);
         g.ctx.check_errors()?;
         // The next number whose image and camera files are both free: earlier screenshots

@@ -223,3 +223,107 @@ pub fn small_stream(
     let stream = forest_render::QuadStream::new(&ctx.device, scene, &opts).unwrap();
     (stream, forest_render::target::Target::new(ctx, 160, 120))
 }
+
+/// Pixels shaded when fragments are shaded in aligned `b`×`b` blocks, for a rectangle of
+/// pixels `[x0, y0, x1, y1)` (edges on pixel boundaries, 2:1 aspect so that no pixel centre
+/// lies on its diagonal) drawn as a triangle strip from its top-left corner in a `size`
+/// target: the blocks that each of its two triangles ((x0,y0) (x1,y0) (x0,y1), then (x1,y0)
+/// (x0,y1) (x1,y1)) covers with a pixel centre, summed over the triangles, times `b²`.
+pub fn rectangle_shaded_in_blocks(rect: [i32; 4], size: (i32, i32), b: i32) -> u64 {
+    let [x0, y0, x1, y1] = rect;
+    assert_eq!(
+        x1 - x0,
+        2 * (y1 - y0),
+        "the diagonal must miss every pixel centre"
+    );
+    let inside = |p: [f32; 2], t: [[f32; 2]; 3]| {
+        let e = |a: [f32; 2], b: [f32; 2]| {
+            (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+        };
+        let (d0, d1, d2) = (e(t[0], t[1]), e(t[1], t[2]), e(t[2], t[0]));
+        (d0 >= 0.0 && d1 >= 0.0 && d2 >= 0.0) || (d0 <= 0.0 && d1 <= 0.0 && d2 <= 0.0)
+    };
+    let [fx0, fy0, fx1, fy1] = rect.map(|v| v as f32);
+    let tris = [
+        [[fx0, fy0], [fx1, fy0], [fx0, fy1]],
+        [[fx1, fy0], [fx0, fy1], [fx1, fy1]],
+    ];
+    let mut blocks = 0;
+    for t in tris {
+        for qy in 0..size.1 / b {
+            for qx in 0..size.0 / b {
+                let hit = (0..b * b).any(|k| {
+                    let (x, y) = (qx * b + k % b, qy * b + k / b);
+                    // Strictly inside the rectangle's pixel range, then the triangle.
+                    (x0..x1).contains(&x)
+                        && (y0..y1).contains(&y)
+                        && inside([x as f32 + 0.5, y as f32 + 0.5], t)
+                });
+                blocks += u64::from(hit);
+            }
+        }
+    }
+    blocks * (b * b) as u64
+}
+
+/// A triangle-strip pipeline of `module`'s `vs` and `fs` into one target of
+/// `forest_render::target::TARGET_FORMAT`, no depth, with `blend`.
+pub fn strip_pipeline(
+    ctx: &GpuContext,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    blend: Option<wgpu::BlendState>,
+) -> wgpu::RenderPipeline {
+    ctx.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("strip"),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+                ..Default::default()
+            },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: forest_render::target::TARGET_FORMAT,
+                    blend,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// A render pass into `view` alone, cleared to transparent black.
+pub fn cleared_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: None,
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

@@ -102,7 +102,6 @@ impl DrawPass {
     /// Create the pipelines for the host's targets: colour and depth formats, sample count
     /// and depth test from `opts`.
     pub fn new(device: &wgpu::Device, opts: &crate::options::RendererOptions) -> Self {
-        let format = opts.format;
         let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("draw"),
             entries: &bind_entries(),
@@ -116,40 +115,17 @@ impl DrawPass {
             label: Some("draw"),
             source: wgpu::ShaderSource::Wgsl(draw_source().into()),
         });
-        let pipeline_of = |topology: wgpu::PrimitiveTopology,
-                           vs: &str,
-                           fs: &str,
-                           blend: Option<wgpu::BlendState>,
-                           depth_write: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(vs),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(opts.depth_stencil(depth_write)),
-                multisample: opts.multisample(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format,
-                        blend,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+        let pipeline_of = |topology, vs: &str, fs: &str, blend, depth_write| {
+            draw_pipeline(
+                device,
+                opts,
+                &layout,
+                &module,
+                topology,
+                [vs, fs],
+                blend,
+                depth_write,
+            )
         };
         let pipeline = |vs: &str, fs: &str, blend: Option<wgpu::BlendState>, depth_write: bool| {
             pipeline_of(
@@ -185,10 +161,53 @@ impl DrawPass {
         }
     }
 
-    /// Record the environment (sky, ground and the terrain `ground` holds, when given) and the indirect quad draws, the latter inside the
-    /// pipeline-statistics query `statistics` when given (so the counts are the trees' alone):
-    /// the composited far trees' draw when `composite` (the stream's options can make such
-    /// quads), then the others'. Returns the draws recorded.
+    /// The counting variants of the quad pipelines (see [`crate::fragments`]): the same
+    /// draws with the counting hooks, and the counters as group 1.
+    pub fn counting(
+        &self,
+        device: &wgpu::Device,
+        opts: &crate::options::RendererOptions,
+    ) -> CountingDraw {
+        let counts = crate::fragments::bind_layout(device);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("counted draw"),
+            bind_group_layouts: &[Some(&self.bind_layout), Some(&counts)],
+            immediate_size: 0,
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("counted draw"),
+            source: wgpu::ShaderSource::Wgsl(super::counting_source(&super::DRAW_WGSL).into()),
+        });
+        let blend = Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
+        let strip = wgpu::PrimitiveTopology::TriangleStrip;
+        CountingDraw {
+            composite: draw_pipeline(
+                device,
+                opts,
+                &layout,
+                &module,
+                strip,
+                ["vs_composite", "fs_composite"],
+                blend,
+                false,
+            ),
+            quads: draw_pipeline(
+                device,
+                opts,
+                &layout,
+                &module,
+                strip,
+                ["vs_quad", "fs_quad"],
+                blend,
+                false,
+            ),
+        }
+    }
+
+    /// Record the environment (sky, ground and the terrain `ground` holds, when given) and
+    /// the indirect quad draws, the latter measured as `measured` asks (so the counts are the
+    /// trees' alone): the composited far trees' draw when `composite` (the stream's options
+    /// can make such quads), then the others'. Returns the draws recorded.
     pub fn record(
         &self,
         pass: &mut wgpu::RenderPass,
@@ -196,8 +215,12 @@ impl DrawPass {
         args_buf: &wgpu::Buffer,
         ground: Option<&crate::terrain::GpuTerrain>,
         composite: bool,
-        statistics: Option<&wgpu::QuerySet>,
+        measured: Measured,
     ) -> u32 {
+        let Measured {
+            statistics,
+            counted,
+        } = measured;
         pass.set_bind_group(0, bind_group, &[]);
         let environment = ground.map_or(0, |t| {
             t.record_ground(pass, &self.environment, &self.terrain)
@@ -207,9 +230,16 @@ impl DrawPass {
         }
         // The stream's two lists, each drawn alone: far trees' composited quads at its
         // front, then the others (see draw.wgsl).
+        let (composite_pipeline, quads_pipeline) = match counted {
+            Some((c, counts)) => {
+                pass.set_bind_group(1, counts, &[]);
+                (&c.composite, &c.quads)
+            }
+            None => (&self.composite, &self.quads),
+        };
         let draws = [
-            (&self.composite, args::DRAW_COMPOSITE),
-            (&self.quads, args::DRAW),
+            (composite_pipeline, args::DRAW_COMPOSITE),
+            (quads_pipeline, args::DRAW),
         ];
         let drawn = &draws[usize::from(!composite)..];
         for (pipeline, offset) in drawn {
@@ -221,4 +251,64 @@ impl DrawPass {
         }
         drawn.len() as u32 + environment
     }
+}
+
+/// How the tree draws of [`DrawPass::record`] are measured.
+#[derive(Clone, Copy, Default)]
+pub struct Measured<'a> {
+    /// Inside this pipeline-statistics query.
+    pub statistics: Option<&'a wgpu::QuerySet>,
+    /// With these counting pipelines and the counters' bind group (group 1).
+    pub counted: Option<(&'a CountingDraw, &'a wgpu::BindGroup)>,
+}
+
+/// The quad pipelines that count fragments ([`DrawPass::counting`]).
+pub struct CountingDraw {
+    composite: wgpu::RenderPipeline,
+    quads: wgpu::RenderPipeline,
+}
+
+/// A tree draw's pipeline: `entries` (vertex, fragment) of `module`, into the host's targets
+/// of `opts` (format, sample count, depth convention), no face culling. The quad stream's and
+/// the geometry renderer's pipelines are all built here.
+#[allow(clippy::too_many_arguments)]
+pub fn draw_pipeline(
+    device: &wgpu::Device,
+    opts: &crate::options::RendererOptions,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    topology: wgpu::PrimitiveTopology,
+    [vs, fs]: [&str; 2],
+    blend: Option<wgpu::BlendState>,
+    depth_write: bool,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(vs),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vs),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(opts.depth_stencil(depth_write)),
+        multisample: opts.multisample(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fs),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: opts.format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }

@@ -8,6 +8,7 @@
 
 pub mod cull;
 pub mod draw;
+pub mod overdraw;
 pub mod refine;
 
 /// The WGSL every module starts with: the camera, the scene's structs, the shared helpers
@@ -30,13 +31,37 @@ pub const COMPUTE_WGSL: [&str; 6] = [
     include_str!("../../shaders/refine.wgsl"),
 ];
 
-/// WGSL of the draw pass.
-pub const DRAW_WGSL: [&str; 4] = [
+/// WGSL of the draw pass (without fragment counting: [`COUNT_OFF_WGSL`] closes it).
+pub const DRAW_WGSL: [&str; 5] = [
     COMMON_WGSL,
     include_str!("../../shaders/draw.wgsl"),
     GROUND_WGSL,
     ENVIRONMENT_WGSL,
+    COUNT_OFF_WGSL,
 ];
+
+/// The fragment-count hooks that do nothing (`shaders/count_off.wgsl`): every draw module
+/// that shades tree fragments ends with this or [`COUNT_ON_WGSL`].
+pub const COUNT_OFF_WGSL: &str = include_str!("../../shaders/count_off.wgsl");
+
+/// The fragment-count hooks that count (`shaders/count_on.wgsl`, group 1: see
+/// [`crate::fragments`]).
+pub const COUNT_ON_WGSL: &str = include_str!("../../shaders/count_on.wgsl");
+
+/// The module of `parts` (a draw module's sources, [`COUNT_OFF_WGSL`] among them) with the
+/// counting hooks in place of the empty ones.
+pub fn counting_source(parts: &[&str]) -> String {
+    parts
+        .iter()
+        .map(|p| {
+            if *p == COUNT_OFF_WGSL {
+                COUNT_ON_WGSL
+            } else {
+                p
+            }
+        })
+        .collect()
+}
 
 /// The compute module's source.
 pub fn compute_source() -> String {
