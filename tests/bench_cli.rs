@@ -51,6 +51,17 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
         "variant,species,camera,distance_radii,elevation_deg,azimuth_deg,between_directions,\
          epsilon,quads,flip_mean,iou,frame_ms"
     );
+    // The walk through the model-size forest and through one at real tree sizes: the same
+    // columns, every method.
+    assert_eq!(header("path.csv"), header("path_real.csv"));
+    let path_real = std::fs::read_to_string(results.join("path_real.csv")).unwrap();
+    for m in ["quads", "impostor", "lods", "hybrid"] {
+        assert!(
+            path_real.lines().any(|l| l.contains(&format!(",{m},"))),
+            "{m}"
+        );
+    }
+    assert!(results.join("path_real.png").is_file());
     for f in [
         "path.csv",
         "budget.csv",
@@ -100,7 +111,7 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
                 compute_invocations,gpu_mb,covered_pixels,fragments_per_covered_pixel,work_source,\
                 exact_fragments_per_covered_pixel,exact_median,exact_p95,\
                 quad_lanes_per_covered_pixel,transparent_share,hidden_share";
-    for f in ["table1.csv", "path.csv", "accuracy.csv"] {
+    for f in ["table1.csv", "path.csv", "path_real.csv", "accuracy.csv"] {
         let text = std::fs::read_to_string(results.join(f)).unwrap();
         let head = text.lines().next().unwrap();
         assert!(head.ends_with(work), "{f}: {head}");
@@ -137,20 +148,31 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
         }
     }
     // Every table counts the same way: the adapter has pipeline statistics for all or none.
-    let sources: std::collections::BTreeSet<String> = ["table1.csv", "path.csv", "accuracy.csv"]
-        .iter()
-        .flat_map(|f| {
-            let text = std::fs::read_to_string(results.join(f)).unwrap();
-            text.lines()
-                .skip(1)
-                .map(|l| l.split(',').rev().nth(6).unwrap().to_string())
-                .collect::<Vec<_>>()
-        })
-        .collect();
+    let sources: std::collections::BTreeSet<String> =
+        ["table1.csv", "path.csv", "path_real.csv", "accuracy.csv"]
+            .iter()
+            .flat_map(|f| {
+                let text = std::fs::read_to_string(results.join(f)).unwrap();
+                text.lines()
+                    .skip(1)
+                    .map(|l| l.split(',').rev().nth(6).unwrap().to_string())
+                    .collect::<Vec<_>>()
+            })
+            .collect();
     assert_eq!(sources.len(), 1, "{sources:?}");
     assert!(results.join("accuracy_work_walkthrough.png").is_file());
     // The walkthrough of random eye-height cameras, and the hybrid's switch choices.
     assert!(accuracy.lines().any(|l| l.contains(",walkthrough,")));
+    // And the same walk through a forest at real tree sizes, every method.
+    for m in ["quads", "impostor", "lods", "hybrid"] {
+        assert!(
+            accuracy
+                .lines()
+                .any(|l| l.starts_with(&format!("{m},")) && l.contains(",walkthrough-real,")),
+            "{m}"
+        );
+    }
+    assert!(results.join("accuracy_walkthrough-real.png").is_file());
     let budget = std::fs::read_to_string(results.join("budget.csv")).unwrap();
     assert!(budget.lines().any(|l| l.starts_with("hybrid near=auto,")));
     let report = std::fs::read_to_string(results.join("REPORT.md")).unwrap();

@@ -1,7 +1,8 @@
 //! Speed against accuracy: every setting of every method, mean FLIP against the 4×4
 //! supersampled full-geometry reference versus GPU frame time, with each method's Pareto front,
 //! at a close-up, a mid-range and a bird's-eye view, and over a walkthrough of seeded random
-//! eye-height cameras inside the forest.
+//! eye-height cameras inside the forest; then the same walkthrough through a forest at real
+//! tree sizes and the demo's density (`walkthrough-real`).
 
 use anyhow::{Context, Result};
 use forest_baselines::geometry::{Lods, MeshMethod, Stochastic, downsample};
@@ -244,12 +245,16 @@ fn epsilon_of(param: &str) -> f32 {
         .unwrap_or(16.0)
 }
 
+/// Trees of the real-size walkthrough's forest, and its ground per tree (m²): the demo's
+/// density, species at their mature heights.
+pub fn real_scene(b: &Bench) -> (u32, f32) {
+    if b.quick { (150, 60.0) } else { (3000, 60.0) }
+}
+
 /// Run the suite.
 pub fn run(b: &Bench) -> Result<Section> {
     let (trees, side, viewport) = scene(b);
     let forest = b.forest(trees, side, 7)?;
-    let mut r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
-    r.set_pipeline_statistics(true);
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&columns());
     let walk = walk_cameras(b.quick);
@@ -264,27 +269,62 @@ pub fn run(b: &Bench) -> Result<Section> {
         .into_iter()
         .filter(|(m, _)| chosen(&b.methods, m.name()))
         .collect();
+    if !groups.is_empty() {
+        let mut r = b.renderer(&forest, viewport, 1.0, true, Background::Transparent)?;
+        measure_views(b, &mut r, &target, &groups, &settings, &mut table)?;
+    }
+    // The same walkthrough through a forest as users build it: real tree sizes at the
+    // demo's density.
+    if chosen(&b.views, "walkthrough-real") {
+        let (real_trees, area) = real_scene(b);
+        let (real, real_side) = b.real_size_forest(real_trees, area, 7)?;
+        let mut r = b.renderer(&real, viewport, 1.0, true, Background::Transparent)?;
+        let cams = walkthrough(&real, real_side, viewport, walk);
+        measure_views(
+            b,
+            &mut r,
+            &target,
+            &[("walkthrough-real", cams)],
+            &settings,
+            &mut table,
+        )?;
+    }
+    b.write("accuracy.csv", &table.csv())?;
+    report(b, table)
+}
+
+/// Measure every setting over each group of cameras (a view, or a walkthrough's cameras)
+/// with `r`, a row per setting and group: means over the group's cameras.
+fn measure_views(
+    b: &Bench,
+    r: &mut ForestRenderer,
+    target: &Target,
+    groups: &[(&str, Vec<Camera>)],
+    settings: &[(Method, String)],
+    table: &mut Table,
+) -> Result<()> {
+    r.set_pipeline_statistics(true);
     for (view, cams) in groups {
         let references = cams
             .iter()
-            .map(|c| reference(b, &mut r, c))
+            .map(|c| reference(b, r, c))
             .collect::<Result<Vec<_>>>()?;
-        for &(method, ref param) in &settings {
+        for &(method, ref param) in settings {
             // Means over the view's cameras (one, or the walkthrough's).
             let (mut frame_ms, mut flip, mut ssim, mut psnr, mut prims) = (0.0, 0.0, 0.0, 0.0, 0);
             let mut work = Vec::new();
             for (cam, reference) in cams.iter().zip(&references) {
                 let mut c = *cam;
                 c.epsilon = epsilon_of(param);
-                let (s, t) = b.measure(&mut r, method, &c, &target, b.frames_for(method))?;
-                // The measured frames gathered statistics (set below); the background is
+                let (s, t) = b.measure(r, method, &c, target, b.frames_for(method))?;
+                // The measured frames gathered statistics (set above); the background is
                 // transparent, so the image's alpha is the coverage.
                 let img = target.read(&b.ctx);
                 let m = forest_metrics::compare(reference, &img)?;
                 work.push(super::ViewWork {
                     work: s.work.clone(),
                     covered: super::covered(&img),
-                    counts: b.count(&mut r, &c, &target)?,
+                    counts: b.count(r, &c, target)?,
                 });
                 frame_ms += t;
                 flip += f64::from(m.flip_mean);
@@ -302,7 +342,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             let mut row = vec![
                 method.name().into(),
                 param.clone(),
-                view.into(),
+                view.to_string(),
                 ms(frame_ms),
                 format!("{flip:.5}"),
                 format!("{:.4}", ssim / n),
@@ -313,8 +353,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             table.push(row);
         }
     }
-    b.write("accuracy.csv", &table.csv())?;
-    report(b, table)
+    Ok(())
 }
 
 /// Cameras of the walkthrough view.
@@ -423,58 +462,22 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
             charts.push(stem);
         }
     }
-    // Fragments shaded per covered pixel in the walkthrough, each method's first setting:
-    // lavapipe's stamps, and the exact counts (invocations, 2×2-quad lanes, the shares that
-    // showed nothing or were hidden) where the table has them.
-    let overdraw = {
-        let k = COLUMNS.len();
-        let num = |row: &[String], i: usize| row.get(k + i).and_then(|c| c.parse::<f64>().ok());
-        let mut out: Vec<String> = Vec::new();
-        let mut seen: Vec<&str> = Vec::new();
-        for row in table.rows.iter().filter(|r| r[2] == "walkthrough") {
-            let Some(stamps) = num(row, 8) else { continue };
-            if seen.contains(&row[0].as_str()) {
-                continue;
-            }
-            seen.push(&row[0]);
-            let exact = match (num(row, 10), num(row, 13), num(row, 14), num(row, 15)) {
-                (Some(f), Some(q), Some(t), Some(h)) => format!(
-                    "; exactly {f:.1} fragments ({:.1}× the limit of one), {q:.1} 2×2-quad \
-                     lanes, {:.0} % transparent, {:.0} % hidden",
-                    f,
-                    100.0 * t,
-                    100.0 * h
-                ),
-                _ => String::new(),
-            };
-            out.push(format!(
-                "{} ({}) {stamps:.2} stamp fragments{exact}",
-                row[0], row[1]
-            ));
-        }
-        out.join("; ")
-    };
-    // The hybrid against the quad stream in the walkthrough, at the same ε.
-    let walk_rows: Vec<&Vec<String>> = table
-        .rows
+    // Per walkthrough (model sizes, real sizes): the fragments each method's first setting
+    // shades per covered pixel, and the hybrid against the quad stream at the same ε.
+    let walks: Vec<String> = ["walkthrough", "walkthrough-real"]
         .iter()
-        .filter(|r| r[2] == "walkthrough")
-        .collect();
-    let walk_ratio = walk_rows
-        .iter()
-        .filter(|r| r[0] == "hybrid" && r[1].ends_with("near=auto"))
-        .filter_map(|h| {
-            let eps = h[1].split(' ').next()?;
-            let q = walk_rows.iter().find(|r| r[0] == "quads" && r[1] == eps)?;
-            Some(format!(
-                "{eps}: {:.2}× the quad stream's frame time, FLIP {:.4} against {:.4}",
-                cell(h, 3) / cell(q, 3),
-                cell(h, 4),
-                cell(q, 4)
-            ))
+        .filter(|v| view_names.iter().any(|n| n == *v))
+        .map(|&view| {
+            let rows: Vec<&Vec<String>> = table.rows.iter().filter(|r| r[2] == view).collect();
+            format!(
+                "In `{view}`, the hybrid with its automatic switch: {}. Fragments shaded per \
+                 covered pixel: {}.",
+                hybrid_against_quads(&rows, &cell),
+                fragments_per_pixel(&rows)
+            )
         })
-        .collect::<Vec<_>>()
-        .join("; ");
+        .collect();
+    let (real_trees, area) = real_scene(b);
     let switches = b.switch_summary();
     let text = format!(
         "{trees} trees over {side:.0} m, {}x{}, transparent background (trees only). The \
@@ -488,16 +491,20 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
          per species, where its finest quads project to the width at which its bake measured \
          the stream as accurate as the triangles, at every ε: {switches}). The walkthrough \
          view is the mean over {walk} seeded random eye-height cameras inside the forest (seed \
-         {WALK_SEED:#x}; none rejected). Hybrid in the walkthrough, with its automatic switch: \
-         {walk_ratio}.\n\nThe work charts put the same settings against the shader \
-         invocations a frame asks of a GPU (pipeline-statistics queries), which a CPU \
-         rasteriser's times distort: it charges triangles far more than a GPU does. Fragments \
-         shaded per covered pixel in the walkthrough (first setting of each method; lavapipe's \
-         pipeline statistics count fragments per 4×4 stamp; the exact counts are tree \
-         fragment invocations, helper lanes excluded, per pixel covered by a shown fragment, \
-         and the 2×2-quad lanes a GPU would run): {overdraw}.\n\n{}",
+         {WALK_SEED:#x}; none rejected); `walkthrough-real` is the same walk through a forest as \
+         users build it: {real_trees} trees at their species' mature heights (oak and ash \
+         15–25 m, pine 20–35 m, aspen 12–20 m, bush 1–3 m) at the demo's {area:.0} m² per \
+         tree.\n\nThe work charts put the same settings against the shader invocations a \
+         frame asks of a GPU (pipeline-statistics queries), which a CPU rasteriser's times \
+         distort: it charges triangles far more than a GPU does. Fragments are counted twice: \
+         lavapipe's pipeline statistics count them per 4×4 stamp; the exact counts are tree \
+         fragment invocations, helper lanes excluded, per pixel covered by a shown fragment \
+         (1 is the limit of one shaded fragment per pixel), with the 2×2-quad lanes a GPU \
+         would run and the shares that showed nothing (transparent) or were shown behind an \
+         opaque fragment (hidden).\n\n{}\n\n{}",
         viewport.0,
         viewport.1,
+        walks.join("\n\n"),
         summary
             .iter()
             .map(|s| format!("- {s}"))
@@ -510,6 +517,53 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
         table,
         charts,
     })
+}
+
+/// The hybrid (`near=auto`) against the quad stream at the same ε, over `rows` of one view.
+fn hybrid_against_quads(rows: &[&Vec<String>], cell: &dyn Fn(&[String], usize) -> f64) -> String {
+    rows.iter()
+        .filter(|r| r[0] == "hybrid" && r[1].ends_with("near=auto"))
+        .filter_map(|h| {
+            let eps = h[1].split(' ').next()?;
+            let q = rows.iter().find(|r| r[0] == "quads" && r[1] == eps)?;
+            Some(format!(
+                "{eps}: {:.2}× the quad stream's frame time, FLIP {:.4} against {:.4}",
+                cell(h, 3) / cell(q, 3),
+                cell(h, 4),
+                cell(q, 4)
+            ))
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Fragments per covered pixel of each method's first setting in `rows`: lavapipe's stamps,
+/// and the exact counts where the table has them.
+fn fragments_per_pixel(rows: &[&Vec<String>]) -> String {
+    let k = COLUMNS.len();
+    let num = |row: &[String], i: usize| row.get(k + i).and_then(|c| c.parse::<f64>().ok());
+    let mut out: Vec<String> = Vec::new();
+    let mut seen: Vec<&str> = Vec::new();
+    for row in rows {
+        let Some(stamps) = num(row, 8) else { continue };
+        if seen.contains(&row[0].as_str()) {
+            continue;
+        }
+        seen.push(&row[0]);
+        let exact = match (num(row, 10), num(row, 13), num(row, 14), num(row, 15)) {
+            (Some(f), Some(q), Some(t), Some(h)) => format!(
+                "; exactly {f:.1} ({q:.1} 2×2-quad lanes, {:.0} % transparent, {:.0} % hidden)",
+                100.0 * t,
+                100.0 * h
+            ),
+            _ => String::new(),
+        };
+        out.push(format!(
+            "{} ({}) {stamps:.2} stamp fragments{exact}",
+            row[0], row[1]
+        ));
+    }
+    out.join("; ")
 }
 
 /// Rebuild the charts and the report section from `accuracy.csv` in the results folder,

@@ -83,7 +83,7 @@ pub struct BenchArgs {
     pub frames: u32,
     /// Accuracy suite: measure only these views (comma-separated; default: all). Use with
     /// its own --out: the CSV, charts and report then hold these views alone.
-    #[arg(long, value_delimiter = ',', value_parser = ["close-up", "mid-range", "birds-eye", "walkthrough"])]
+    #[arg(long, value_delimiter = ',', value_parser = ["close-up", "mid-range", "birds-eye", "walkthrough", "walkthrough-real"])]
     pub views: Vec<String>,
     /// Accuracy suite: measure only these methods (comma-separated; default: all).
     #[arg(long, value_delimiter = ',', value_parser = ["quads", "impostor", "geometry", "stochastic", "lods", "hybrid"])]
@@ -267,6 +267,53 @@ impl Bench {
         let manifests: Vec<_> = self.species.iter().map(|s| &s.atlas.manifest).collect();
         forest_format::species::check(&forest, &manifests, Path::new("the bench's forest"))?;
         Ok(forest)
+    }
+
+    /// A forest of `trees` trees at real sizes: each species at its mature heights
+    /// ([`forest_format::generate::species_height`], by the atlas folder's name; a species
+    /// not in that table keeps its model's size ×0.8–1.25), `area_per_tree` m² of ground per
+    /// tree, as `forest scene` makes it by default. Returns the forest and its side (metres).
+    pub fn real_size_forest(
+        &self,
+        trees: u32,
+        area_per_tree: f32,
+        seed: u64,
+    ) -> Result<(Forest, f32)> {
+        let side = (trees as f32 * area_per_tree).sqrt();
+        let species_scale = self
+            .species_paths
+            .iter()
+            .zip(&self.species)
+            .map(|(path, s)| {
+                let name = path
+                    .file_stem()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                match forest_format::generate::species_height(&name) {
+                    Some((lo, hi)) => {
+                        let top = s.atlas.manifest.model_top();
+                        (lo / top, hi / top)
+                    }
+                    None => GenerateParams::default().scale,
+                }
+            })
+            .collect();
+        let forest = generate(&GenerateParams {
+            trees,
+            species: self
+                .species_paths
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect(),
+            area_per_tree,
+            species_scale,
+            seed,
+            ..GenerateParams::default()
+        })
+        .map_err(anyhow::Error::msg)?;
+        let manifests: Vec<_> = self.species.iter().map(|s| &s.atlas.manifest).collect();
+        forest_format::species::check(&forest, &manifests, Path::new("the bench's forest"))?;
+        Ok((forest, side))
     }
 
     /// Every method's renderer for `forest` (the geometry ones when `geometry`).

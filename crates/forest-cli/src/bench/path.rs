@@ -1,5 +1,6 @@
 //! A walkthrough of 100 views through the forest (the paper's Figure 7): frame time and
-//! primitives per view for every method.
+//! primitives per view for every method, through a forest at the models' sizes and through
+//! one at real tree sizes.
 
 use anyhow::Result;
 use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
@@ -39,16 +40,75 @@ pub fn view(
     }
 }
 
-/// Run the suite.
+/// One walk's forest: its CSV and chart stem, how the report names it, and its forest.
+struct Walk {
+    stem: &'static str,
+    label: String,
+    forest: forest_format::forest::Forest,
+    side: f32,
+}
+
+/// Run the suite: the walk through the model-size forest (`path.csv`), then the same walk
+/// through a forest at real tree sizes and the demo's density (`path_real.csv`).
 pub fn run(b: &Bench) -> Result<Section> {
     let (trees, side, viewport, views) = if b.quick {
         (300, 60.0, (160, 120), 4)
     } else {
         (10_000, 320.0, (400, 300), 100)
     };
+    // As many trees at real sizes, at the demo's density.
+    let area = super::accuracy::real_scene(b).1;
+    let (real, real_side) = b.real_size_forest(trees, area, 11)?;
+    let walks = [
+        Walk {
+            stem: "path",
+            label: format!("{trees} trees at their models' sizes over {side:.0} m"),
+            forest: b.forest(trees, side, 11)?,
+            side,
+        },
+        Walk {
+            stem: "path_real",
+            label: format!(
+                "{} trees at their species' mature heights, {area:.0} m² per tree, over \
+                 {real_side:.0} m",
+                real.instances.len()
+            ),
+            forest: real,
+            side: real_side,
+        },
+    ];
+    let mut texts = Vec::new();
+    let mut summary = Table::new(&["forest", "method", "mean_ms", "worst_ms", "views_measured"]);
+    for w in &walks {
+        let (text, means) = walk(b, w, viewport, views)?;
+        texts.push(text);
+        for (m, mean, worst, stride) in &means {
+            summary.push(vec![
+                w.stem.to_string(),
+                m.to_string(),
+                ms(*mean),
+                ms(*worst),
+                views.div_ceil(*stride as u32).to_string(),
+            ]);
+        }
+    }
+    Ok(Section {
+        title: "Walkthrough (Figure 7)".into(),
+        text: texts.join("\n\n"),
+        table: summary,
+        charts: walks.iter().map(|w| w.stem.to_string()).collect(),
+    })
+}
+
+/// A method's mean and worst frame time (ms) over a walk, and the stride of views measured.
+type Means = Vec<(&'static str, f64, f64, usize)>;
+
+/// Measure every method over `views` views of `w`'s walk; write its CSV and chart. Returns
+/// the report's paragraph and each method's means.
+fn walk(b: &Bench, w: &Walk, viewport: (u32, u32), views: u32) -> Result<(String, Means)> {
+    let (forest, side) = (&w.forest, w.side);
     let geometry = !b.models.is_empty();
-    let forest = b.forest(trees, side, 11)?;
-    let mut r = b.renderer(&forest, viewport, 16.0, geometry, Background::Sky)?;
+    let mut r = b.renderer(forest, viewport, 16.0, geometry, Background::Sky)?;
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut methods = vec![(Method::Quads, 1), (Method::Impostor, 1)];
     if geometry {
@@ -96,19 +156,20 @@ pub fn run(b: &Bench) -> Result<Section> {
         let mean = s.points.iter().map(|p| p.1).sum::<f64>() / s.points.len().max(1) as f64;
         let worst = s.points.iter().map(|p| p.1).fold(0.0, f64::max);
         println!(
-            "path, {}: mean {mean:.2} ms, worst {worst:.2} ms",
+            "{}, {}: mean {mean:.2} ms, worst {worst:.2} ms",
+            w.stem,
             method.name()
         );
         means.push((method.name(), mean, worst, stride));
         series.push(s);
     }
-    b.write("path.csv", &table.csv())?;
+    b.write(&format!("{}.csv", w.stem), &table.csv())?;
     b.chart(
-        "path",
+        w.stem,
         &Chart {
             title: format!(
-                "Walkthrough: {trees} trees, {views} views, {}x{}",
-                viewport.0, viewport.1
+                "Walkthrough: {}, {views} views, {}x{}",
+                w.label, viewport.0, viewport.1
             ),
             x_label: "view along the path".into(),
             y_label: "GPU ms per frame".into(),
@@ -119,8 +180,10 @@ pub fn run(b: &Bench) -> Result<Section> {
     )?;
     let quads = means.first().map(|m| m.1).unwrap_or(f64::NAN);
     let text = format!(
-        "{views} views along an S-shaped walk at eye height through {trees} trees over \
-         {side:.0} m (the paper's Figure 7), {}x{}, ε 16, default parameters.\n\n{}",
+        "{views} views along an S-shaped walk at eye height through {} (the paper's Figure \
+         7; `{}.csv`), {}x{}, ε 16, default parameters.\n\n{}",
+        w.label,
+        w.stem,
         viewport.0,
         viewport.1,
         means
@@ -137,19 +200,5 @@ pub fn run(b: &Bench) -> Result<Section> {
             .collect::<Vec<_>>()
             .join("\n")
     );
-    let mut summary = Table::new(&["method", "mean_ms", "worst_ms", "views_measured"]);
-    for (m, mean, worst, stride) in &means {
-        summary.push(vec![
-            m.to_string(),
-            ms(*mean),
-            ms(*worst),
-            views.div_ceil(*stride as u32).to_string(),
-        ]);
-    }
-    Ok(Section {
-        title: "Walkthrough (Figure 7)".into(),
-        text,
-        table: summary,
-        charts: vec!["path".into()],
-    })
+    Ok((text, means))
 }
