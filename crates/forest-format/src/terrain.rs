@@ -396,9 +396,20 @@ impl Terrain {
     }
 }
 
+/// Without the `terrain-exr` feature (the runtime's build): an EXR height field is refused.
+#[cfg(not(feature = "terrain-exr"))]
+fn exr_heights(path: &Path, _bytes: &[u8]) -> Result<(u32, u32, Vec<f32>), FormatError> {
+    Err(FormatError::invalid(
+        path,
+        "an EXR height field needs forest-format's `terrain-exr` feature (forest scene has it); \
+         or give a 16-bit greyscale .png",
+    ))
+}
+
 /// The heights of an EXR height field: its size read from the header and checked before any
 /// pixel is decoded, then one channel (`Y`, else `R`, else `Z`, else the first) of the first
 /// flat layer, as f32.
+#[cfg(feature = "terrain-exr")]
 fn exr_heights(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<f32>), FormatError> {
     use exr::prelude::{ReadChannels, ReadLayers};
     let img_err = |e: exr::error::Error| FormatError::Image {
@@ -645,32 +656,44 @@ mod tests {
         assert!((t.heights[3] - 30.0).abs() < 1e-4);
         assert!((t.height(0.0, 2.0) - 31.0).abs() < 1e-4);
 
-        let exr = dir.path().join("h.exr");
-        let img = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_fn(4, 3, |x, y| {
-            image::Rgb([x as f32 - 0.5 * y as f32, 0.0, 0.0])
-        });
-        image::DynamicImage::ImageRgb32F(img).save(&exr).unwrap();
-        let t = Terrain::from_image(&exr, 1.0, 0.0).unwrap();
-        assert_eq!(t.size, [4, 3]);
-        assert_eq!(t.heights[4 * 2 + 3], 2.0);
-
-        // A single-channel EXR (the usual height-map export), half floats, channel "Y".
-        let single = dir.path().join("y.exr");
+        // EXR height fields, with the feature that reads them (the runtime's build refuses
+        // them by name).
+        #[cfg(feature = "terrain-exr")]
         {
-            use exr::prelude::*;
-            let samples: Vec<f16> = (0..15).map(|k| f16::from_f32(k as f32 * 0.5)).collect();
-            let channel = AnyChannel::new("Y", FlatSamples::F16(samples));
-            let layer = Layer::new(
-                (5, 3),
-                LayerAttributes::named("heights"),
-                Encoding::FAST_LOSSLESS,
-                AnyChannels::sort(SmallVec::from_vec(vec![channel])),
-            );
-            Image::from_layer(layer).write().to_file(&single).unwrap();
+            let exr = dir.path().join("h.exr");
+            let img = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_fn(4, 3, |x, y| {
+                image::Rgb([x as f32 - 0.5 * y as f32, 0.0, 0.0])
+            });
+            image::DynamicImage::ImageRgb32F(img).save(&exr).unwrap();
+            let t = Terrain::from_image(&exr, 1.0, 0.0).unwrap();
+            assert_eq!(t.size, [4, 3]);
+            assert_eq!(t.heights[4 * 2 + 3], 2.0);
+
+            // A single-channel EXR (the usual height-map export), half floats, channel "Y".
+            let single = dir.path().join("y.exr");
+            {
+                use exr::prelude::*;
+                let samples: Vec<f16> = (0..15).map(|k| f16::from_f32(k as f32 * 0.5)).collect();
+                let channel = AnyChannel::new("Y", FlatSamples::F16(samples));
+                let layer = Layer::new(
+                    (5, 3),
+                    LayerAttributes::named("heights"),
+                    Encoding::FAST_LOSSLESS,
+                    AnyChannels::sort(SmallVec::from_vec(vec![channel])),
+                );
+                Image::from_layer(layer).write().to_file(&single).unwrap();
+            }
+            let t = Terrain::from_image(&single, 2.0, 0.0).unwrap();
+            assert_eq!(t.size, [5, 3]);
+            assert_eq!(t.heights[14], 7.0);
         }
-        let t = Terrain::from_image(&single, 2.0, 0.0).unwrap();
-        assert_eq!(t.size, [5, 3]);
-        assert_eq!(t.heights[14], 7.0);
+        #[cfg(not(feature = "terrain-exr"))]
+        {
+            let exr = dir.path().join("h.exr");
+            std::fs::write(&exr, b"v/1\x01").unwrap();
+            let e = Terrain::from_image(&exr, 1.0, 0.0).unwrap_err().to_string();
+            assert!(e.contains("terrain-exr"), "{e}");
+        }
 
         let err = |p: &Path| Terrain::from_image(p, 1.0, 10.0).unwrap_err().to_string();
         let eight = dir.path().join("8bit.png");
@@ -693,12 +716,15 @@ mod tests {
         let full = std::fs::read(&png).unwrap();
         std::fs::write(&cut, &full[..full.len() / 2]).unwrap();
         assert!(err(&cut).contains("cut.png"), "{}", err(&cut));
-        let nan = dir.path().join("nan.exr");
-        let img = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_fn(2, 2, |x, _| {
-            image::Rgb([if x == 1 { f32::NAN } else { 0.0 }, 0.0, 0.0])
-        });
-        image::DynamicImage::ImageRgb32F(img).save(&nan).unwrap();
-        assert!(err(&nan).contains("sample (1, 0)"), "{}", err(&nan));
+        #[cfg(feature = "terrain-exr")]
+        {
+            let nan = dir.path().join("nan.exr");
+            let img = image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_fn(2, 2, |x, _| {
+                image::Rgb([if x == 1 { f32::NAN } else { 0.0 }, 0.0, 0.0])
+            });
+            image::DynamicImage::ImageRgb32F(img).save(&nan).unwrap();
+            assert!(err(&nan).contains("sample (1, 0)"), "{}", err(&nan));
+        }
         let tif = dir.path().join("h.tif");
         std::fs::write(&tif, b"x").unwrap();
         assert!(err(&tif).contains(".exr"), "{}", err(&tif));

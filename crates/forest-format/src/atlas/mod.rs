@@ -106,6 +106,16 @@ impl Atlas {
         }
         let colour_file = match p.colour {
             ColourEncoding::Png => encode_png(w, h, &rgb, image::ExtendedColorType::Rgb8),
+            #[cfg(not(feature = "atlas-jpeg"))]
+            ColourEncoding::Jpeg { .. } => {
+                return Err(FormatError::Image {
+                    path: p.colour.file_name().into(),
+                    what: "JPEG atlas colour needs forest-format's `atlas-jpeg` feature (the \
+                           bake has it)"
+                        .into(),
+                });
+            }
+            #[cfg(feature = "atlas-jpeg")]
             ColourEncoding::Jpeg { quality } => {
                 let mut out = Vec::new();
                 let mut enc = jpeg_encoder::Encoder::new(&mut out, quality);
