@@ -68,7 +68,9 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub supersample: u32,
     /// Count every tree fragment exactly (each view is drawn twice more) and report the
-    /// fragments per covered pixel, the 2×2-quad lanes and the hidden and transparent shares.
+    /// fragments per covered pixel, the 2×2-quad lanes and the hidden and transparent shares
+    /// (not with --supersample). Tree fragments behind the ground count as shaded: the
+    /// count's early depth test sees the trees' own depth, not the ground's.
     #[arg(long)]
     pub fragments: bool,
     /// What the PNG shows: the image (`off`), or `overdraw`, a heat map of the fragments
@@ -574,6 +576,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     if args.overdraw() && args.supersample > 1 {
         bail!("--debug-view overdraw counts the pixels it shows: render it without --supersample");
+    }
+    if args.fragments && args.supersample > 1 {
+        bail!(
+            "--fragments counts the pixels of the image as rendered: count it without \
+             --supersample (it would count the {0}×{0} larger image)",
+            args.supersample
+        );
     }
     let mesh_method = args.m.checked_method(forest.species.len())?;
     let ctx = crate::gpu_context()?;

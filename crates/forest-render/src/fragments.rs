@@ -225,8 +225,9 @@ impl FragmentCounter {
 
 /// The exact fragment counts of one frame of `renderer` into `counter`: the counter is
 /// attached with `attach`, the frame drawn twice by `draw` (see
-/// [`FragmentCounter::count_frame`]) and the counter detached again, also when `draw` fails.
-/// Counting touches only these two frames; the renderer's own pipelines are unchanged.
+/// [`FragmentCounter::count_frame`]) and then detached (`attach(None)`), also when `draw`
+/// fails: a counter the caller had attached before is detached too. The renderer's own
+/// pipelines are unchanged.
 pub fn count_fragments<R, E>(
     ctx: &GpuContext,
     counter: &FragmentCounter,

@@ -75,8 +75,10 @@ fn readback<'a>(
 
 /// The quad stream of one view over a shared scene.
 pub struct QuadStream {
-    /// The counting quad pipelines and the counters' bind group, while counting fragments.
-    fragment_counts: Option<(crate::passes::draw::CountingDraw, wgpu::BindGroup)>,
+    /// The counting quad pipelines, built at the first attached counter and kept.
+    counting_draw: Option<crate::passes::draw::CountingDraw>,
+    /// The attached counters' bind group, while counting fragments.
+    fragment_counts: Option<wgpu::BindGroup>,
     /// The uploaded scene (shared, immutable).
     pub scene: Arc<GpuScene>,
     /// Buffer sizes.
@@ -207,6 +209,7 @@ impl QuadStream {
         )?;
         let levels = scene.tables.max_levels;
         Ok(Self {
+            counting_draw: None,
             fragment_counts: None,
             iterations: if opts.refine {
                 levels.saturating_sub(1)
@@ -788,18 +791,16 @@ impl QuadStream {
     }
 
     /// Count fragments into `counter` from the next frame on ([`crate::fragments`]), or stop
-    /// counting (`None`).
+    /// counting (`None`). The counting pipelines are built at the first counter and kept.
     pub fn set_fragment_counter(
         &mut self,
         device: &wgpu::Device,
         counter: Option<&crate::fragments::FragmentCounter>,
     ) {
-        self.fragment_counts = counter.map(|c| {
-            (
-                self.passes.draw.counting(device, &self.opts),
-                c.bind_group().clone(),
-            )
-        });
+        if counter.is_some() && self.counting_draw.is_none() {
+            self.counting_draw = Some(self.passes.draw.counting(device, &self.opts));
+        }
+        self.fragment_counts = counter.map(|c| c.bind_group().clone());
     }
 
     /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
@@ -831,7 +832,10 @@ impl QuadStream {
             self.options.far_nearest && self.options.far_composite,
             crate::passes::draw::Measured {
                 statistics: self.counting().map(|q| &q.set),
-                counted: self.fragment_counts.as_ref().map(|(d, b)| (d, b)),
+                counted: self
+                    .counting_draw
+                    .as_ref()
+                    .zip(self.fragment_counts.as_ref()),
             },
         );
         self.recorded.1.store(draws, Ordering::Relaxed);

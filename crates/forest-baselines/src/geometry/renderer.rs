@@ -47,9 +47,11 @@ pub struct GeometryRenderer {
     /// pipelines built on demand ([`Self::set_fragment_counter`]).
     draw_layout: wgpu::BindGroupLayout,
     targets: RendererOptions,
-    /// The counting geometry and billboard pipelines and the counters' bind group, while
-    /// counting fragments.
-    fragment_counts: Option<([wgpu::RenderPipeline; 2], wgpu::BindGroup)>,
+    /// The counting geometry and billboard pipelines, built at the first attached counter
+    /// and kept.
+    counting_draw: Option<[wgpu::RenderPipeline; 2]>,
+    /// The attached counters' bind group, while counting fragments.
+    fragment_counts: Option<wgpu::BindGroup>,
     terrain: forest_render::terrain::GpuTerrain,
     atmosphere: Atmosphere,
     compute_bg: wgpu::BindGroup,
@@ -413,6 +415,7 @@ impl GeometryRenderer {
             terrain_pipeline,
             draw_layout,
             targets: opts.clone(),
+            counting_draw: None,
             fragment_counts: None,
             terrain,
             atmosphere: opts.atmosphere,
@@ -597,13 +600,13 @@ impl GeometryRenderer {
 
     /// Count the trees' fragments into `counter` from the next frame on
     /// (`forest_render::fragments`), or stop counting (`None`). The counting pipelines are
-    /// built here; the frame's own pipelines are untouched.
+    /// built at the first counter and kept; the frame's own pipelines are untouched.
     pub fn set_fragment_counter(
         &mut self,
         device: &wgpu::Device,
         counter: Option<&forest_render::fragments::FragmentCounter>,
     ) {
-        self.fragment_counts = counter.map(|c| {
+        if counter.is_some() && self.counting_draw.is_none() {
             let counts = forest_render::fragments::bind_layout(device);
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("counted geometry draw"),
@@ -628,14 +631,12 @@ impl GeometryRenderer {
                     true,
                 )
             };
-            (
-                [
-                    pipeline(["vs_geo", "fs_geo"]),
-                    pipeline(["vs_billboard", "fs_billboard"]),
-                ],
-                c.bind_group().clone(),
-            )
-        });
+            self.counting_draw = Some([
+                pipeline(["vs_geo", "fs_geo"]),
+                pipeline(["vs_billboard", "fs_billboard"]),
+            ]);
+        }
+        self.fragment_counts = counter.map(|c| c.bind_group().clone());
     }
 
     /// Record the draw into a render pass after [`Self::encode_compute`]: the environment (sky
@@ -653,12 +654,12 @@ impl GeometryRenderer {
         if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
         }
-        let [draw, billboard] = match &self.fragment_counts {
-            Some(([draw, billboard], counts)) => {
+        let [draw, billboard] = match (&self.counting_draw, &self.fragment_counts) {
+            (Some([draw, billboard]), Some(counts)) => {
                 pass.set_bind_group(1, counts, &[]);
                 [draw, billboard]
             }
-            None => [&self.draw, &self.billboard],
+            _ => [&self.draw, &self.billboard],
         };
         let first_billboard = self.method.first_billboard_band();
         for band in 0..BANDS {

@@ -462,7 +462,7 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
             charts.push(stem);
         }
     }
-    // Per walkthrough (model sizes, real sizes): the fragments each method's first setting
+    // Per walkthrough (model sizes, real sizes): the fragments each method's default setting
     // shades per covered pixel, and the hybrid against the quad stream at the same ε.
     let walks: Vec<String> = ["walkthrough", "walkthrough-real"]
         .iter()
@@ -555,8 +555,7 @@ const DEFAULT_PARAMS: [&str; 6] = [
 ];
 
 /// Fragments per covered pixel of each method in `rows` at its default setting (else its
-/// first): lavapipe's stamps, and the exact counts where the table has them, as a multiple of
-/// the limit of one shaded fragment per covered pixel.
+/// first): lavapipe's stamps and the exact counts, each where the table has them.
 fn fragments_per_pixel(rows: &[&Vec<String>]) -> String {
     let k = COLUMNS.len();
     let num = |row: &[String], i: usize| row.get(k + i).and_then(|c| c.parse::<f64>().ok());
@@ -575,20 +574,22 @@ fn fragments_per_pixel(rows: &[&Vec<String>]) -> String {
         else {
             continue;
         };
-        let Some(stamps) = num(row, 8) else { continue };
-        let exact = match (num(row, 10), num(row, 13), num(row, 14), num(row, 15)) {
-            (Some(f), Some(q), Some(t), Some(h)) => format!(
-                "; exactly {f:.1}, {f:.1}× the limit of one ({q:.1} 2×2-quad lanes, {:.0} % \
-                 transparent, {:.0} % hidden)",
+        let mut parts = Vec::new();
+        if let Some(stamps) = num(row, 8) {
+            parts.push(format!("{stamps:.2} stamp fragments"));
+        }
+        if let (Some(f), Some(q), Some(t), Some(h)) =
+            (num(row, 10), num(row, 13), num(row, 14), num(row, 15))
+        {
+            parts.push(format!(
+                "exactly {f:.1} ({q:.1} 2×2-quad lanes, {:.0} % transparent, {:.0} % hidden)",
                 100.0 * t,
                 100.0 * h
-            ),
-            _ => String::new(),
-        };
-        out.push(format!(
-            "{m} ({}) {stamps:.2} stamp fragments{exact}",
-            row[1]
-        ));
+            ));
+        }
+        if !parts.is_empty() {
+            out.push(format!("{m} ({}) {}", row[1], parts.join("; ")));
+        }
     }
     out.join("; ")
 }

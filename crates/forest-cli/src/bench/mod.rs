@@ -279,8 +279,9 @@ impl Bench {
 
     /// A forest of `trees` trees at real sizes: each species at its mature heights
     /// ([`forest_format::generate::species_height`], by the atlas folder's name; a species
-    /// not in that table keeps its model's size ×0.8–1.25), `area_per_tree` m² of ground per
-    /// tree, as `forest scene` makes it by default. Returns the forest and its side (metres).
+    /// not in that table keeps its model's size ×0.8–1.25, as `forest scene` sizes trees by
+    /// default), `area_per_tree` m² of ground per tree. Returns the forest and its side
+    /// (metres).
     pub fn real_size_forest(
         &self,
         trees: u32,

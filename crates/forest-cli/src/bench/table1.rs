@@ -126,24 +126,32 @@ pub fn run(b: &Bench) -> Result<Section> {
         .rev()
         .map(|r| {
             let c = |k: usize| r.get(10 + k).map_or("", String::as_str);
+            let pct = |k: usize| {
+                c(k).parse::<f64>()
+                    .map_or(String::new(), |v| format!("{:.0} %", 100.0 * v))
+            };
+            let stamps = if c(8).is_empty() {
+                String::new()
+            } else {
+                format!("{} stamp fragments per covered pixel; ", c(8))
+            };
             format!(
                 "{} trees, {}: {} dispatches, {} vertex and {} fragment invocations for {} \
-                 covered pixels ({} stamp fragments per covered pixel; exactly {} fragment \
-                 invocations, median {}, 95th percentile {}, and {} 2×2-quad lanes; {} of \
-                 them transparent and {} hidden), {} compute invocations, {} MB",
+                 covered pixels ({stamps}exactly {} fragment invocations per covered pixel, \
+                 median {}, 95th percentile {}, and {} 2×2-quad lanes; {} of them \
+                 transparent and {} hidden), {} compute invocations, {} MB",
                 r[0],
                 r[1],
                 c(0),
                 c(2),
                 c(4),
                 c(7),
-                c(8),
                 c(10),
                 c(11),
                 c(12),
                 c(13),
-                c(14),
-                c(15),
+                pct(14),
+                pct(15),
                 c(5),
                 c(6)
             )

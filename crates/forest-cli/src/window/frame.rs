@@ -57,10 +57,21 @@ impl Viewer {
                 g.renderer.set_light(light)?;
             }
             g.renderer.set_pipeline_statistics(self.count_work);
-            if self.debug == DebugView::Overdraw {
+            // A counter the device cannot hold (a window past its storage limit) is said on
+            // the HUD, and the view goes back to off.
+            let mut refused = false;
+            let counted = self.debug == DebugView::Overdraw
+                && match super::overdraw(&mut g) {
+                    Ok(()) => true,
+                    Err(e) => {
+                        self.say(format!("overdraw view: {e:#}"));
+                        refused = true;
+                        false
+                    }
+                };
+            if counted {
                 // The counted frame's two draws (forest_render::fragments), then the heat
                 // map over the second.
-                super::overdraw(&mut g)?;
                 let o = g.overdraw.as_ref().expect("made above");
                 o.counter.begin(&g.ctx);
                 let mut first = g.ctx.device.create_command_encoder(&Default::default());
@@ -80,6 +91,9 @@ impl Viewer {
             let ui_ctx = g.egui.clone();
             let mut choice = (None, None);
             let mut out = ui_ctx.run_pass(raw, |c| choice = self.hud(c));
+            if refused {
+                choice.1 = Some(DebugView::Off);
+            }
             // egui insists that texture updates are consumed: take them out now.
             let set: Vec<_> = out.textures_delta.set.drain().collect();
             let free: Vec<_> = out.textures_delta.free.drain().collect();

@@ -366,8 +366,6 @@ impl Viewer {
             return Ok(());
         };
         // The stream's own buffers grow; the scene on the GPU is kept as it is.
-        // Counting pipelines are made again for the stream's new passes.
-        detach_overdraw(g);
         match g.renderer.stream.resize_for(&g.ctx.device, wish.0, wish.1) {
             Ok(()) => {
                 let quads = g.renderer.stream.capacity.quads;
