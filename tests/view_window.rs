@@ -323,14 +323,7 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         .enumerate()
     {
         let p = shot2.get_pixel(b as u32 * side + side / 2, 240 - 2 * side);
-        let want = c.map(|v| {
-            let s = if v <= 0.003_130_8 {
-                12.92 * v
-            } else {
-                1.055 * v.powf(1.0 / 2.4) - 0.055
-            };
-            (s * 255.0).round() as u8
-        });
+        let want = c.map(|v| (forest_format::shading::srgb_encode(v) * 255.0).round() as u8);
         assert!(
             (0..3).all(|k| p[k].abs_diff(want[k]) <= 1),
             "legend swatch {b}: {p:?}, want {want:?}"

@@ -212,14 +212,7 @@ fn a_fragment_behind_written_depth_is_not_shaded() {
 
 /// sRGB bytes of a linear colour, as an sRGB target stores it.
 fn srgb(c: [f32; 3]) -> [u8; 3] {
-    c.map(|v| {
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0).round() as u8
-    })
+    c.map(|v| (forest_format::shading::srgb_encode(v) * 255.0).round() as u8)
 }
 
 #[test]
