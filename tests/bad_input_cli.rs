@@ -297,6 +297,15 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         d,
         &["'-1'", "--seed"],
     );
+    for span in ["0", "65"] {
+        let mut a = render("1,2,3");
+        a.extend(["--far-span".to_string(), span.to_string()]);
+        refused(
+            &strs(&a),
+            d,
+            &[&format!("'{span}'"), "--far-span", "1..=64"],
+        );
+    }
     // Options whose values may start with a hyphen reach their own check.
     let f = &forest_file;
     for (option, value, cause) in [

@@ -210,12 +210,18 @@ pub struct MethodArgs {
     /// node's covered box (for comparison; the images agree, the fragments do not).
     #[arg(long)]
     pub untrimmed: bool,
-    /// Quad stream: blend the aspects of every tree, as the paper does, also of trees that
-    /// span less than ε pixels (drawn by default with their nearest aspect alone).
+    /// Quad stream: blend the aspects of every tree and refine every tree, as the paper does,
+    /// also the far trees (see --far-span; drawn by default with their nearest aspect alone).
     #[arg(long)]
     pub far_blend: bool,
-    /// Quad stream: draw each slab of a tree that spans less than ε pixels as its own quad
-    /// (by default its slabs are composited into one quad, sampled through their parallax).
+    /// Quad stream: a tree narrower than this many ε (pixels) across is far: drawn with its
+    /// nearest aspect alone, its slabs composited into one quad, unrefined. 1 keeps only the
+    /// trees narrower than ε far
+    #[arg(long, default_value_t = forest_render::options::FAR_SPAN_DEFAULT,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(forest_render::options::FAR_SPAN_MAX)))]
+    pub far_span: u32,
+    /// Quad stream: draw each slab of a far tree (see --far-span) as its own quad (by default
+    /// its slabs are composited into one quad, sampled through their parallax).
     #[arg(long)]
     pub far_slabs: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
@@ -252,6 +258,7 @@ impl MethodArgs {
             trim: !self.untrimmed,
             far_nearest: !self.far_blend,
             far_composite: !self.far_slabs,
+            far_span: self.far_span,
         }
     }
 
@@ -785,7 +792,7 @@ fn stream_for(
         ..target_options(args)
     };
     let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
-    stream.set_options(args.m.stream_options());
+    stream.set_options(args.m.stream_options())?;
     Ok(stream)
 }
 

@@ -205,7 +205,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         geometry,
     );
     r.stream.set_debug_view(args.debug_view);
-    r.stream.set_options(args_models.stream_options());
+    r.stream.set_options(args_models.stream_options())?;
     let method = args_models.chosen(mesh_method)?;
     r.set_method(&ctx, method)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);

@@ -104,7 +104,8 @@ fn levels_view_shows_exactly_the_levels_in_the_stream() {
     s.set_options(forest_render::options::StreamOptions {
         blend: forest_render::options::AspectBlend::Nearest,
         ..Default::default()
-    });
+    })
+    .unwrap();
     // ε large enough that the tree is a mix of levels.
     let img = render(&ctx, &mut s, &t, &close_camera(24.0), DebugView::Levels);
     let stats = s.read_stats(&ctx);

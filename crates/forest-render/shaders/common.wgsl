@@ -5,7 +5,8 @@ struct Camera {
     view_proj: mat4x4<f32>,
     // xyz: eye position (world, metres); w: epsilon, the refinement threshold in pixels.
     eye: vec4<f32>,
-    // xyz: unit view direction (world); w: unused.
+    // xyz: unit view direction (world); w: the far span, in units of ε: a tree narrower than
+    // it is a far tree (StreamOptions::far_span).
     forward: vec4<f32>,
     // x, y: viewport size in pixels; z: debug view of the draw pass (0 off, 1 levels,
     // 2 blend weights, 3 wireframe; see renderer::DebugView); w: stream flags (FLAG_*, see

@@ -102,12 +102,15 @@ fn visible(inst: Instance, sp: Species) -> bool {
 
 const SQRT3: f32 = 1.7320508;
 
-// Whether a tree of bounding radius `r` (world) centred at `c` spans less than ε pixels
-// across, seen at the depth of its nearest level-0 corner: its level-0 quads, as wide as the
-// tree, are then never refined, and it is drawn with its nearest aspect alone (its slabs
-// composited into one quad, unless FLAG_FAR_SLABS), unless FLAG_FAR_BLEND. Mirrored by
-// `far_tree` in reference.rs, operation for operation.
-fn far_tree(c: vec3<f32>, r: f32) -> bool {
+// Whether a tree of bounding radius `r` (world) centred at `c` is far: seen at the depth of its
+// nearest level-0 corner, it spans S pixels across with S < far span × ε (forward.w × eye.w)
+// and S · sin θ < ε, θ the angle between the view (object space, `v`, unnormalised) and the
+// nearest aspect's direction `nd` (unit): the parallax its one aspect makes is then within ε.
+// Trees narrower than ε are always far. A far tree's level-0 quads are never refined, and it
+// is drawn with its nearest aspect alone (its slabs composited into one quad, unless
+// FLAG_FAR_SLABS), unless FLAG_FAR_BLEND. Mirrored by `far_tree` in reference.rs, operation
+// for operation; no division, so that both round alike.
+fn far_tree(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> bool {
     if ((stream_flags(camera) & FLAG_FAR_BLEND) != 0u) { return false; }
     let m = camera.view_proj;
     // The nearest a level-0 quad's corner can be: the slab squares' corners lie within
@@ -118,7 +121,13 @@ fn far_tree(c: vec3<f32>, r: f32) -> bool {
     let half = camera.viewport.y * 0.5;
     let d = 2.0 * r * half;
     let e = camera.eye.w * w;
-    return d * d * fy < e * e;
+    let span = camera.forward.w * e;
+    let s2 = d * d * fy;
+    if (s2 >= span * span) { return false; }
+    // sin²θ |v|² = |v|² − (nd · v)²
+    let vv = v.x * v.x + v.y * v.y + v.z * v.z;
+    let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
+    return s2 * (vv - cv * cv) < e * e * vv;
 }
 
 // Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, the
@@ -128,9 +137,7 @@ fn far_tree(c: vec3<f32>, r: f32) -> bool {
 // from zero cannot make the GPU and the CPU reference (reference::aspect_weights) disagree.
 fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
     var q = vec3<u32>(unorm12(w.x), unorm12(w.y), unorm12(w.z));
-    var big = 0u;
-    if (q.y > q[big]) { big = 1u; }
-    if (q.z > q[big]) { big = 2u; }
+    let big = largest(q);
     if (nearest || (stream_flags(camera) & FLAG_NEAREST) != 0u) {
         var one = vec3<u32>(0u);
         one[big] = WEIGHT_ONE;
@@ -139,6 +146,14 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
     let sum = q.x + q.y + q.z;
     q[big] = q[big] + WEIGHT_ONE - sum;
     return q;
+}
+
+// Index of the largest of quantised weights `q` (first on ties): the nearest aspect.
+fn largest(q: vec3<u32>) -> u32 {
+    var big = 0u;
+    if (q.y > q[big]) { big = 1u; }
+    if (q.z > q[big]) { big = 2u; }
+    return big;
 }
 
 // Level-0 quads of one tree, in drawing order: slabs back to front (a far tree's slabs as one
@@ -161,7 +176,9 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, front: u32, last: b
     }
     let eye_obj = to_object_dir(inst, camera.eye.xyz - centre);
     let bl = blend(sp, eye_obj);
-    let far = far_tree(centre, sp.sphere.w * inst.scale);
+    let q = vec3<u32>(unorm12(bl.w.x), unorm12(bl.w.y), unorm12(bl.w.z));
+    let nearest_dir = frames[sp.dir_base + bl.idx[largest(q)]].dir.xyz;
+    let far = far_tree(centre, sp.sphere.w * inst.scale, eye_obj, nearest_dir);
     let w12 = aspect_weights(bl.w, far);
     if (far && sp.slabs > 1u && (stream_flags(camera) & FLAG_FAR_SLABS) == 0u) {
         // One quad for all the slabs of the nearest aspect, on the front-most slab's root.

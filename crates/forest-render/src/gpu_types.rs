@@ -11,7 +11,8 @@ pub struct GpuCamera {
     pub view_proj: [[f32; 4]; 4],
     /// Eye position (world, metres) and, in `w`, ε in pixels.
     pub eye: [f32; 4],
-    /// Unit view direction (world).
+    /// Unit view direction (world); in `w`, the quad stream's far span in units of ε
+    /// ([`crate::options::StreamOptions::far_span`]).
     pub forward: [f32; 4],
     /// Viewport width and height in pixels; `z`: the draw pass's debug view
     /// ([`crate::options::DebugView`] as a number, 0 = off); `w` unused.

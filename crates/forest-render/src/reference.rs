@@ -69,12 +69,7 @@ fn flags(cam: &GpuCamera) -> u32 {
 /// largest alone (see `aspect_weights` in `shaders/cull.wgsl`).
 pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
     let mut w = weight.map(unorm12);
-    let mut big = 0;
-    for a in 1..3 {
-        if w[a] > w[big] {
-            big = a;
-        }
-    }
+    let big = largest(w);
     if flags & FLAG_NEAREST != 0 {
         let mut one = [0; 3];
         one[big] = WEIGHT_ONE;
@@ -85,12 +80,26 @@ pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
     w
 }
 
+/// Index of the largest of quantised weights (first on ties): the nearest aspect (see
+/// `largest` in `shaders/cull.wgsl`).
+fn largest(w: [u32; 3]) -> usize {
+    let mut big = 0;
+    for a in 1..3 {
+        if w[a] > w[big] {
+            big = a;
+        }
+    }
+    big
+}
+
 /// √3 in f32, as `SQRT3` in `shaders/cull.wgsl`.
 const SQRT3: f32 = 1.732_050_8;
 
-/// Whether a tree spans less than ε pixels across, seen at the depth of its nearest level-0
-/// corner (see `far_tree` in `shaders/cull.wgsl`).
-fn far_tree(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
+/// Whether a tree is far: narrower than its far span (`forward.w` × ε) pixels, seen at the
+/// depth of its nearest level-0 corner, and its nearest aspect's parallax within ε (see
+/// `far_tree` in `shaders/cull.wgsl`; `v` the object-space view, `nd` that aspect's unit
+/// direction).
+fn far_tree(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> bool {
     if flags(cam) & FLAG_FAR_BLEND != 0 {
         return false;
     }
@@ -103,7 +112,14 @@ fn far_tree(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
     let half = cam.viewport[1] * 0.5;
     let d = 2.0 * r * half;
     let e = cam.eye[3] * w;
-    d * d * fy < e * e
+    let span = cam.forward[3] * e;
+    let s2 = d * d * fy;
+    if s2 >= span * span {
+        return false;
+    }
+    let vv = v.x * v.x + v.y * v.y + v.z * v.z;
+    let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
+    s2 * (vv - cv * cv) < e * e * vv
 }
 
 fn xyz(v: [f32; 4]) -> Vec3 {
@@ -148,7 +164,8 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let upper = tris(sp.tri_base, sp.tri_count);
     let lower = tris(sp.tri_base + sp.tri_count, sp.lower_tri_count);
     let bl = blend(&dirs, &upper, &lower, eye_obj);
-    let far = far_tree(cam, centre, sp.sphere[3] * inst.scale);
+    let nearest = dirs[bl.index[largest(bl.weight.map(unorm12))] as usize];
+    let far = far_tree(cam, centre, sp.sphere[3] * inst.scale, eye_obj, nearest);
     let w12 = aspect_weights(bl.weight, flags(cam) | if far { FLAG_NEAREST } else { 0 });
     if far && sp.slabs > 1 && flags(cam) & FLAG_FAR_SLABS == 0 {
         // One quad for all the slabs of the nearest aspect, on the front-most slab's root.

@@ -584,8 +584,10 @@ impl QuadStream {
     }
 
     /// Choose the stream's run-time options from the next [`Self::prepare`] on.
-    pub fn set_options(&mut self, options: StreamOptions) {
+    pub fn set_options(&mut self, options: StreamOptions) -> Result<(), RenderError> {
+        options.validate()?;
         self.options = options;
+        Ok(())
     }
 
     /// The run-time options in use.
@@ -658,7 +660,7 @@ impl QuadStream {
 
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
         g.viewport[2] = self.debug.shader_value() as f32;
-        g.viewport[3] = self.options.flags() as f32;
+        self.options.apply(&mut g);
         g.forms = self.forms;
         g.set_light(&self.light);
         crate::camera::upload(queue, &self.camera, &g, &mut self.writes);

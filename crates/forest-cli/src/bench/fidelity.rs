@@ -87,6 +87,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             trim: false,
             far_nearest: false,
             far_composite: false,
+            far_span: 1,
         },
         epsilon: EPS,
         geometry: false,
@@ -429,7 +430,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                         }
                     }
                 };
-                r.stream.set_options(v.options);
+                r.stream.set_options(v.options)?;
                 let mut flips = Vec::new();
                 for (ci, (view, rf)) in views.iter().zip(&refs).enumerate() {
                     let mut cam = view.cam;
@@ -471,7 +472,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                         frame_ms,
                     });
                 }
-                r.stream.set_options(StreamOptions::default());
+                r.stream.set_options(StreamOptions::default())?;
                 eprintln!(
                     "fidelity: {species} {}: mean FLIP {:.4} ({:.1} s)",
                     v.name,
