@@ -220,6 +220,11 @@ pub struct MethodArgs {
     #[arg(long, default_value_t = forest_render::options::FAR_SPAN_DEFAULT,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(forest_render::options::FAR_SPAN_MAX)))]
     pub far_span: u32,
+    /// Quad stream: aspect sharpening, 0 to 0.333: each of a tree's 1–3 blend weights loses
+    /// this share and the rest are scaled back to one, so aspects of small weight fade out
+    /// (fewer layers of quads); 0 is the paper's blend
+    #[arg(long, default_value_t = f64::from(forest_render::options::SHARPEN_DEFAULT) / 4095.0, value_parser = parse_sharpen)]
+    pub sharpen: f64,
     /// Quad stream: draw each slab of a far tree (see --far-span) as its own quad (by default
     /// its slabs are composited into one quad, sampled through their parallax).
     #[arg(long)]
@@ -235,6 +240,14 @@ pub struct MethodArgs {
     /// in it is drawn by both forms through complementary screen-door masks).
     #[arg(long, allow_negative_numbers = true, default_value_t = Hybrid::default().band)]
     pub band: f32,
+}
+
+fn parse_sharpen(s: &str) -> Result<f64, String> {
+    let max = f64::from(forest_render::options::SHARPEN_MAX) / 4095.0;
+    match s.parse::<f64>() {
+        Ok(x) if (0.0..=max).contains(&x) => Ok(x),
+        _ => Err(format!("{s:?}: expected a share from 0 to {max:.3}")),
+    }
 }
 
 fn parse_near(s: &str) -> Result<Near, String> {
@@ -259,6 +272,7 @@ impl MethodArgs {
             far_nearest: !self.far_blend,
             far_composite: !self.far_slabs,
             far_span: self.far_span,
+            sharpen: (self.sharpen * 4095.0).round() as u32,
         }
     }
 

@@ -269,6 +269,8 @@ const FLAG_DEPTH_ERROR: u32 = 4u;
 const FLAG_UNTRIMMED: u32 = 8u;
 const FLAG_FAR_BLEND: u32 = 16u;
 const FLAG_FAR_SLABS: u32 = 32u;
+// Bits 8–19 of the flags: aspect sharpening in units of 1/WEIGHT_ONE (StreamOptions::sharpen).
+const SHARPEN_SHIFT: u32 = 8u;
 // A far tree's slabs drawn as one quad: level 0 at column 1, which level 0 lacks (mirrors
 // Quad::COMPOSITE_POS); its node is the root of the front-most slab present.
 const COMPOSITE_POS: u32 = 16u;

@@ -130,9 +130,9 @@ fn far_tree(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> bool {
     return s2 * (vv - cv * cv) < e * e * vv;
 }
 
-// Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, the
-// remainder given to the largest (first on ties); with FLAG_NEAREST or `nearest` the largest
-// alone.
+// Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, then
+// sharpened (StreamOptions::sharpen), the remainder given to the largest (first on ties); with
+// FLAG_NEAREST or `nearest` the largest alone.
 // Quantising first puts every later decision on integers, so a weight a rounding error away
 // from zero cannot make the GPU and the CPU reference (reference::aspect_weights) disagree.
 fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
@@ -142,6 +142,13 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
         var one = vec3<u32>(0u);
         one[big] = WEIGHT_ONE;
         return one;
+    }
+    // Sharpening: each weight less t, the rest scaled back up (integers, as the CPU mirror;
+    // the largest keeps at least one since t < WEIGHT_ONE / 3).
+    let t = (stream_flags(camera) >> SHARPEN_SHIFT) & 4095u;
+    if (t > 0u) {
+        let s = vec3<u32>(max(q.x, t) - t, max(q.y, t) - t, max(q.z, t) - t);
+        q = (s * WEIGHT_ONE) / (s.x + s.y + s.z);
     }
     let sum = q.x + q.y + q.z;
     q[big] = q[big] + WEIGHT_ONE - sum;

@@ -106,7 +106,8 @@ impl FrameParams {
     }
 }
 
-/// The camera uniform from its parts: matrix, eye and ε, forward, viewport, frustum planes.
+/// The camera uniform from its parts: matrix, eye and ε, forward, viewport, frustum planes,
+/// with the default stream options (what a stream writes unless given others).
 pub(crate) fn gpu_camera(
     m: Mat4,
     eye: Vec3,
@@ -114,17 +115,17 @@ pub(crate) fn gpu_camera(
     viewport: (u32, u32),
     epsilon: f32,
 ) -> GpuCamera {
-    GpuCamera {
+    let mut g = GpuCamera {
         view_proj: m.to_cols_array_2d(),
         eye: eye.extend(epsilon).to_array(),
-        forward: forward
-            .extend(crate::options::FAR_SPAN_DEFAULT as f32)
-            .to_array(),
+        forward: forward.extend(0.0).to_array(),
         viewport: [viewport.0 as f32, viewport.1 as f32, 0.0, 0.0],
         planes: frustum_planes(m),
         forms: crate::forms::FORMS_QUADS,
         ..Default::default()
-    }
+    };
+    crate::options::StreamOptions::default().apply(&mut g);
+    g
 }
 
 /// The six frustum planes of a clip matrix (`xyz · p + w ≥ 0` inside, unit normals, metres):

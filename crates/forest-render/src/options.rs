@@ -197,18 +197,24 @@ pub struct StreamOptions {
     /// instead of up to three. On (the default); off blends every tree's aspects and refines
     /// every tree, as the paper does.
     pub far_nearest: bool,
-    /// The width below which a tree is far, in units of ε (1 to [`FAR_SPAN_MAX`]): a far tree
-    /// is drawn as one aspect, its slabs composited, unrefined. Default [`FAR_SPAN_DEFAULT`]:
-    /// measured by `forest bench accuracy` (walkthrough, ε 16) and Table 1's 100k-tree view
-    /// from inside, spans of 1, 2, 4 and 8 ε changed the walkthrough's mean FLIP by 0,
-    /// +0.05, +0.3 and +1.1 % and cut its fragments per covered pixel by 0, 10, 21 and 31 %,
-    /// Table 1's by 0, 30, 44 and 50 % (at 8 ε the composited quads' costlier fragments
-    /// outweighed the cut). 1 is the stream before this option: only trees narrower than ε.
+    /// The width below which a tree may be far, in units of ε (1 to [`FAR_SPAN_MAX`]): a tree
+    /// S pixels wide with S < far_span · ε and S · sin θ < ε (θ from the view to its nearest
+    /// aspect) is drawn as one aspect, its slabs composited, unrefined. Default
+    /// [`FAR_SPAN_DEFAULT`], chosen by the measurements under "The far span and aspect
+    /// sharpening" in docs/rendering.md. 1 is the stream before this option: only trees
+    /// narrower than ε are far.
     pub far_span: u32,
     /// Draw such a tree's slabs as one quad, composited in the fragment shader on the plane
     /// through the tree's centre (its slabs' parallax is below ε there), instead of one quad
     /// per slab. On (the default, with `far_nearest`); off draws each slab's quad.
     pub far_composite: bool,
+    /// Aspect sharpening, in units of 1/[`WEIGHT_ONE`](crate::gpu_types::WEIGHT_ONE) (0 to
+    /// [`SHARPEN_MAX`]): each of a tree's 1–3 blend weights loses this much (to no less than
+    /// 0) and the rest are scaled back to a sum of one, so an aspect of small weight fades out
+    /// continuously (no pop) instead of adding a faint layer of quads. Default
+    /// [`SHARPEN_DEFAULT`] (10 %), chosen by the measurements under "The far span and aspect
+    /// sharpening" in docs/rendering.md. 0 is the paper's barycentric blend.
+    pub sharpen: u32,
 }
 
 impl Default for StreamOptions {
@@ -220,9 +226,18 @@ impl Default for StreamOptions {
             far_nearest: true,
             far_composite: true,
             far_span: FAR_SPAN_DEFAULT,
+            sharpen: SHARPEN_DEFAULT,
         }
     }
 }
+
+/// Default [`StreamOptions::sharpen`]: 10 % of a weight of one.
+pub const SHARPEN_DEFAULT: u32 = 410;
+/// Largest [`StreamOptions::sharpen`]: below a third of one, so the largest of three weights
+/// summing to one always keeps a share.
+pub const SHARPEN_MAX: u32 = 1364;
+/// First bit of [`StreamOptions::sharpen`] in the flags of `viewport.w` (12 bits).
+pub const SHARPEN_SHIFT: u32 = 8;
 
 /// Default [`StreamOptions::far_span`].
 pub const FAR_SPAN_DEFAULT: u32 = 4;
@@ -253,6 +268,12 @@ impl StreamOptions {
 
     /// Refuse options out of their ranges, naming the option.
     pub fn validate(self) -> Result<(), crate::RenderError> {
+        if self.sharpen > SHARPEN_MAX {
+            return Err(crate::RenderError::Parameter(format!(
+                "aspect sharpening {}/4095: expected at most {SHARPEN_MAX}/4095 (a third of one)",
+                self.sharpen
+            )));
+        }
         if !(1..=FAR_SPAN_MAX).contains(&self.far_span) {
             return Err(crate::RenderError::Parameter(format!(
                 "far span {}: expected 1 to {FAR_SPAN_MAX} (a multiple of ε)",
@@ -282,6 +303,7 @@ impl StreamOptions {
             } else {
                 FLAG_FAR_SLABS
             }
+            | self.sharpen.min(SHARPEN_MAX) << SHARPEN_SHIFT
     }
 }
 
@@ -574,6 +596,43 @@ impl RendererOptions {
 mod tests {
     use super::*;
 
+    /// Sharpening: weights (0.7, 0.25, 0.05) quantise to (2867, 1024, 205), whose sum's excess
+    /// the largest gives back; less 410 each, (2457, 614, 0), scaled to 4095 in integers
+    /// (3276, 818, 0), and the remainder to the largest. A sharpening past a third is refused; the value rides in flag bits 8–19.
+    #[test]
+    fn sharpening_fades_the_faint_aspect_out_exactly() {
+        let flags = |sharpen| {
+            StreamOptions {
+                sharpen,
+                ..Default::default()
+            }
+            .flags()
+        };
+        let w = [0.7, 0.25, 0.05];
+        assert_eq!(
+            crate::reference::aspect_weights(w, flags(0)),
+            [2866, 1024, 205]
+        );
+        assert_eq!(
+            crate::reference::aspect_weights(w, flags(410)),
+            [3277, 818, 0]
+        );
+        assert_eq!((flags(410) >> SHARPEN_SHIFT) & 4095, 410);
+        assert_eq!(flags(0) >> SHARPEN_SHIFT, 0);
+        let e = StreamOptions {
+            sharpen: SHARPEN_MAX + 1,
+            ..Default::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("sharpening"), "{e}");
+        // The largest share a third of one can leave: the largest weight keeps the whole.
+        let q = crate::reference::aspect_weights([0.34, 0.33, 0.33], flags(SHARPEN_MAX));
+        assert_eq!(q.iter().sum::<u32>(), crate::gpu_types::WEIGHT_ONE);
+        assert_eq!(q[0], crate::gpu_types::WEIGHT_ONE);
+    }
+
     /// A far span out of 1..=FAR_SPAN_MAX is refused with a message naming it; the options
     /// reach the camera uniform where the shaders read them.
     #[test]
@@ -599,9 +658,10 @@ mod tests {
             let mut g = crate::gpu_types::GpuCamera::default();
             o.apply(&mut g);
             assert_eq!(g.forward[3], good as f32);
-            assert_eq!(g.viewport[3] as u32, FLAG_NEAREST);
+            assert_eq!(g.viewport[3] as u32, o.flags());
+            assert_eq!(o.flags() & 0xff, FLAG_NEAREST);
         }
-        // A camera made without a stream carries the default span, as a stream would write.
+        // A camera made without a stream carries the default options, as a stream would write.
         let cam = crate::Camera {
             eye: glam::Vec3::new(0.0, 2.0, 10.0),
             target: glam::Vec3::ZERO,
@@ -611,7 +671,11 @@ mod tests {
             viewport: (64, 48),
             epsilon: 4.0,
         };
-        assert_eq!(cam.to_gpu().forward[3], FAR_SPAN_DEFAULT as f32);
+        let mut g = cam.to_gpu();
+        assert_eq!(g.forward[3], FAR_SPAN_DEFAULT as f32);
+        assert_eq!(g.viewport[3] as u32, StreamOptions::default().flags());
+        StreamOptions::default().apply(&mut g);
+        assert_eq!(g, cam.to_gpu());
     }
 
     /// The environment shader tints the atmosphere's sky by the frame's sky light over the

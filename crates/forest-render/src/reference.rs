@@ -8,7 +8,9 @@ use forest_format::QuadNode;
 use forest_format::node::ERROR_BOUNDS;
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE, kept_composites};
-use crate::options::{FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST};
+use crate::options::{
+    FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST, SHARPEN_SHIFT,
+};
 use crate::scene::SceneTables;
 
 /// Result of the reference: the final stream and the frame's counters.
@@ -65,7 +67,8 @@ fn flags(cam: &GpuCamera) -> u32 {
 }
 
 /// Blend weights in units of 1/[`WEIGHT_ONE`], summing to exactly [`WEIGHT_ONE`]: each rounded,
-/// the rounding remainder given to the largest (first on ties); with [`FLAG_NEAREST`] the
+/// sharpened by the flags' [`SHARPEN_SHIFT`] bits (each less that share, the rest scaled back
+/// to one), the remainder given to the largest (first on ties); with [`FLAG_NEAREST`] the
 /// largest alone (see `aspect_weights` in `shaders/cull.wgsl`).
 pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
     let mut w = weight.map(unorm12);
@@ -74,6 +77,12 @@ pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
         let mut one = [0; 3];
         one[big] = WEIGHT_ONE;
         return one;
+    }
+    let t = (flags >> SHARPEN_SHIFT) & 4095;
+    if t > 0 {
+        let s = w.map(|x| x.max(t) - t);
+        let sum = s[0] + s[1] + s[2];
+        w = s.map(|x| x * WEIGHT_ONE / sum);
     }
     let sum = w[0] + w[1] + w[2];
     w[big] = w[big] + WEIGHT_ONE - sum;

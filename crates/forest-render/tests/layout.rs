@@ -158,16 +158,19 @@ fn bind_group_layouts_match_the_wgsl() {
 
 #[test]
 fn constants_shared_with_the_wgsl_agree() {
-    use forest_render::options::{DebugView, FLAG_DEPTH_ERROR, FLAG_DITHER, FLAG_NEAREST};
+    use forest_render::options::{self, DebugView, FLAG_DEPTH_ERROR, FLAG_DITHER, FLAG_NEAREST};
     let c = compute_source();
     let d = draw_source();
-    let pairs: [(&str, &str, f64); 9] = [
+    let pairs: [(&str, &str, f64); 12] = [
         (&c, "WG", f64::from(forest_render::capacity::WG)),
         (&c, "BLOCK", f64::from(forest_render::capacity::BLOCK)),
         (&c, "WEIGHT_ONE", f64::from(WEIGHT_ONE)),
         (&c, "FLAG_DITHER", f64::from(FLAG_DITHER)),
         (&c, "FLAG_NEAREST", f64::from(FLAG_NEAREST)),
         (&c, "FLAG_DEPTH_ERROR", f64::from(FLAG_DEPTH_ERROR)),
+        (&c, "FLAG_FAR_BLEND", f64::from(options::FLAG_FAR_BLEND)),
+        (&c, "FLAG_FAR_SLABS", f64::from(options::FLAG_FAR_SLABS)),
+        (&c, "SHARPEN_SHIFT", f64::from(options::SHARPEN_SHIFT)),
         (&c, "NONE", f64::from(u32::MAX)),
         (
             &c,

@@ -88,6 +88,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             far_nearest: false,
             far_composite: false,
             far_span: 1,
+            sharpen: 0,
         },
         epsilon: EPS,
         geometry: false,
