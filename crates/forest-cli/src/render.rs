@@ -11,6 +11,7 @@ use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
 use forest_render::fragments::{FragmentCounter, FragmentCounts, FragmentSummary};
+use forest_render::gpu_types::WEIGHT_ONE;
 use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOptions};
 use forest_render::passes::overdraw::OverdrawPass;
 use forest_render::scene::SpeciesData;
@@ -214,16 +215,16 @@ pub struct MethodArgs {
     /// also the far trees (see --far-span; drawn by default with their nearest aspect alone).
     #[arg(long)]
     pub far_blend: bool,
-    /// Quad stream: a tree narrower than this many ε (pixels) across is far: drawn with its
-    /// nearest aspect alone, its slabs composited into one quad, unrefined. 1 keeps only the
-    /// trees narrower than ε far
+    /// Quad stream: a tree narrower than this many ε (pixels) across, whose nearest aspect's
+    /// parallax stays within ε, is far: drawn with that aspect alone, its slabs composited
+    /// into one quad, unrefined. 1 keeps only the trees narrower than ε far
     #[arg(long, default_value_t = forest_render::options::FAR_SPAN_DEFAULT,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(forest_render::options::FAR_SPAN_MAX)))]
     pub far_span: u32,
     /// Quad stream: aspect sharpening, 0 to 0.333: each of a tree's 1–3 blend weights loses
     /// this share and the rest are scaled back to one, so aspects of small weight fade out
     /// (fewer layers of quads); 0 is the paper's blend
-    #[arg(long, default_value_t = f64::from(forest_render::options::SHARPEN_DEFAULT) / 4095.0, value_parser = parse_sharpen)]
+    #[arg(long, default_value_t = f64::from(forest_render::options::SHARPEN_DEFAULT) / f64::from(WEIGHT_ONE), value_parser = parse_sharpen)]
     pub sharpen: f64,
     /// Quad stream: draw each slab of a far tree (see --far-span) as its own quad (by default
     /// its slabs are composited into one quad, sampled through their parallax).
@@ -243,7 +244,7 @@ pub struct MethodArgs {
 }
 
 fn parse_sharpen(s: &str) -> Result<f64, String> {
-    let max = f64::from(forest_render::options::SHARPEN_MAX) / 4095.0;
+    let max = f64::from(forest_render::options::SHARPEN_MAX) / f64::from(WEIGHT_ONE);
     match s.parse::<f64>() {
         Ok(x) if (0.0..=max).contains(&x) => Ok(x),
         _ => Err(format!("{s:?}: expected a share from 0 to {max:.3}")),
@@ -272,7 +273,7 @@ impl MethodArgs {
             far_nearest: !self.far_blend,
             far_composite: !self.far_slabs,
             far_span: self.far_span,
-            sharpen: (self.sharpen * 4095.0).round() as u32,
+            sharpen: (self.sharpen * f64::from(WEIGHT_ONE)).round() as u32,
         }
     }
 

@@ -633,15 +633,19 @@ fn trees_narrower_than_epsilon_draw_their_nearest_aspect_alone() {
     assert!(m.flip_mean < 0.15, "FLIP {}", m.flip_mean);
 }
 
-/// One of three option sets on the six test cameras (the five named ones at ε 4 and the far
-/// view at ε 16): each frame checked against the CPU reference, its counts, its exact
-/// fragments summed over the views, and its FLIP against the 4×4 reference summed over them.
-/// `between(name, a, b)` checks each view's consecutive frame statistics.
+/// What [`sweep`] measured of its three option sets: exact fragments and FLIP against the 4×4
+/// reference, each summed over the six views.
 struct Sweep {
     fragments: [u64; 3],
     flips: [f32; 3],
 }
 
+/// Three option sets on the six test cameras (the five named ones at ε 4 and the far view at
+/// ε 16): each frame checked against the CPU reference (`checked_frame`), counted exactly,
+/// and compared with the 4×4 reference; no view may be more than FLIP 0.01 less accurate
+/// with the second set than with the first, and the second must shade fewer fragments than
+/// the first, the third no more than the second. `between(name, a, b)` checks each view's
+/// consecutive frame statistics.
 fn sweep(
     label: &str,
     options: [forest_render::options::StreamOptions; 3],

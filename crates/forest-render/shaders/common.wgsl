@@ -5,8 +5,9 @@ struct Camera {
     view_proj: mat4x4<f32>,
     // xyz: eye position (world, metres); w: epsilon, the refinement threshold in pixels.
     eye: vec4<f32>,
-    // xyz: unit view direction (world); w: the far span, in units of ε: a tree narrower than
-    // it is a far tree (StreamOptions::far_span).
+    // xyz: unit view direction (world); w: the far span K, in units of ε: a tree narrower
+    // than K·ε pixels whose nearest aspect's parallax stays within ε is a far tree
+    // (StreamOptions::far_span, far_tree in cull.wgsl).
     forward: vec4<f32>,
     // x, y: viewport size in pixels; z: debug view of the draw pass (0 off, 1 levels,
     // 2 blend weights, 3 wireframe; see renderer::DebugView); w: stream flags (FLAG_*, see
@@ -271,6 +272,7 @@ const FLAG_FAR_BLEND: u32 = 16u;
 const FLAG_FAR_SLABS: u32 = 32u;
 // Bits 8–19 of the flags: aspect sharpening in units of 1/WEIGHT_ONE (StreamOptions::sharpen).
 const SHARPEN_SHIFT: u32 = 8u;
+const SHARPEN_MASK: u32 = 4095u;
 // A far tree's slabs drawn as one quad: level 0 at column 1, which level 0 lacks (mirrors
 // Quad::COMPOSITE_POS); its node is the root of the front-most slab present.
 const COMPOSITE_POS: u32 = 16u;

@@ -130,13 +130,18 @@ fn far_tree(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> bool {
     return s2 * (vv - cv * cv) < e * e * vv;
 }
 
-// Blend weights in units of 1/WEIGHT_ONE summing to exactly WEIGHT_ONE: each rounded, then
-// sharpened (StreamOptions::sharpen), the remainder given to the largest (first on ties); with
+// A blend's weights rounded to units of 1/WEIGHT_ONE. Quantising first puts every later
+// decision on integers, so a weight a rounding error away from zero cannot make the GPU and
+// the CPU reference (reference::quantise, aspect_weights) disagree.
+fn quantise(w: vec3<f32>) -> vec3<u32> {
+    return vec3<u32>(unorm12(w.x), unorm12(w.y), unorm12(w.z));
+}
+
+// Blend weights from quantised ones `q`, summing to exactly WEIGHT_ONE: sharpened
+// (StreamOptions::sharpen), the remainder given to the largest (first on ties); with
 // FLAG_NEAREST or `nearest` the largest alone.
-// Quantising first puts every later decision on integers, so a weight a rounding error away
-// from zero cannot make the GPU and the CPU reference (reference::aspect_weights) disagree.
-fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
-    var q = vec3<u32>(unorm12(w.x), unorm12(w.y), unorm12(w.z));
+fn aspect_weights(quantised: vec3<u32>, nearest: bool) -> vec3<u32> {
+    var q = quantised;
     let big = largest(q);
     if (nearest || (stream_flags(camera) & FLAG_NEAREST) != 0u) {
         var one = vec3<u32>(0u);
@@ -145,7 +150,7 @@ fn aspect_weights(w: vec3<f32>, nearest: bool) -> vec3<u32> {
     }
     // Sharpening: each weight less t, the rest scaled back up (integers, as the CPU mirror;
     // the largest keeps at least one since t < WEIGHT_ONE / 3).
-    let t = (stream_flags(camera) >> SHARPEN_SHIFT) & 4095u;
+    let t = (stream_flags(camera) >> SHARPEN_SHIFT) & SHARPEN_MASK;
     if (t > 0u) {
         let s = vec3<u32>(max(q.x, t) - t, max(q.y, t) - t, max(q.z, t) - t);
         q = (s * WEIGHT_ONE) / (s.x + s.y + s.z);
@@ -183,10 +188,10 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, front: u32, last: b
     }
     let eye_obj = to_object_dir(inst, camera.eye.xyz - centre);
     let bl = blend(sp, eye_obj);
-    let q = vec3<u32>(unorm12(bl.w.x), unorm12(bl.w.y), unorm12(bl.w.z));
+    let q = quantise(bl.w);
     let nearest_dir = frames[sp.dir_base + bl.idx[largest(q)]].dir.xyz;
     let far = far_tree(centre, sp.sphere.w * inst.scale, eye_obj, nearest_dir);
-    let w12 = aspect_weights(bl.w, far);
+    let w12 = aspect_weights(q, far);
     if (far && sp.slabs > 1u && (stream_flags(camera) & FLAG_FAR_SLABS) == 0u) {
         // One quad for all the slabs of the nearest aspect, on the front-most slab's root.
         var a = 0u;

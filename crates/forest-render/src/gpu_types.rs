@@ -15,7 +15,8 @@ pub struct GpuCamera {
     /// ([`crate::options::StreamOptions::far_span`]).
     pub forward: [f32; 4],
     /// Viewport width and height in pixels; `z`: the draw pass's debug view
-    /// ([`crate::options::DebugView`] as a number, 0 = off); `w` unused.
+    /// ([`crate::options::DebugView`] as a number, 0 = off); `w`: the quad stream's flags
+    /// ([`crate::options::StreamOptions::flags`]).
     pub viewport: [f32; 4],
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],

@@ -4,7 +4,7 @@
 
 use forest_format::shading::Lighting;
 
-use crate::gpu_types::GpuEnvironment;
+use crate::gpu_types::{GpuEnvironment, WEIGHT_ONE};
 
 /// What the trees are drawn over.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -208,7 +208,7 @@ pub struct StreamOptions {
     /// through the tree's centre (its slabs' parallax is below ε there), instead of one quad
     /// per slab. On (the default, with `far_nearest`); off draws each slab's quad.
     pub far_composite: bool,
-    /// Aspect sharpening, in units of 1/[`WEIGHT_ONE`](crate::gpu_types::WEIGHT_ONE) (0 to
+    /// Aspect sharpening, in units of 1/[`WEIGHT_ONE`](WEIGHT_ONE) (0 to
     /// [`SHARPEN_MAX`]): each of a tree's 1–3 blend weights loses this much (to no less than
     /// 0) and the rest are scaled back to a sum of one, so an aspect of small weight fades out
     /// continuously (no pop) instead of adding a faint layer of quads. Default
@@ -236,8 +236,10 @@ pub const SHARPEN_DEFAULT: u32 = 410;
 /// Largest [`StreamOptions::sharpen`]: below a third of one, so the largest of three weights
 /// summing to one always keeps a share.
 pub const SHARPEN_MAX: u32 = 1364;
-/// First bit of [`StreamOptions::sharpen`] in the flags of `viewport.w` (12 bits).
+/// First bit of [`StreamOptions::sharpen`] in the flags of `viewport.w`.
 pub const SHARPEN_SHIFT: u32 = 8;
+/// Mask of [`StreamOptions::sharpen`]'s 12 bits once shifted down by [`SHARPEN_SHIFT`].
+pub const SHARPEN_MASK: u32 = 0xfff;
 
 /// Default [`StreamOptions::far_span`].
 pub const FAR_SPAN_DEFAULT: u32 = 4;
@@ -270,7 +272,8 @@ impl StreamOptions {
     pub fn validate(self) -> Result<(), crate::RenderError> {
         if self.sharpen > SHARPEN_MAX {
             return Err(crate::RenderError::Parameter(format!(
-                "aspect sharpening {}/4095: expected at most {SHARPEN_MAX}/4095 (a third of one)",
+                "aspect sharpening {}/{WEIGHT_ONE}: expected at most {SHARPEN_MAX}/{WEIGHT_ONE} \
+                 (a third of one)",
                 self.sharpen
             )));
         }
@@ -608,16 +611,17 @@ mod tests {
             }
             .flags()
         };
+        use crate::reference::quantise;
         let w = [0.7, 0.25, 0.05];
         assert_eq!(
-            crate::reference::aspect_weights(w, flags(0)),
+            crate::reference::aspect_weights(quantise(w), flags(0)),
             [2866, 1024, 205]
         );
         assert_eq!(
-            crate::reference::aspect_weights(w, flags(410)),
+            crate::reference::aspect_weights(quantise(w), flags(410)),
             [3277, 818, 0]
         );
-        assert_eq!((flags(410) >> SHARPEN_SHIFT) & 4095, 410);
+        assert_eq!((flags(410) >> SHARPEN_SHIFT) & SHARPEN_MASK, 410);
         assert_eq!(flags(0) >> SHARPEN_SHIFT, 0);
         let e = StreamOptions {
             sharpen: SHARPEN_MAX + 1,
@@ -628,9 +632,9 @@ mod tests {
         .to_string();
         assert!(e.contains("sharpening"), "{e}");
         // The largest share a third of one can leave: the largest weight keeps the whole.
-        let q = crate::reference::aspect_weights([0.34, 0.33, 0.33], flags(SHARPEN_MAX));
-        assert_eq!(q.iter().sum::<u32>(), crate::gpu_types::WEIGHT_ONE);
-        assert_eq!(q[0], crate::gpu_types::WEIGHT_ONE);
+        let q = crate::reference::aspect_weights(quantise([0.34, 0.33, 0.33]), flags(SHARPEN_MAX));
+        assert_eq!(q.iter().sum::<u32>(), WEIGHT_ONE);
+        assert_eq!(q[0], WEIGHT_ONE);
     }
 
     /// A far span out of 1..=FAR_SPAN_MAX is refused with a message naming it; the options

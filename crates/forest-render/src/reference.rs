@@ -9,7 +9,7 @@ use forest_format::node::ERROR_BOUNDS;
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE, kept_composites};
 use crate::options::{
-    FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST, SHARPEN_SHIFT,
+    FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST, SHARPEN_MASK, SHARPEN_SHIFT,
 };
 use crate::scene::SceneTables;
 
@@ -66,19 +66,25 @@ fn flags(cam: &GpuCamera) -> u32 {
     cam.viewport[3] as u32
 }
 
-/// Blend weights in units of 1/[`WEIGHT_ONE`], summing to exactly [`WEIGHT_ONE`]: each rounded,
-/// sharpened by the flags' [`SHARPEN_SHIFT`] bits (each less that share, the rest scaled back
-/// to one), the remainder given to the largest (first on ties); with [`FLAG_NEAREST`] the
-/// largest alone (see `aspect_weights` in `shaders/cull.wgsl`).
-pub fn aspect_weights(weight: [f32; 3], flags: u32) -> [u32; 3] {
-    let mut w = weight.map(unorm12);
+/// A blend's weights rounded to units of 1/[`WEIGHT_ONE`] (see `quantise` in
+/// `shaders/cull.wgsl`).
+pub fn quantise(weight: [f32; 3]) -> [u32; 3] {
+    weight.map(unorm12)
+}
+
+/// Blend weights from [`quantise`]d ones, summing to exactly [`WEIGHT_ONE`]: sharpened by the
+/// flags' [`SHARPEN_SHIFT`] bits (each less that share, the rest scaled back to one), the
+/// remainder given to the largest (first on ties); with [`FLAG_NEAREST`] the largest alone
+/// (see `aspect_weights` in `shaders/cull.wgsl`).
+pub fn aspect_weights(quantised: [u32; 3], flags: u32) -> [u32; 3] {
+    let mut w = quantised;
     let big = largest(w);
     if flags & FLAG_NEAREST != 0 {
         let mut one = [0; 3];
         one[big] = WEIGHT_ONE;
         return one;
     }
-    let t = (flags >> SHARPEN_SHIFT) & 4095;
+    let t = (flags >> SHARPEN_SHIFT) & SHARPEN_MASK;
     if t > 0 {
         let s = w.map(|x| x.max(t) - t);
         let sum = s[0] + s[1] + s[2];
@@ -173,9 +179,10 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let upper = tris(sp.tri_base, sp.tri_count);
     let lower = tris(sp.tri_base + sp.tri_count, sp.lower_tri_count);
     let bl = blend(&dirs, &upper, &lower, eye_obj);
-    let nearest = dirs[bl.index[largest(bl.weight.map(unorm12))] as usize];
+    let q = quantise(bl.weight);
+    let nearest = dirs[bl.index[largest(q)] as usize];
     let far = far_tree(cam, centre, sp.sphere[3] * inst.scale, eye_obj, nearest);
-    let w12 = aspect_weights(bl.weight, flags(cam) | if far { FLAG_NEAREST } else { 0 });
+    let w12 = aspect_weights(q, flags(cam) | if far { FLAG_NEAREST } else { 0 });
     if far && sp.slabs > 1 && flags(cam) & FLAG_FAR_SLABS == 0 {
         // One quad for all the slabs of the nearest aspect, on the front-most slab's root.
         let a = (0..3).rev().find(|&a| w12[a] > 0).unwrap_or(0);

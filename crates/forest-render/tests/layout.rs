@@ -161,7 +161,7 @@ fn constants_shared_with_the_wgsl_agree() {
     use forest_render::options::{self, DebugView, FLAG_DEPTH_ERROR, FLAG_DITHER, FLAG_NEAREST};
     let c = compute_source();
     let d = draw_source();
-    let pairs: [(&str, &str, f64); 12] = [
+    let pairs: [(&str, &str, f64); 13] = [
         (&c, "WG", f64::from(forest_render::capacity::WG)),
         (&c, "BLOCK", f64::from(forest_render::capacity::BLOCK)),
         (&c, "WEIGHT_ONE", f64::from(WEIGHT_ONE)),
@@ -171,6 +171,7 @@ fn constants_shared_with_the_wgsl_agree() {
         (&c, "FLAG_FAR_BLEND", f64::from(options::FLAG_FAR_BLEND)),
         (&c, "FLAG_FAR_SLABS", f64::from(options::FLAG_FAR_SLABS)),
         (&c, "SHARPEN_SHIFT", f64::from(options::SHARPEN_SHIFT)),
+        (&c, "SHARPEN_MASK", f64::from(options::SHARPEN_MASK)),
         (&c, "NONE", f64::from(u32::MAX)),
         (
             &c,
