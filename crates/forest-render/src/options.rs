@@ -208,7 +208,7 @@ pub struct StreamOptions {
     /// through the tree's centre (its slabs' parallax is below ε there), instead of one quad
     /// per slab. On (the default, with `far_nearest`); off draws each slab's quad.
     pub far_composite: bool,
-    /// Aspect sharpening, in units of 1/[`WEIGHT_ONE`](WEIGHT_ONE) (0 to
+    /// Aspect sharpening, in units of 1/[`WEIGHT_ONE`] (0 to
     /// [`SHARPEN_MAX`]): each of a tree's 1–3 blend weights loses this much (to no less than
     /// 0) and the rest are scaled back to a sum of one, so an aspect of small weight fades out
     /// continuously (no pop) instead of adding a faint layer of quads. Default
