@@ -306,6 +306,28 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
             &[&format!("'{span}'"), "--far-span", "1..=64"],
         );
     }
+    // Shadow options out of range, and shadows asked of a method that does not draw them.
+    for (option, value, cause) in [
+        (
+            "--shadow-cascades",
+            "5",
+            "shadow cascades 5: expected 1 to 4",
+        ),
+        ("--shadow-resolution", "16", "shadow resolution 16"),
+        ("--shadow-distance", "-5", "shadow distance -5"),
+        ("--shadow-epsilon", "0", "shadow epsilon 0"),
+    ] {
+        let mut a = render("1,2,3");
+        a.extend(["--shadows", "on", option, value].map(String::from));
+        refused(&strs(&a), d, &[cause]);
+    }
+    let mut a = render("1,2,3");
+    a.extend(["--shadows", "on", "--method", "geometry", "--models", &bush].map(String::from));
+    refused(
+        &strs(&a),
+        d,
+        &["--shadows on", "geometry method does not draw shadows"],
+    );
     // Options whose values may start with a hyphen reach their own check.
     let f = &forest_file;
     for (option, value, cause) in [

@@ -15,6 +15,7 @@ use forest_render::gpu_types::WEIGHT_ONE;
 use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOptions};
 use forest_render::passes::overdraw::OverdrawPass;
 use forest_render::scene::SpeciesData;
+use forest_render::shadow::ShadowOptions;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
 use glam::{Quat, Vec3};
@@ -65,6 +66,8 @@ pub struct RenderArgs {
     pub m: MethodArgs,
     #[command(flatten)]
     pub light: LightArgs,
+    #[command(flatten)]
+    pub shadow: ShadowArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub supersample: u32,
@@ -107,6 +110,45 @@ pub struct LightArgs {
     /// Exposure: every radiance is scaled by it (above 0).
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub exposure: f32,
+}
+
+/// The sun's shadows (shared by `forest render` and `forest view`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct ShadowArgs {
+    /// The sun's shadows, cast by the trees onto the ground and each other through cascaded
+    /// shadow maps (the quad stream and impostors; the other methods do not draw them yet).
+    #[arg(long, default_value = "off", value_parser = ["on", "off"])]
+    pub shadows: String,
+    /// Shadow cascades, 1 to 4.
+    #[arg(long, default_value_t = ShadowOptions::default().cascades)]
+    pub shadow_cascades: u32,
+    /// Side of each cascade's map in texels (64 to 8192).
+    #[arg(long, default_value_t = ShadowOptions::default().resolution)]
+    pub shadow_resolution: u32,
+    /// Shadows end this far along the view (metres).
+    #[arg(long, allow_negative_numbers = true, default_value_t = ShadowOptions::default().distance)]
+    pub shadow_distance: f32,
+    /// The light views' refinement threshold ε, in shadow-map texels.
+    #[arg(long, allow_negative_numbers = true, default_value_t = ShadowOptions::default().epsilon)]
+    pub shadow_epsilon: f32,
+}
+
+impl ShadowArgs {
+    /// The shadow options asked for (None: off), checked: the error names the bad value.
+    pub fn options(&self) -> Result<Option<ShadowOptions>> {
+        if self.shadows == "off" {
+            return Ok(None);
+        }
+        let o = ShadowOptions {
+            cascades: self.shadow_cascades,
+            resolution: self.shadow_resolution,
+            distance: self.shadow_distance,
+            epsilon: self.shadow_epsilon,
+            ..Default::default()
+        };
+        o.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(Some(o))
+    }
 }
 
 impl LightArgs {
@@ -607,6 +649,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let mesh_method = args.m.checked_method(forest.species.len())?;
+    let shadows = args.shadow.options()?;
+    if shadows.is_some() && mesh_method.is_some() {
+        bail!(
+            "--shadows on: the {} method does not draw shadows yet (the quad stream and \
+             impostors do)",
+            args.m.method
+        );
+    }
     let ctx = crate::gpu_context()?;
     if let Method::Hybrid(h) = args.m.chosen(mesh_method)? {
         return render_hybrid(args, h, &ctx, &forest, &species, &cameras);
@@ -615,6 +665,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return render_geometry(args, m, &ctx, &forest, &species, &cameras);
     }
     let mut stream = stream_for(args, &ctx, &species, &forest)?;
+    stream.set_shadows(&ctx.device, shadows)?;
     stream.set_pipeline_statistics(args.json);
     render_views(args, &ctx, &cameras, |cam, target| {
         let stats = stream.render_fitted(&ctx, cam, target)?;
@@ -635,6 +686,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
                 "overflow_refine": stats.overflow_refine,
                 "capacity_quads": stream.capacity.quads,
+                "shadow_cascades": stream.shadows().map(|s| s.stats(&ctx).iter().map(|c| {
+                    let ct = c.times.unwrap_or_default();
+                    serde_json::json!({"visible_trees": c.visible_trees, "quads": c.quads,
+                        "cull_ms": ct.cull_ms, "refine_ms": ct.refine_ms, "draw_ms": ct.draw_ms,
+                        "overflow_cull": c.overflow_cull, "overflow_refine": c.overflow_refine})
+                }).collect::<Vec<_>>()),
                 "stream_bytes": stream.capacity.bytes(),
                 "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
                 "work": work_json(&stats.work),

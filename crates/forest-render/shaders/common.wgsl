@@ -29,6 +29,16 @@ struct Camera {
     sky_light: vec4<f32>,
     // xyz: ground-bounce irradiance on a surface facing down; w unused.
     ground_light: vec4<f32>,
+    // The sun's shadow cascades (forest_render::shadow): world -> shadow clip of each
+    // (orthographic, depth 0 towards the sun), the view depth (metres along forward) where
+    // each ends, each one's texel (metres) and depth bias (clip units).
+    shadow: array<mat4x4<f32>, 4>,
+    shadow_splits: vec4<f32>,
+    shadow_texel: vec4<f32>,
+    shadow_bias: vec4<f32>,
+    // x: cascades in use (0: no shadows); y: the map's side (texels); z: the receivers'
+    // offset (texels); w unused.
+    shadow_params: vec4<f32>,
 }
 
 // The project's one shading model (mirrors forest_format::shading::Lighting::shade): albedo

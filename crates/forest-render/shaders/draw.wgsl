@@ -86,6 +86,9 @@ struct QuadVertex {
     species: u32,
     sphere: vec4<f32>,
     sun_obj: vec4<f32>,
+    // The tree's bounding sphere (world centre, radius): where its points look up the sun's
+    // shadow map (tree_shadow).
+    tree: vec4<f32>,
 }
 
 // A plain quad's inter-stage variables (QuadVertex's fields of the same names).
@@ -100,6 +103,7 @@ struct QuadOut {
     @location(6) @interpolate(flat) frame_up: vec3<f32>,
     // Interpolated over the quad from its corners' marches.
     @location(7) sun_vis: f32,
+    @location(8) @interpolate(flat) tree: vec4<f32>,
 }
 
 // A composited quad's inter-stage variables (QuadVertex's fields of the same names).
@@ -119,6 +123,7 @@ struct CompositeOut {
     @location(11) @interpolate(flat) species: u32,
     @location(12) @interpolate(flat) sphere: vec4<f32>,
     @location(13) @interpolate(flat) sun_obj: vec4<f32>,
+    @location(14) @interpolate(flat) tree: vec4<f32>,
 }
 
 // What every quad's fragment needs besides its colour (see shade) and its lighting (see
@@ -197,20 +202,22 @@ fn node_min_extent(sp: Species, f: Frame, inst: Instance, slab: u32, x: f32, y: 
 // are.
 @vertex
 fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
-    let v = quad_vertex(vi, kept_composites(state.composites, state.overflow_cull) + qi);
+    let v = quad_vertex(vi, kept_composites(state.composites, state.overflow_cull) + qi, true);
     return QuadOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
-                   v.sun_vis);
+                   v.sun_vis, v.tree);
 }
 
 @vertex
 fn vs_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> CompositeOut {
-    let v = quad_vertex(vi, qi);
+    let v = quad_vertex(vi, qi, true);
     return CompositeOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right,
                         v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back, v.species,
-                        v.sphere, v.sun_obj);
+                        v.sphere, v.sun_obj, v.tree);
 }
 
-fn quad_vertex(vi: u32, qi: u32) -> QuadVertex {
+// Corner `vi` of stream quad `qi`; `shaded`: with the sun's march (the draw), or without
+// (the light views' casting pass, cast.wgsl, which shades nothing).
+fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
     let q = quads[qi];
     let inst = instances[q.instance];
     let sp = species[inst.species];
@@ -329,6 +336,7 @@ fn quad_vertex(vi: u32, qi: u32) -> QuadVertex {
     out.species = inst.species;
     out.sphere = sp.sphere;
     out.sun_obj = vec4<f32>(sun_obj, sp.opacity_depth);
+    out.tree = vec4<f32>(to_world(inst, sp.sphere.xyz), sp.sphere.w * inst.scale);
     // A plain quad marches at its corners and interpolates. Coarse quads smear the crown's
     // shadow so (a far view: FLIP 0.164 against the reference, 0.124 marching per fragment),
     // but a march per fragment in fs_quad, even behind a branch no fragment takes, cost a CPU
@@ -338,7 +346,7 @@ fn quad_vertex(vi: u32, qi: u32) -> QuadVertex {
     // tree, marches per fragment (fs_composite), through the coarse level: the full march
     // there cost a tenth of the draw time.
     out.sun_vis = 1.0;
-    if (!composite) {
+    if (!composite && shaded) {
         let m = quad_march(level);
         // From the corner's Gauss point: the quad's 2×2 Gauss–Legendre nodes, ±1/√3 of the
         // half box about its middle, on the node's plane.
@@ -393,8 +401,9 @@ fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
     count_enter(in.clip);
     let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
     let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
+    // The crown's own shadow (the march) times the other casters' (the sun's shadow map).
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, in.sun_vis);
+                     in.frame_up, in.sun_vis * tree_shadow(in.world, in.tree));
     let out = shade(f, lit_texel(f, c, g));
     count_shown(in.clip, out.a);
     return out;
@@ -422,7 +431,7 @@ fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
     let vis = sun_transmittance_coarse(opacity, colour_sampler, in.species, in.sphere,
                                        in.sun_obj.w, p, in.sun_obj.xyz);
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, vis);
+                     in.frame_up, vis * tree_shadow(in.world, in.tree));
     let out = shade(f, lit_texel(f, c, g));
     count_shown(in.clip, out.a);
     return out;

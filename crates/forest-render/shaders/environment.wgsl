@@ -202,9 +202,10 @@ fn ground_albedo(xz: vec2<f32>) -> vec3<f32> {
 }
 
 // The ground at `world` with unit normal `n` under the shared shading model
-// (forest_format::shading: in sun, open sky, no translucency).
+// (forest_format::shading: open sky, no translucency), in the sun unless the module's shadow
+// lookup (shadow_on.wgsl or shadow_off.wgsl) finds a caster.
 fn ground_shade(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    return shade_light(ground_albedo(world.xz), n, 1.0, 1.0, 0.0);
+    return shade_light(ground_albedo(world.xz), n, sun_shadow(world, n), 1.0, 0.0);
 }
 
 // The terrain, shaded as the plane is at its interpolated normal, then hazed.

@@ -130,9 +130,20 @@ pub fn upload(
     camera: &GpuCamera,
     writes: &mut (u64, u64),
 ) {
-    queue.write_buffer(buffer, 0, bytemuck::bytes_of(camera));
+    upload_all(queue, buffer, std::slice::from_ref(camera), writes);
+}
+
+/// [`upload`] of several cameras in one write, one after another from offset 0 (a view's
+/// camera and its light views', see [`crate::shadow_maps`]).
+pub fn upload_all(
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    cameras: &[GpuCamera],
+    writes: &mut (u64, u64),
+) {
+    queue.write_buffer(buffer, 0, bytemuck::cast_slice(cameras));
     writes.0 += 1;
-    writes.1 += std::mem::size_of::<GpuCamera>() as u64;
+    writes.1 += std::mem::size_of_val(cameras) as u64;
 }
 
 #[cfg(test)]

@@ -3,7 +3,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// The camera and the frame's light: the only data written to the GPU per frame (288 bytes).
+/// The camera, the frame's light and its sun's shadow cascades: the only data written to the
+/// GPU per frame (608 bytes; a stream with shadows writes one per light view after it, in the
+/// same write, see [`crate::shadow`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuCamera {
@@ -31,6 +33,18 @@ pub struct GpuCamera {
     pub sky_light: [f32; 4],
     /// Ground-bounce irradiance on a surface facing down, linear RGB (`w` unused).
     pub ground_light: [f32; 4],
+    /// World → shadow clip of each sun cascade (orthographic, depth 0 towards the sun, 1
+    /// away), column-major; the first `shadow_params.x` are used.
+    pub shadow: [[[f32; 4]; 4]; 4],
+    /// Where each cascade ends: view depth along `forward` (metres) of its far split.
+    pub shadow_splits: [f32; 4],
+    /// Each cascade's texel (metres across).
+    pub shadow_texel: [f32; 4],
+    /// Each cascade's depth bias (shadow-clip depth units, subtracted from a receiver's).
+    pub shadow_bias: [f32; 4],
+    /// `x`: cascades in use (0: no shadows); `y`: the map's side in texels; `z`: the
+    /// receivers' offset towards the sun and along their normal, in texels; `w` unused.
+    pub shadow_params: [f32; 4],
 }
 
 impl GpuCamera {

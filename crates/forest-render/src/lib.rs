@@ -58,6 +58,8 @@ pub mod options;
 pub mod passes;
 pub mod reference;
 pub mod scene;
+pub mod shadow;
+pub mod shadow_maps;
 pub mod stats;
 pub mod stream;
 pub mod target;

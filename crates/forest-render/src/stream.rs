@@ -104,7 +104,16 @@ pub struct QuadStream {
     options: StreamOptions,
     forms: [f32; 4],
     light: forest_format::shading::Lighting,
+    /// The sun's shadow maps, when on ([`Self::set_shadows`]).
+    shadows: Option<crate::shadow_maps::ShadowMaps>,
+    /// The receivers' group while shadows are off.
+    no_shadows: wgpu::BindGroup,
 }
+
+/// Bytes of the camera buffer: the view's camera, then a light-view camera per cascade
+/// (written together, the frame's one upload; see [`crate::shadow_maps`]).
+const CAMERA_BYTES: usize =
+    std::mem::size_of::<GpuCamera>() * (1 + crate::shadow::MAX_CASCADES as usize);
 
 fn buffer(
     device: &wgpu::Device,
@@ -169,9 +178,12 @@ impl QuadStream {
         use wgpu::BufferUsages as U;
         let camera = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("camera"),
-            contents: bytemuck::bytes_of(&crate::frame::nothing_visible()),
-            usage: U::UNIFORM | U::COPY_DST,
+            contents: bytemuck::cast_slice(
+                &[crate::frame::nothing_visible(); 1 + crate::shadow::MAX_CASCADES as usize],
+            ),
+            usage: U::UNIFORM | U::COPY_DST | U::COPY_SRC,
         });
+        debug_assert_eq!(camera.size() as usize, CAMERA_BYTES);
         let environment = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("environment"),
             contents: bytemuck::bytes_of(&environment_uniform(
@@ -208,6 +220,7 @@ impl QuadStream {
             &readback(queries.as_ref(), statistics.as_ref()),
         )?;
         let levels = scene.tables.max_levels;
+        let no_shadows = crate::shadow_maps::no_shadows(device, &passes.draw.shadow_layout);
         Ok(Self {
             counting_draw: None,
             fragment_counts: None,
@@ -235,7 +248,59 @@ impl QuadStream {
             options: StreamOptions::default(),
             forms: crate::forms::FORMS_QUADS,
             light: opts.lighting,
+            shadows: None,
+            no_shadows,
         })
+    }
+
+    /// Cast and receive the sun's shadows with `opts` from the next frame on, or not
+    /// (`None`). The maps and their light-view streams are built here (kept while the
+    /// options stay the same); refused, with nothing changed, when the options are out of
+    /// range or the device cannot hold the maps.
+    pub fn set_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        opts: Option<crate::shadow::ShadowOptions>,
+    ) -> Result<(), RenderError> {
+        match opts {
+            None => self.shadows = None,
+            Some(o) => {
+                if self.shadows.as_ref().map(|s| *s.options()) != Some(o) {
+                    self.shadows = Some(crate::shadow_maps::ShadowMaps::new(
+                        device,
+                        self.scene.clone(),
+                        &o,
+                        &self.passes.draw.shadow_layout,
+                    )?);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The shadow maps, when shadows are on.
+    pub fn shadows(&self) -> Option<&crate::shadow_maps::ShadowMaps> {
+        self.shadows.as_ref()
+    }
+
+    /// The camera buffer (a light-view stream's is filled by copies, see
+    /// [`crate::shadow_maps`]).
+    pub(crate) fn camera_buffer(&self) -> &wgpu::Buffer {
+        &self.camera
+    }
+
+    /// What the casting pass draws from: the final stream's draw group and the indirect
+    /// arguments.
+    pub(crate) fn cast_parts(&self) -> (&wgpu::BindGroup, &wgpu::Buffer) {
+        (
+            &self.sized.bg_draw[(self.iterations % 2) as usize],
+            &self.sized.args,
+        )
+    }
+
+    /// Bytes of the view's own buffers (not the scene's).
+    pub fn view_bytes(&self) -> u64 {
+        self.sized.view_bytes
     }
 
     /// The per-view buffers and bind groups for `capacity`, checked against the device's
@@ -663,7 +728,11 @@ impl QuadStream {
         self.options.apply(&mut g);
         g.forms = self.forms;
         g.set_light(&self.light);
-        crate::camera::upload(queue, &self.camera, &g, &mut self.writes);
+        let cameras = match &self.shadows {
+            Some(sh) => crate::shadow::cameras(&g, &self.light, sh.options(), self.options),
+            None => vec![g],
+        };
+        crate::camera::upload_all(queue, &self.camera, &cameras, &mut self.writes);
         self.prepared = true;
     }
 
@@ -703,7 +772,11 @@ impl QuadStream {
         loop {
             self.render_frame(ctx, camera, target)?;
             let stats = self.read_stats(ctx);
-            if !self.fit(&ctx.device, &stats)? {
+            let mut grew = self.fit(&ctx.device, &stats)?;
+            if let Some(sh) = &mut self.shadows {
+                grew |= sh.fit(ctx)?;
+            }
+            if !grew {
                 return Ok(stats);
             }
         }
@@ -743,8 +816,13 @@ impl QuadStream {
         self.resolve_times(encoder);
     }
 
-    /// The compute passes of a frame: cull and refine (before the render pass that draws).
+    /// The compute passes of a frame: cull and refine (before the render pass that draws),
+    /// after the sun's shadow maps when shadows are on (each cascade's cull, refine and
+    /// casting pass, [`crate::shadow_maps::ShadowMaps::encode`]).
     pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(sh) = &self.shadows {
+            sh.encode(encoder, &self.camera);
+        }
         let ts = |b: u32| {
             self.queries
                 .as_ref()
@@ -829,6 +907,9 @@ impl QuadStream {
         let draws = self.passes.draw.record(
             pass,
             &self.sized.bg_draw[(self.iterations % 2) as usize],
+            self.shadows
+                .as_ref()
+                .map_or(&self.no_shadows, |s| s.receivers()),
             &self.sized.args,
             (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,
@@ -895,7 +976,9 @@ impl QuadStream {
                 passes: statistics
                     .filter(|_| self.count_work)
                     .and_then(crate::work::decode),
-                bytes: self.scene.bytes + self.sized.view_bytes,
+                bytes: self.scene.bytes
+                    + self.sized.view_bytes
+                    + self.shadows.as_ref().map_or(0, |s| s.bytes()),
             },
         }
     }

@@ -138,13 +138,21 @@ fn bind_group_layouts_match_the_wgsl() {
     // The compute layout is shared by every entry point and matches every binding the WGSL
     // declares.
     assert_eq!(layout_check::reflected_bindings(&compute_source()), compute);
+    // The draw: its group 0 and the shadow maps' group 2.
+    let mut draw = layout_check::layout_bindings(0, &bind_entries());
+    draw.extend(layout_check::layout_bindings(
+        2,
+        &forest_render::shadow_maps::receiver_entries(),
+    ));
+    layout_check::check_layout(&draw_source(), &draw, |_| true);
+    // The light views' casting pass reads group 0 alone.
     layout_check::check_layout(
-        &draw_source(),
+        &[draw_source().as_str(), forest_render::passes::CAST_WGSL].concat(),
         &layout_check::layout_bindings(0, &bind_entries()),
-        |_| true,
+        |e| ["vs_cast", "fs_cast"].contains(&e),
     );
     // The counting variant of the quad draws adds the counters as group 1.
-    let mut counted = layout_check::layout_bindings(0, &bind_entries());
+    let mut counted = draw.clone();
     counted.extend(layout_check::layout_bindings(
         1,
         &forest_render::fragments::layout_entries(),

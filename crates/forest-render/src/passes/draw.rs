@@ -91,6 +91,8 @@ pub const OPACITY_BINDING: u32 = 14;
 pub struct DrawPass {
     /// Bind-group layout (camera, scene tables, final stream, textures, environment).
     pub bind_layout: wgpu::BindGroupLayout,
+    /// Layout of group 2, the sun's shadow maps ([`crate::shadow_maps::receiver_layout`]).
+    pub shadow_layout: wgpu::BindGroupLayout,
     environment: wgpu::RenderPipeline,
     terrain: wgpu::RenderPipeline,
     /// Far trees' composited quads (drawn first).
@@ -100,15 +102,17 @@ pub struct DrawPass {
 
 impl DrawPass {
     /// Create the pipelines for the host's targets: colour and depth formats, sample count
-    /// and depth test from `opts`.
+    /// and depth test from `opts`. Group 1 is the fragment counters' (when counting), group 2
+    /// the shadow maps'.
     pub fn new(device: &wgpu::Device, opts: &crate::options::RendererOptions) -> Self {
         let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("draw"),
             entries: &bind_entries(),
         });
+        let shadow_layout = crate::shadow_maps::receiver_layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("draw"),
-            bind_group_layouts: &[Some(&bind_layout)],
+            bind_group_layouts: &[Some(&bind_layout), None, Some(&shadow_layout)],
             immediate_size: 0,
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -158,6 +162,7 @@ impl DrawPass {
                 false,
             ),
             bind_layout,
+            shadow_layout,
         }
     }
 
@@ -171,7 +176,11 @@ impl DrawPass {
         let counts = crate::fragments::bind_layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("counted draw"),
-            bind_group_layouts: &[Some(&self.bind_layout), Some(&counts)],
+            bind_group_layouts: &[
+                Some(&self.bind_layout),
+                Some(&counts),
+                Some(&self.shadow_layout),
+            ],
             immediate_size: 0,
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -207,11 +216,14 @@ impl DrawPass {
     /// Record the environment (sky, ground and the terrain `ground` holds, when given) and
     /// the indirect quad draws, the latter measured as `measured` asks (so the counts are the
     /// trees' alone): the composited far trees' draw when `composite` (the stream's options
-    /// can make such quads), then the others'. Returns the draws recorded.
+    /// can make such quads), then the others'. `shadows` is the receivers' group 2. Returns
+    /// the draws recorded.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         pass: &mut wgpu::RenderPass,
         bind_group: &wgpu::BindGroup,
+        shadows: &wgpu::BindGroup,
         args_buf: &wgpu::Buffer,
         ground: Option<&crate::terrain::GpuTerrain>,
         composite: bool,
@@ -222,6 +234,7 @@ impl DrawPass {
             counted,
         } = measured;
         pass.set_bind_group(0, bind_group, &[]);
+        pass.set_bind_group(2, shadows, &[]);
         let environment = ground.map_or(0, |t| {
             t.record_ground(pass, &self.environment, &self.terrain)
         });

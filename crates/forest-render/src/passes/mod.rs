@@ -6,6 +6,7 @@
 //! have no dispatches of their own: their phases are fused into the passes' dispatches. The
 //! draw pass has its own module (common + draw).
 
+pub mod cast;
 pub mod cull;
 pub mod draw;
 pub mod overdraw;
@@ -31,14 +32,29 @@ pub const COMPUTE_WGSL: [&str; 6] = [
     include_str!("../../shaders/refine.wgsl"),
 ];
 
-/// WGSL of the draw pass (without fragment counting: [`COUNT_OFF_WGSL`] closes it).
-pub const DRAW_WGSL: [&str; 5] = [
+/// WGSL of the draw pass (without fragment counting: [`COUNT_OFF_WGSL`] closes it), with the
+/// sun's shadow lookups ([`SHADOW_ON_WGSL`]).
+pub const DRAW_WGSL: [&str; 6] = [
     COMMON_WGSL,
     include_str!("../../shaders/draw.wgsl"),
     GROUND_WGSL,
     ENVIRONMENT_WGSL,
+    SHADOW_ON_WGSL,
     COUNT_OFF_WGSL,
 ];
+
+/// The sun's shadow lookups against the cascades' maps, bound as group 2
+/// (`shaders/shadow_on.wgsl`; see [`crate::shadow_maps`]): `sun_shadow(world, normal)` and
+/// `tree_shadow(point, sphere)`.
+pub const SHADOW_ON_WGSL: &str = include_str!("../../shaders/shadow_on.wgsl");
+
+/// The same lookups for a module drawn without shadow maps: every point lit
+/// (`shaders/shadow_off.wgsl`). Every module that includes [`ENVIRONMENT_WGSL`] also includes
+/// this or [`SHADOW_ON_WGSL`].
+pub const SHADOW_OFF_WGSL: &str = include_str!("../../shaders/shadow_off.wgsl");
+
+/// The light views' casting pass (`shaders/cast.wgsl`), appended to [`DRAW_WGSL`].
+pub const CAST_WGSL: &str = include_str!("../../shaders/cast.wgsl");
 
 /// The fragment-count hooks that do nothing (`shaders/count_off.wgsl`): every draw module
 /// that shades tree fragments ends with this or [`COUNT_ON_WGSL`].

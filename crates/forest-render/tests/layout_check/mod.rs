@@ -62,6 +62,11 @@ pub fn shared() -> Vec<Expect> {
                 ("sun_colour", offset_of!(GpuCamera, sun_colour)),
                 ("sky_light", offset_of!(GpuCamera, sky_light)),
                 ("ground_light", offset_of!(GpuCamera, ground_light)),
+                ("shadow", offset_of!(GpuCamera, shadow)),
+                ("shadow_splits", offset_of!(GpuCamera, shadow_splits)),
+                ("shadow_texel", offset_of!(GpuCamera, shadow_texel)),
+                ("shadow_bias", offset_of!(GpuCamera, shadow_bias)),
+                ("shadow_params", offset_of!(GpuCamera, shadow_params)),
             ],
         ),
         (

@@ -1,0 +1,468 @@
+//! The sun's shadow cascades, on the CPU: the options, the split of a view's depth range,
+//! each cascade's orthographic light view fitted around its slice of the view frustum, and
+//! the light-view cameras the quad stream culls, refines and draws for (one per cascade).
+//!
+//! Fitting follows the usual stable scheme (practical split, after Zhang et al.'s parallel-split
+//! shadow maps): each slice of the view frustum is enclosed by a sphere whose radius depends only
+//! on the slice (not on where the camera looks), and the sphere's centre is snapped to the
+//! cascade's texel grid in a light frame that depends only on the sun. Moving or turning the
+//! camera therefore moves every cascade by whole texels and never rescales it: the shadows do not
+//! swim.
+//!
+//! No wgpu here: [`crate::shadow_maps`] owns the maps and their passes.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use crate::gpu_types::GpuCamera;
+
+/// Most cascades (the camera uniform holds four matrices).
+pub const MAX_CASCADES: u32 = 4;
+/// Smallest and largest shadow-map side (texels).
+pub const RESOLUTION_RANGE: (u32, u32) = (64, 8192);
+
+/// How the sun's shadows are made and looked up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowOptions {
+    /// Cascades, 1 to [`MAX_CASCADES`].
+    pub cascades: u32,
+    /// Side of each cascade's map, texels (a power of two is not required).
+    pub resolution: u32,
+    /// Shadows end this far from the eye along the view (metres), or at the view's far plane
+    /// if that is nearer.
+    pub distance: f32,
+    /// Where the splits lie between uniform (0) and logarithmic (1) spacing.
+    pub split_lambda: f32,
+    /// The light views' refinement threshold ε, in texels.
+    pub epsilon: f32,
+    /// How far towards the sun beyond a cascade's sphere casters are still drawn (metres):
+    /// at least the tallest tree's height over the sine of the lowest sun wanted.
+    pub reach: f32,
+    /// Receivers look their shadow up this many texels towards the sun and along their normal
+    /// (the bias against acne; it also bounds the peter-panning, see `docs/rendering.md`).
+    pub offset_texels: f32,
+}
+
+impl Default for ShadowOptions {
+    /// Three cascades of 1024² over the first 300 m, refined to 32 texels.
+    fn default() -> Self {
+        Self {
+            cascades: 3,
+            resolution: 1024,
+            distance: 300.0,
+            split_lambda: 0.8,
+            epsilon: 32.0,
+            reach: 120.0,
+            offset_texels: 1.5,
+        }
+    }
+}
+
+impl ShadowOptions {
+    /// Refuse options out of their ranges, naming the option.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_CASCADES).contains(&self.cascades) {
+            return Err(format!(
+                "shadow cascades {}: expected 1 to {MAX_CASCADES}",
+                self.cascades
+            ));
+        }
+        let (lo, hi) = RESOLUTION_RANGE;
+        if !(lo..=hi).contains(&self.resolution) {
+            return Err(format!(
+                "shadow resolution {}: expected {lo} to {hi} texels",
+                self.resolution
+            ));
+        }
+        let positive = [
+            ("shadow distance", self.distance),
+            ("shadow epsilon", self.epsilon),
+        ];
+        for (what, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{what} {v}: expected a positive number"));
+            }
+        }
+        if !(self.reach.is_finite() && self.reach >= 0.0) {
+            return Err(format!(
+                "shadow reach {}: expected 0 or more metres",
+                self.reach
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.split_lambda) {
+            return Err(format!(
+                "shadow split lambda {}: expected 0 (uniform) to 1 (logarithmic)",
+                self.split_lambda
+            ));
+        }
+        if !(0.0..=16.0).contains(&self.offset_texels) {
+            return Err(format!(
+                "shadow offset {} texels: expected 0 to 16",
+                self.offset_texels
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One cascade: the slice of the view it covers and its light view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cascade {
+    /// View depths (metres along the view direction) where the slice begins and ends.
+    pub split: (f32, f32),
+    /// Centre of the sphere enclosing the slice (world), after snapping.
+    pub centre: Vec3,
+    /// The sphere's radius (metres): the map spans 2·radius across.
+    pub radius: f32,
+    /// World → shadow clip (orthographic; depth 0 at the sun's end of the box, 1 at the other).
+    pub view_proj: Mat4,
+    /// One texel's width (metres).
+    pub texel: f32,
+    /// Depth of the box (metres), from its sun end to its far end.
+    pub depth_range: f32,
+}
+
+/// The view a cascade set is fitted to: its clip matrix, eye and unit view direction.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewSlice {
+    /// Projection × view (any perspective projection into wgpu's clip space).
+    pub view_proj: Mat4,
+    /// Eye (world).
+    pub eye: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+}
+
+impl ViewSlice {
+    /// The near and far distances of the view along its direction (the far one may be
+    /// infinite), and the widest lateral offset of the frustum's edges per metre of depth.
+    fn extent(&self) -> (f32, f32, f32) {
+        let inv = self.view_proj.inverse();
+        let depth_at = |x: f32, y: f32, z: f32| -> (f32, Vec3) {
+            let h = inv * Vec4::new(x, y, z, 1.0);
+            if h.w.abs() < 1e-12 {
+                return (f32::INFINITY, h.truncate());
+            }
+            let p = h.truncate() / h.w;
+            (self.forward.dot(p - self.eye), p - self.eye)
+        };
+        let (d0, _) = depth_at(0.0, 0.0, 0.0);
+        let (d1, _) = depth_at(0.0, 0.0, 1.0);
+        let near = d0.min(d1).max(1e-3);
+        let far = d0.max(d1);
+        let mut k = 0.0f32;
+        for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+            // A point halfway through the depth range lies on the corner's ray.
+            let (d, r) = depth_at(x, y, 0.5);
+            let r = if d < 0.0 { -r } else { r };
+            let along = r.dot(self.forward);
+            if along > 1e-9 {
+                k = k.max((r / along - self.forward).length());
+            }
+        }
+        (near, far, k)
+    }
+}
+
+/// The view depths where the cascades split: `n + 1` values from `near` to `end`, blending
+/// logarithmic and uniform spacing by `lambda`.
+pub fn split_depths(near: f32, end: f32, n: u32, lambda: f32) -> Vec<f32> {
+    (0..=n)
+        .map(|i| {
+            let t = i as f32 / n as f32;
+            let log = near * (end / near).powf(t);
+            let uni = near + (end - near) * t;
+            lambda * log + (1.0 - lambda) * uni
+        })
+        .collect()
+}
+
+/// The smallest sphere about the view axis enclosing the frustum slice between depths `a` and
+/// `b` whose edges spread `k` metres laterally per metre of depth: its centre's depth and its
+/// radius. It depends on the slice alone, not on where the view looks.
+pub fn slice_sphere(a: f32, b: f32, k: f32) -> (f32, f32) {
+    let k2 = 1.0 + k * k;
+    let z = (0.5 * (a + b) * k2).clamp(a, b);
+    let r = ((z - a).powi(2) + (a * k).powi(2))
+        .sqrt()
+        .max(((b - z).powi(2) + (b * k).powi(2)).sqrt());
+    (z, r)
+}
+
+/// A light frame that depends on the sun alone: world → light view (a rotation; the light
+/// looks along −`sun`).
+pub fn light_rotation(sun: Vec3) -> Mat4 {
+    let up = if sun.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    glam::camera::rh::view::look_at_mat4(Vec3::ZERO, -sun, up)
+}
+
+/// The cascades of `view` under a sun in unit direction `sun` (towards the sun).
+pub fn fit_cascades(view: &ViewSlice, sun: Vec3, opts: &ShadowOptions) -> Vec<Cascade> {
+    let sun = sun.normalize_or(Vec3::Y);
+    let (near, far, k) = view.extent();
+    let end = opts.distance.min(far).max(near * 1.001);
+    let splits = split_depths(near, end, opts.cascades, opts.split_lambda);
+    let rot = light_rotation(sun);
+    let res = opts.resolution as f32;
+    splits
+        .windows(2)
+        .map(|s| {
+            let (z, radius) = slice_sphere(s[0], s[1], k);
+            // Round the radius up to a 1/64 of its power of two, so that rounding noise in
+            // the view's matrices cannot rescale the map from frame to frame.
+            let quantum = radius.max(1e-3).log2().ceil().exp2() / 64.0;
+            let radius = (radius / quantum).ceil() * quantum;
+            let texel = 2.0 * radius / res;
+            let c = rot.transform_point3(view.eye + view.forward * z);
+            // Whole texels in the sun's frame: the map moves without swimming.
+            let cx = (c.x / texel).round() * texel;
+            let cy = (c.y / texel).round() * texel;
+            let centre = rot.inverse().transform_point3(Vec3::new(cx, cy, c.z));
+            // The box runs from `reach` beyond the sphere on the sun's side to its far side.
+            let near_l = -c.z - radius - opts.reach;
+            let far_l = -c.z + radius;
+            let proj = glam::camera::rh::proj::directx::orthographic(
+                cx - radius,
+                cx + radius,
+                cy - radius,
+                cy + radius,
+                near_l,
+                far_l,
+            );
+            Cascade {
+                split: (s[0], s[1]),
+                centre,
+                radius,
+                view_proj: proj * rot,
+                texel,
+                depth_range: far_l - near_l,
+            }
+        })
+        .collect()
+}
+
+/// Write the cascades into the view's camera uniform (what its receivers look up).
+pub fn write_receivers(g: &mut GpuCamera, cascades: &[Cascade], opts: &ShadowOptions) {
+    let n = cascades.len().min(MAX_CASCADES as usize);
+    for (i, c) in cascades.iter().take(n).enumerate() {
+        g.shadow[i] = c.view_proj.to_cols_array_2d();
+        g.shadow_splits[i] = c.split.1;
+        g.shadow_texel[i] = c.texel;
+        // Half a texel of slope at 45° plus the depth quantum: the comparison's own rounding.
+        g.shadow_bias[i] = 0.5 * c.texel / c.depth_range + 1e-6;
+    }
+    g.shadow_params = [n as f32, opts.resolution as f32, opts.offset_texels, 0.0];
+}
+
+/// The camera a cascade's light-view stream culls, refines and draws with: the cascade's
+/// matrix, the eye far along the sun (so every tree is seen from the sun's direction and
+/// picks its aspects by it), ε in texels, and the stream's options with far trees left to
+/// the plain stream (no composited quads: the casting pipeline draws plain quads).
+pub fn light_camera(
+    c: &Cascade,
+    sun: Vec3,
+    opts: &ShadowOptions,
+    stream: crate::options::StreamOptions,
+) -> GpuCamera {
+    let sun = sun.normalize_or(Vec3::Y);
+    // Far enough that the direction to any tree in the box is the sun's within 1e-4 rad.
+    let eye = c.centre + sun * (1e4 * (c.radius + opts.reach).max(1.0));
+    let mut g = crate::frame::gpu_camera(
+        c.view_proj,
+        eye,
+        -sun,
+        (opts.resolution, opts.resolution),
+        opts.epsilon,
+    );
+    crate::options::StreamOptions {
+        far_nearest: false,
+        ..stream
+    }
+    .apply(&mut g);
+    g
+}
+
+/// The frame's cameras with shadows: `view` (the view's camera, light and options already in
+/// it) with its cascades written in, then each cascade's light camera under `light`. What a
+/// stream with shadows writes in its one upload.
+pub fn cameras(
+    view: &GpuCamera,
+    light: &forest_format::shading::Lighting,
+    opts: &ShadowOptions,
+    stream: crate::options::StreamOptions,
+) -> Vec<GpuCamera> {
+    let slice = ViewSlice {
+        view_proj: Mat4::from_cols_array_2d(&view.view_proj),
+        eye: Vec3::from_slice(&view.eye[..3]),
+        forward: Vec3::from_slice(&view.forward[..3]),
+    };
+    let cascades = fit_cascades(&slice, light.sun_dir, opts);
+    let mut out = vec![*view];
+    write_receivers(&mut out[0], &cascades, opts);
+    out.extend(cascades.iter().map(|c| {
+        let mut l = light_camera(c, light.sun_dir, opts, stream);
+        l.set_light(light);
+        l
+    }));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(eye: Vec3, target: Vec3) -> ViewSlice {
+        let cam = crate::Camera {
+            eye,
+            target,
+            fov_y_deg: 60.0,
+            near: 0.5,
+            far: 2000.0,
+            viewport: (1600, 900),
+            epsilon: 4.0,
+        };
+        ViewSlice {
+            view_proj: cam.view_proj(),
+            eye: cam.eye,
+            forward: cam.forward(),
+        }
+    }
+
+    #[test]
+    fn splits_run_from_near_to_the_shadow_distance() {
+        let s = split_depths(1.0, 100.0, 2, 1.0);
+        assert_eq!(s.len(), 3);
+        assert!((s[1] - 10.0).abs() < 1e-4, "logarithmic middle {}", s[1]);
+        let s = split_depths(1.0, 101.0, 2, 0.0);
+        assert!((s[1] - 51.0).abs() < 1e-4, "uniform middle {}", s[1]);
+    }
+
+    #[test]
+    fn a_slice_sphere_touches_its_farthest_corners() {
+        // A slice from 10 to 20 m whose edges spread 0.5 m per metre.
+        let (z, r) = slice_sphere(10.0, 20.0, 0.5);
+        assert!((10.0..=20.0).contains(&z));
+        let near = ((z - 10.0).powi(2) + 25.0).sqrt();
+        let far = ((20.0 - z).powi(2) + 100.0).sqrt();
+        assert!((r - near.max(far)).abs() < 1e-4);
+        // Interior centre: both ends touch the sphere.
+        assert!((near - far).abs() < 1e-3, "{near} {far}");
+    }
+
+    #[test]
+    fn every_point_of_a_slice_lands_inside_its_cascade() {
+        let v = view(Vec3::new(3.0, 1.7, -4.0), Vec3::new(40.0, 4.0, 30.0));
+        let sun = Vec3::new(0.4, 0.5, 0.3).normalize();
+        let opts = ShadowOptions::default();
+        let cascades = fit_cascades(&v, sun, &opts);
+        assert_eq!(cascades.len(), 3);
+        let inv = v.view_proj.inverse();
+        for c in &cascades {
+            for (x, y) in [
+                (-1.0, -1.0),
+                (1.0, -1.0),
+                (-1.0, 1.0),
+                (1.0, 1.0),
+                (0.0, 0.0),
+            ] {
+                // The corner ray's points at the slice's two depths.
+                let p = inv.project_point3(Vec3::new(x, y, 0.5));
+                let r = p - v.eye;
+                let r = r / r.dot(v.forward);
+                for d in [c.split.0, c.split.1] {
+                    let s = c.view_proj.project_point3(v.eye + r * d);
+                    assert!(
+                        s.x.abs() <= 1.0 + 1e-4 && s.y.abs() <= 1.0 + 1e-4,
+                        "{s} outside cascade {c:?}"
+                    );
+                    assert!((0.0..=1.0).contains(&s.z), "depth {}", s.z);
+                }
+            }
+            // A point `reach` towards the sun from the far edge of the sphere is still in
+            // the box; beyond that it is not.
+            let top = c.centre + sun * (c.radius + opts.reach * 0.99);
+            assert!(c.view_proj.project_point3(top).z >= 0.0);
+            let beyond = c.centre + sun * (c.radius + opts.reach * 1.01);
+            assert!(c.view_proj.project_point3(beyond).z < 0.0);
+        }
+    }
+
+    #[test]
+    fn turning_or_moving_the_camera_moves_cascades_by_whole_texels() {
+        let sun = Vec3::new(-0.3, 0.6, 0.5).normalize();
+        let opts = ShadowOptions::default();
+        let a = fit_cascades(
+            &view(Vec3::new(0.0, 2.0, 0.0), Vec3::new(10.0, 2.0, 30.0)),
+            sun,
+            &opts,
+        );
+        let b = fit_cascades(
+            &view(Vec3::new(0.37, 2.0, 0.11), Vec3::new(-20.0, 3.0, 25.0)),
+            sun,
+            &opts,
+        );
+        let rot = light_rotation(sun);
+        for (a, b) in a.iter().zip(&b) {
+            assert_eq!(a.radius, b.radius, "the map's scale does not change");
+            // A fixed world point's texel position differs by a whole number of texels.
+            let p = Vec3::new(5.0, 0.0, 12.0);
+            let ta = a.view_proj.project_point3(p) * 0.5 * opts.resolution as f32;
+            let tb = b.view_proj.project_point3(p) * 0.5 * opts.resolution as f32;
+            for d in [(ta.x - tb.x), (ta.y - tb.y)] {
+                assert!((d - d.round()).abs() < 2e-2, "shift {d} texels");
+            }
+            let ca = rot.transform_point3(a.centre) / a.texel;
+            assert!((ca.x - ca.x.round()).abs() < 1e-2);
+        }
+    }
+
+    #[test]
+    fn a_light_camera_looks_down_the_sun_from_afar() {
+        let sun = Vec3::new(0.2, 0.9, 0.1).normalize();
+        let opts = ShadowOptions::default();
+        let cascades = fit_cascades(
+            &view(Vec3::ZERO + Vec3::Y, Vec3::new(0.0, 1.0, 10.0)),
+            sun,
+            &opts,
+        );
+        let g = light_camera(&cascades[0], sun, &opts, Default::default());
+        let eye = Vec3::from_slice(&g.eye[..3]);
+        assert!((eye - cascades[0].centre).normalize().dot(sun) > 0.999_999);
+        assert_eq!(g.viewport[0], opts.resolution as f32);
+        assert_eq!(g.eye[3], opts.epsilon);
+        assert_ne!(g.viewport[3] as u32 & crate::options::FLAG_FAR_BLEND, 0);
+    }
+
+    #[test]
+    fn bad_options_are_named() {
+        let bad = [
+            ShadowOptions {
+                cascades: 0,
+                ..Default::default()
+            },
+            ShadowOptions {
+                cascades: 5,
+                ..Default::default()
+            },
+            ShadowOptions {
+                resolution: 16,
+                ..Default::default()
+            },
+            ShadowOptions {
+                distance: f32::NAN,
+                ..Default::default()
+            },
+            ShadowOptions {
+                split_lambda: 1.5,
+                ..Default::default()
+            },
+            ShadowOptions {
+                reach: -1.0,
+                ..Default::default()
+            },
+        ];
+        for o in bad {
+            assert!(o.validate().is_err(), "{o:?}");
+        }
+        assert!(ShadowOptions::default().validate().is_ok());
+    }
+}

@@ -1,0 +1,254 @@
+//! The sun's shadow maps of one view: a depth array with a layer per cascade, one light-view
+//! quad stream per cascade (its own cull and refine, as for a camera), the casting pass, and
+//! the bind group (group 2 of the draw) the receivers look the maps up through.
+//!
+//! Per frame nothing more is uploaded: the view's stream writes its own camera and each
+//! cascade's light-view camera in one write ([`crate::shadow::light_camera`]), and
+//! [`ShadowMaps::encode`] copies each light camera into its stream's camera buffer on the GPU
+//! before that stream's passes.
+
+use std::sync::Arc;
+
+use crate::context::RenderError;
+use crate::gpu_types::GpuCamera;
+use crate::options::RendererOptions;
+use crate::passes::cast::{CastPass, SHADOW_FORMAT};
+use crate::scene::GpuScene;
+use crate::shadow::ShadowOptions;
+use crate::stats::FrameStats;
+use crate::stream::QuadStream;
+
+/// Mean quad layers per texel a light-view stream is first sized for (it grows to what
+/// frames need, [`ShadowMaps::fit`]): a shadow map sees the canopy's top, far fewer layers
+/// than a camera looking through the forest.
+const LIGHT_OVERDRAW: f32 = 0.25;
+
+/// Layout entries of the receivers' group (group 2 of the draw, `shaders/shadow_on.wgsl`):
+/// the maps as a depth array and their comparison sampler.
+pub fn receiver_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+    [
+        wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        },
+        wgpu::BindGroupLayoutEntry {
+            binding: 1,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+            count: None,
+        },
+    ]
+}
+
+/// The receivers' bind-group layout.
+pub fn receiver_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("shadow receivers"),
+        entries: &receiver_entries(),
+    })
+}
+
+/// A depth array of `layers` layers of `side`² texels, sampled and drawn into.
+fn depth_array(device: &wgpu::Device, side: u32, layers: u32) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("shadow maps"),
+        size: wgpu::Extent3d {
+            width: side,
+            height: side,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: SHADOW_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+/// The receivers' group over `texture` (all its layers).
+fn receiver_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    texture: &wgpu::Texture,
+) -> wgpu::BindGroup {
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("shadow compare"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        compare: Some(wgpu::CompareFunction::LessEqual),
+        ..Default::default()
+    });
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("shadow receivers"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            },
+        ],
+    })
+}
+
+/// The receivers' group of a view without shadows: a 1×1 map that is never read (the camera
+/// says no cascades are in use).
+pub fn no_shadows(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::BindGroup {
+    receiver_group(device, layout, &depth_array(device, 1, 1))
+}
+
+/// The shadow maps of one view and the light-view streams that fill them.
+pub struct ShadowMaps {
+    opts: ShadowOptions,
+    layers: Vec<wgpu::TextureView>,
+    receivers: wgpu::BindGroup,
+    streams: Vec<QuadStream>,
+    cast: CastPass,
+    /// Bytes of the maps.
+    map_bytes: u64,
+}
+
+impl ShadowMaps {
+    /// The maps and light-view streams of `opts` over `scene`; `layout` is the receivers'
+    /// layout of the stream that will read them. Sizes are checked against the device
+    /// before anything is allocated.
+    pub fn new(
+        device: &wgpu::Device,
+        scene: Arc<GpuScene>,
+        opts: &ShadowOptions,
+        layout: &wgpu::BindGroupLayout,
+    ) -> Result<Self, RenderError> {
+        opts.validate().map_err(RenderError::Parameter)?;
+        let limits = device.limits();
+        if opts.resolution > limits.max_texture_dimension_2d
+            || opts.cascades > limits.max_texture_array_layers
+        {
+            return Err(RenderError::DeviceLimit {
+                what: format!(
+                    "{} shadow cascades of {}² texels (texels on a side)",
+                    opts.cascades, opts.resolution
+                ),
+                needed: u64::from(opts.resolution),
+                limit: u64::from(limits.max_texture_dimension_2d),
+                hint: ": lower the shadow resolution",
+            });
+        }
+        let texture = depth_array(device, opts.resolution, opts.cascades);
+        let layers = (0..opts.cascades)
+            .map(|k| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("shadow cascade"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: k,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let stream_opts = RendererOptions {
+            viewport: (opts.resolution, opts.resolution),
+            min_epsilon: opts.epsilon,
+            overdraw: LIGHT_OVERDRAW,
+            ..Default::default()
+        };
+        let streams = (0..opts.cascades)
+            .map(|_| QuadStream::new(device, scene.clone(), &stream_opts))
+            .collect::<Result<Vec<_>, _>>()?;
+        let map_bytes = u64::from(opts.resolution).pow(2) * 4 * u64::from(opts.cascades);
+        Ok(Self {
+            opts: *opts,
+            layers,
+            receivers: receiver_group(device, layout, &texture),
+            streams,
+            cast: CastPass::new(device),
+            map_bytes,
+        })
+    }
+
+    /// The options the maps were built for.
+    pub fn options(&self) -> &ShadowOptions {
+        &self.opts
+    }
+
+    /// The receivers' bind group (group 2 of the draw).
+    pub fn receivers(&self) -> &wgpu::BindGroup {
+        &self.receivers
+    }
+
+    /// The light-view streams, one per cascade (their counters: [`Self::stats`]).
+    pub fn streams(&self) -> &[QuadStream] {
+        &self.streams
+    }
+
+    /// Bytes on the GPU: the maps and the light-view streams' own buffers.
+    pub fn bytes(&self) -> u64 {
+        self.map_bytes + self.streams.iter().map(|s| s.view_bytes()).sum::<u64>()
+    }
+
+    /// Record every cascade: copy its light camera from slot `k + 1` of `cameras` (the view's
+    /// camera buffer, [`crate::shadow`]), cull and refine for it, then draw its quads into
+    /// its layer, cleared first to the far depth. Each stream times its passes as a view's
+    /// stream does (its counters' `draw_ms` is the casting pass).
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, cameras: &wgpu::Buffer) {
+        let size = std::mem::size_of::<GpuCamera>() as u64;
+        for (k, (stream, layer)) in self.streams.iter().zip(&self.layers).enumerate() {
+            encoder.copy_buffer_to_buffer(
+                cameras,
+                size * (k as u64 + 1),
+                stream.camera_buffer(),
+                0,
+                size,
+            );
+            stream.encode_compute(encoder);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow cascade"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: layer,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: stream.draw_timestamps(),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            let (group, args) = stream.cast_parts();
+            self.cast.record(&mut pass, group, args);
+            drop(pass);
+            stream.resolve_times(encoder);
+        }
+    }
+
+    /// Each cascade's counters of the last submitted frame (waits for the GPU).
+    pub fn stats(&self, ctx: &crate::GpuContext) -> Vec<FrameStats> {
+        self.streams.iter().map(|s| s.read_stats(ctx)).collect()
+    }
+
+    /// Grow every light-view stream whose last frame overflowed (see [`QuadStream::fit`]);
+    /// whether any grew (the frame should then be drawn again).
+    pub fn fit(&mut self, ctx: &crate::GpuContext) -> Result<bool, RenderError> {
+        let mut grew = false;
+        for s in &mut self.streams {
+            let stats = s.read_stats(ctx);
+            grew |= s.fit(&ctx.device, &stats)?;
+        }
+        Ok(grew)
+    }
+}
