@@ -306,7 +306,7 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
             &[&format!("'{span}'"), "--far-span", "1..=64"],
         );
     }
-    // Shadow options out of range, and shadows asked of a method that does not draw them.
+    // Shadow options out of range.
     for (option, value, cause) in [
         (
             "--shadow-cascades",
@@ -321,13 +321,6 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         a.extend(["--shadows", "on", option, value].map(String::from));
         refused(&strs(&a), d, &[cause]);
     }
-    let mut a = render("1,2,3");
-    a.extend(["--shadows", "on", "--method", "geometry", "--models", &bush].map(String::from));
-    refused(
-        &strs(&a),
-        d,
-        &["--shadows on", "geometry method does not draw shadows"],
-    );
     // Options whose values may start with a hyphen reach their own check.
     let f = &forest_file;
     for (option, value, cause) in [

@@ -37,12 +37,12 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     // Trees drawn as quads alone (the hybrid method) are not drawn here.
-    if (quad_share(camera.forms, distance(camera.eye.xyz, c), sp.switch_unit * inst.scale, i)
+    if (quad_share(camera.forms, distance(camera.form_eye.xyz, c), sp.switch_unit * inst.scale, i)
         == WEIGHT_ONE) {
         keys[i] = NONE;
         return;
     }
-    let d = distance(camera.eye.xyz, c) / inst.scale;
+    let d = distance(camera.form_eye.xyz, c) / inst.scale;
     let key = method_band(method, d) * geo_consts.y + inst.species;
     keys[i] = key;
     atomicAdd(&counts[key], 1u);

@@ -50,12 +50,15 @@ struct GeoOut {
     @location(7) world: vec3<f32>,
     // Transmittance towards the sun through the tree's own crown (its opacity volume).
     @location(8) sun_vis: f32,
+    // The tree's bounding sphere (world centre, radius), where the sun's shadow map is read
+    // (tree_shadow, shadow_on.wgsl).
+    @location(9) @interpolate(flat) tree: vec4<f32>,
 }
 
 // The instance and its quad share (0 outside the hybrid's transition band).
 fn geo_form(id: u32, inst: Instance) -> vec2<u32> {
     let sp = geo_species[inst.species];
-    let d = distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz));
+    let d = distance(camera.form_eye.xyz, to_world(inst, sp.sphere.xyz));
     return vec2<u32>(id, quad_share(camera.forms, d, sp.switch_unit * inst.scale, id));
 }
 
@@ -66,6 +69,12 @@ fn quads_own(pixel: vec2<f32>, form: vec2<u32>) -> bool {
 
 @vertex
 fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> GeoOut {
+    return geo_vertex(vi, ii, true);
+}
+
+// Vertex `vi` of listed tree `ii`; `shaded`: with the march towards the sun (the draw), or
+// without (the light views' casting pass, geometry_cast.wgsl).
+fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
     let id = visible_list[ii];
     let inst = instances[id];
     let v = vertices[vi];
@@ -73,7 +82,7 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     var contrast = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     if (method.mode == 1u && v.element != NONE) {
         let sp = geo_species[inst.species];
-        let d = distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz)) / inst.scale;
+        let d = distance(camera.form_eye.xyz, to_world(inst, sp.sphere.xyz)) / inst.scale;
         let lambda = lod_lambda(method, d);
         if (lambda < 1.0) {
             let u = (f32(v.element) + 0.5) / f32(sp.leaves);
@@ -96,8 +105,12 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     out.contrast = contrast;
     out.form = geo_form(id, inst);
     let sp = geo_species[inst.species];
-    out.sun_vis = sun_transmittance(opacity, opacity_sampler, inst.species, sp.sphere,
-                                    sp.opacity_depth, p, to_object_dir(inst, camera.sun.xyz));
+    out.tree = vec4<f32>(to_world(inst, sp.sphere.xyz), sp.sphere.w * inst.scale);
+    out.sun_vis = 1.0;
+    if (shaded) {
+        out.sun_vis = sun_transmittance(opacity, opacity_sampler, inst.species, sp.sphere,
+                                        sp.opacity_depth, p, to_object_dir(inst, camera.sun.xyz));
+    }
     return out;
 }
 
@@ -123,7 +136,8 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
         n = -n;
         sky = in.sky.y;
     }
-    let c = shade_light(albedo, n, in.sun_vis, sky, m.kd.a);
+    // The crown's own shadow (the march) times the other casters' (the sun's shadow map).
+    let c = shade_light(albedo, n, in.sun_vis * tree_shadow(in.world, in.tree), sky, m.kd.a);
     let out = hazed(vec4<f32>(c, 1.0), in.world);
     count_shown(in.clip, out.a);
     count_depth(in.clip);
@@ -151,6 +165,8 @@ struct BillboardOut {
     // Unit direction from the eye through the tree's centre, in object space: the view ray
     // that median_depth_point follows through the crown.
     @location(11) @interpolate(flat) view_obj: vec3<f32>,
+    // The tree's bounding sphere (world centre, radius).
+    @location(12) @interpolate(flat) tree: vec4<f32>,
 }
 
 // A camera-facing quad over the tree's bounding sphere showing the billboard image whose
@@ -189,6 +205,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.species = inst.species;
     out.sun_obj = vec4<f32>(to_object_dir(inst, camera.sun.xyz), sp.opacity_depth);
     out.view_obj = to_object_dir(inst, f);
+    out.tree = vec4<f32>(c, r);
     return out;
 }
 
@@ -210,7 +227,8 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
                                    in.sun_obj.w, in.obj, in.view_obj);
     let v = sun_transmittance_coarse(opacity, opacity_sampler, in.species, in.sphere,
                                      in.sun_obj.w, start, in.sun_obj.xyz);
-    let out = hazed(vec4<f32>(shade_light(t.rgb, n, v, g.z, g.w), 1.0), in.world);
+    let vis = v * tree_shadow(in.world, in.tree);
+    let out = hazed(vec4<f32>(shade_light(t.rgb, n, vis, g.z, g.w), 1.0), in.world);
     count_shown(in.clip, out.a);
     count_depth(in.clip);
     return out;

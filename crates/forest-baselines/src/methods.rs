@@ -173,6 +173,21 @@ impl ForestRenderer {
         Ok(())
     }
 
+    /// Cast and receive the sun's shadows with `opts` from the next frame on, or not
+    /// (`None`), for every method: one set of maps, the quad stream's, which the geometry
+    /// renderer casts into and reads as well (so the hybrid's two forms share them).
+    pub fn set_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        opts: Option<forest_render::shadow::ShadowOptions>,
+    ) -> Result<(), RenderError> {
+        self.stream.set_shadows(device, opts)?;
+        if let Some(g) = &mut self.geometry {
+            g.share_shadows(device, self.stream.shadows().map(|s| s.targets().clone()));
+        }
+        Ok(())
+    }
+
     /// Switch the method; the geometry-based ones and the hybrid need the geometry renderer.
     pub fn set_method(&mut self, ctx: &GpuContext, method: Method) -> Result<(), RenderError> {
         let missing = RenderError::MissingData {
@@ -223,7 +238,9 @@ impl ForestRenderer {
                 g.set_forms(forms);
                 self.stream.set_camera(ctx, camera)?;
                 g.set_camera(ctx, camera)?;
-                self.stream.encode_compute(encoder);
+                // Both forms cast into the stream's maps, each tree in the form it is drawn in.
+                self.stream.encode_shadows(encoder, true, Some(&*g));
+                self.stream.encode_view_compute(encoder);
                 g.encode_compute(encoder);
                 {
                     let opts = self.stream.options_built();
@@ -290,7 +307,8 @@ impl ForestRenderer {
         loop {
             self.render_frame(ctx, camera, target)?;
             let stats = self.read_stats(ctx);
-            if !self.fit(&ctx.device, &stats)? {
+            // The light views' streams grow too, so no tree is left out of the shadows.
+            if !(self.fit(&ctx.device, &stats)? | self.stream.fit_shadows(ctx)?) {
                 return Ok(stats);
             }
         }

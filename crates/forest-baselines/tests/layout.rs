@@ -91,6 +91,11 @@ fn shaders_validate() {
     use forest_baselines::shaders::{GEOMETRY_CULL_WGSL, GEOMETRY_DRAW_WGSL};
     for src in [
         GEOMETRY_DRAW_WGSL.concat(),
+        [
+            GEOMETRY_DRAW_WGSL.concat().as_str(),
+            forest_baselines::shaders::GEOMETRY_CAST_WGSL,
+        ]
+        .concat(),
         forest_render::passes::counting_source(&GEOMETRY_DRAW_WGSL),
         GEOMETRY_CULL_WGSL.concat(),
     ] {
@@ -108,14 +113,22 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
         layout_check::reflected_bindings(&cull),
         layout_check::layout_bindings(0, &compute_entries())
     );
-    // Every draw entry point, the environment's too, uses the one draw group.
+    // Every draw entry point, the environment's too, uses the one draw group and the shadow
+    // maps' group 2.
+    let mut drawn = layout_check::layout_bindings(0, &draw_entries());
+    drawn.extend(layout_check::layout_bindings(
+        2,
+        &forest_render::shadow_maps::receiver_entries(),
+    ));
+    layout_check::check_layout(&draw, &drawn, |_| true);
+    // The light views' casting pass reads the draw group alone.
     layout_check::check_layout(
-        &draw,
+        &[draw.as_str(), forest_baselines::shaders::GEOMETRY_CAST_WGSL].concat(),
         &layout_check::layout_bindings(0, &draw_entries()),
-        |_| true,
+        |e| e.ends_with("_cast") || e == "vs_billboard",
     );
     // The counting variant adds the counters as group 1.
-    let mut counted = layout_check::layout_bindings(0, &draw_entries());
+    let mut counted = drawn.clone();
     counted.extend(layout_check::layout_bindings(
         1,
         &forest_render::fragments::layout_entries(),

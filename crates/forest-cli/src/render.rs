@@ -116,9 +116,9 @@ pub struct LightArgs {
 #[derive(clap::Args, Debug, Clone)]
 pub struct ShadowArgs {
     /// The sun's shadows, cast by the trees onto the ground and each other through cascaded
-    /// shadow maps (the quad stream and impostors; the other methods do not draw them yet).
-    #[arg(long, default_value = "off", value_parser = ["on", "off"])]
-    pub shadows: String,
+    /// shadow maps, by every method [default: off in `render`, on in `view`]
+    #[arg(long, value_parser = ["on", "off"])]
+    pub shadows: Option<String>,
     /// Shadow cascades, 1 to 4.
     #[arg(long, default_value_t = ShadowOptions::default().cascades)]
     pub shadow_cascades: u32,
@@ -134,9 +134,10 @@ pub struct ShadowArgs {
 }
 
 impl ShadowArgs {
-    /// The shadow options asked for (None: off), checked: the error names the bad value.
-    pub fn options(&self) -> Result<Option<ShadowOptions>> {
-        if self.shadows == "off" {
+    /// The shadow options asked for (None: off; `on` when not given), checked: the error
+    /// names the bad value.
+    pub fn options(&self, on: bool) -> Result<Option<ShadowOptions>> {
+        if self.shadows.as_deref().map_or(!on, |s| s == "off") {
             return Ok(None);
         }
         let o = ShadowOptions {
@@ -649,14 +650,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let mesh_method = args.m.checked_method(forest.species.len())?;
-    let shadows = args.shadow.options()?;
-    if shadows.is_some() && mesh_method.is_some() {
-        bail!(
-            "--shadows on: the {} method does not draw shadows yet (the quad stream and \
-             impostors do)",
-            args.m.method
-        );
-    }
+    args.shadow.options(false)?;
     let ctx = crate::gpu_context()?;
     if let Method::Hybrid(h) = args.m.chosen(mesh_method)? {
         return render_hybrid(args, h, &ctx, &forest, &species, &cameras);
@@ -665,7 +659,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return render_geometry(args, m, &ctx, &forest, &species, &cameras);
     }
     let mut stream = stream_for(args, &ctx, &species, &forest)?;
-    stream.set_shadows(&ctx.device, shadows)?;
+    stream.set_shadows(&ctx.device, args.shadow.options(false)?)?;
     stream.set_pipeline_statistics(args.json);
     render_views(args, &ctx, &cameras, |cam, target| {
         let stats = stream.render_fitted(&ctx, cam, target)?;
@@ -881,6 +875,7 @@ fn render_hybrid(
     let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
+    r.set_shadows(&ctx.device, args.shadow.options(false)?)?;
     r.set_pipeline_statistics(args.json);
     render_views(args, ctx, cameras, |cam, target| {
         let stats = r.render_fitted(ctx, cam, target)?;
@@ -1057,6 +1052,7 @@ fn render_geometry(
     let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
     let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
+    geo.set_shadows(&ctx.device, args.shadow.options(false)?)?;
     geo.set_pipeline_statistics(args.json);
     render_views(args, ctx, cameras, |cam, target| {
         geo.render_frame(ctx, cam, target)?;

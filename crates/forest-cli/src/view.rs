@@ -55,6 +55,8 @@ pub struct ViewArgs {
     pub m: MethodArgs,
     #[command(flatten)]
     pub light: crate::render::LightArgs,
+    #[command(flatten)]
+    pub shadow: crate::render::ShadowArgs,
 }
 
 fn parse_debug_view(s: &str) -> Result<DebugView, String> {
@@ -208,6 +210,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     r.stream.set_options(args_models.stream_options())?;
     let method = args_models.chosen(mesh_method)?;
     r.set_method(&ctx, method)?;
+    r.set_shadows(&ctx.device, args.shadow.options(true)?)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
     let mut total_ms = 0.0;
     for (i, key) in path.keys.iter().enumerate() {
@@ -281,6 +284,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
         method: start,
         debug_view: args.debug_view,
         hour: args.light.time.unwrap_or(12.0),
+        shadows: args.shadow.options(true)?,
         path,
         record_to: args.record.clone(),
         screenshots: args.screenshots.clone(),

@@ -6,15 +6,15 @@
 
 mod common;
 
-use forest_baselines::geometry::{GeometryRenderer, MeshMethod, PreparedGeometry};
+use forest_baselines::geometry::{MeshMethod, PreparedGeometry};
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::atlas::HybridSwitch;
 use forest_format::forest::Forest;
 use forest_render::forms as hybrid;
-use forest_render::options::{Atmosphere, Background, RendererOptions};
-use forest_render::target::{TARGET_FORMAT, Target};
-use forest_render::{Camera, GpuContext, GpuScene, QuadStream, SpeciesData, reference};
+use forest_render::options::{Atmosphere, Background};
+use forest_render::target::Target;
+use forest_render::{Camera, GpuContext, SpeciesData, reference};
 use glam::Vec3;
 
 const WEIGHT_ONE: u32 = forest_render::gpu_types::WEIGHT_ONE;
@@ -37,7 +37,7 @@ fn renderer_in(
     atmosphere: Atmosphere,
 ) -> ForestRenderer {
     let species = common::species();
-    renderer_of(
+    common::forest_renderer(
         ctx,
         &species,
         common::prepared(),
@@ -45,31 +45,6 @@ fn renderer_in(
         viewport,
         background,
         atmosphere,
-    )
-}
-
-/// Both forms of `species` (and their geometry, `prepared`).
-fn renderer_of(
-    ctx: &GpuContext,
-    species: &[SpeciesData],
-    prepared: &PreparedGeometry,
-    forest: &Forest,
-    viewport: (u32, u32),
-    background: Background,
-    atmosphere: Atmosphere,
-) -> ForestRenderer {
-    let scene = GpuScene::new(ctx, species, forest).unwrap();
-    let opts = RendererOptions {
-        format: TARGET_FORMAT,
-        viewport,
-        background,
-        atmosphere,
-        ..Default::default()
-    };
-    let geometry = GeometryRenderer::with_targets(ctx, prepared, forest, &opts).unwrap();
-    ForestRenderer::new(
-        QuadStream::new(&ctx.device, scene, &opts).unwrap(),
-        Some(geometry),
     )
 }
 
@@ -104,13 +79,21 @@ fn save(name: &str, images: &[(&str, &image::RgbaImage)]) {
 fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     let ctx = common::ctx();
     let forest = common::forest(300);
-    // In haze too: both forms go through the same haze, so the ends still match exactly.
-    for (background, atmosphere) in [
-        (Background::Transparent, Atmosphere::CLEAR),
-        (Background::Sky, Atmosphere::CLEAR),
-        (Background::Sky, Atmosphere::hazy(300.0)),
+    // In haze too: both forms go through the same haze, so the ends still match exactly; and
+    // with the sun's shadows, which both forms cast into one set of maps.
+    let shadows = forest_render::shadow::ShadowOptions {
+        resolution: 256,
+        epsilon: 8.0,
+        ..Default::default()
+    };
+    for (background, atmosphere, shadows) in [
+        (Background::Transparent, Atmosphere::CLEAR, None),
+        (Background::Sky, Atmosphere::CLEAR, None),
+        (Background::Sky, Atmosphere::hazy(300.0), None),
+        (Background::Sky, Atmosphere::CLEAR, Some(shadows)),
     ] {
         let mut r = renderer_in(&ctx, &forest, (160, 120), background, atmosphere);
+        r.set_shadows(&ctx.device, shadows).unwrap();
         for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
             let quads = frame(&ctx, &mut r, Method::Quads, &cam);
             let zero = frame(&ctx, &mut r, hybrid_at(0.0), &cam);
@@ -128,10 +111,17 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
             ] {
                 if got != want {
                     save(
-                        &format!("hybrid-{name}-{background:?}-{}", atmosphere.visibility),
+                        &format!(
+                            "hybrid-{name}-{background:?}-{}-{}",
+                            atmosphere.visibility,
+                            shadows.is_some()
+                        ),
                         &[("expected", want), ("hybrid", got)],
                     );
-                    panic!("{name} {background:?}: the hybrid {what} differs");
+                    panic!(
+                        "{name} {background:?} shadows {}: the hybrid {what} differs",
+                        shadows.is_some()
+                    );
                 }
             }
         }
@@ -273,7 +263,7 @@ fn classification_matches(
     prepared: &PreparedGeometry,
     near: Near,
 ) {
-    let mut r = renderer_of(
+    let mut r = common::forest_renderer(
         ctx,
         species,
         prepared,

@@ -37,8 +37,11 @@ struct Camera {
     shadow_texel: vec4<f32>,
     shadow_bias: vec4<f32>,
     // x: cascades in use (0: no shadows); y: the map's side (texels); z: the receivers'
-    // offset (texels); w unused.
+    // offset (texels); w: 1 for reverse-Z maps (a host's), else 0.
     shadow_params: vec4<f32>,
+    // xyz: the eye whose distances choose each tree's form and level of detail (eye, except in
+    // a light view: the eye of the view it casts for); w unused.
+    form_eye: vec4<f32>,
 }
 
 // The project's one shading model (mirrors forest_format::shading::Lighting::shade): albedo

@@ -182,7 +182,7 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, front: u32, last: b
     let sp = species[inst.species];
     let centre = to_world(inst, sp.sphere.xyz);
     // Trees drawn as geometry alone (the hybrid method) have no quads.
-    if (quad_share(camera.forms, distance(camera.eye.xyz, centre), sp.switch_unit * inst.scale,
+    if (quad_share(camera.forms, distance(camera.form_eye.xyz, centre), sp.switch_unit * inst.scale,
                    inst_id) == 0u) {
         return 0u;
     }

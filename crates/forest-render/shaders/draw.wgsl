@@ -322,7 +322,7 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
     let hi = quad_hi(q);
     out.alpha = select(0.0, f32(hi - lo) / f32(hi), hi > 0u);
     if ((flags & FLAG_DITHER) != 0u) { out.alpha = 1.0; }
-    let form = quad_share(camera.forms, distance(camera.eye.xyz, to_world(inst, sp.sphere.xyz)),
+    let form = quad_share(camera.forms, distance(camera.form_eye.xyz, to_world(inst, sp.sphere.xyz)),
                           sp.switch_unit * inst.scale, q.instance);
     out.share = vec4<u32>(lo, hi, q.instance, form);
     out.frame_right = to_world_dir(inst, f.right.xyz);

@@ -24,9 +24,13 @@ fn sun_shadow(world: vec3<f32>, normal: vec3<f32>) -> f32 {
     let p = world + (camera.sun.xyz + normal) * (camera.shadow_params.z * texel);
     let c = camera.shadow[k] * vec4<f32>(p, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * c.x, 0.5 - 0.5 * c.y);
+    // Reverse-Z maps (a host's, shadow_params.w = 1) keep the nearest caster's greatest depth.
+    let reverse = camera.shadow_params.w != 0.0;
     // Outside the map, or nearer the sun than its box: nothing casts there.
-    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || c.z <= 0.0) { return 1.0; }
-    let z = min(c.z - camera.shadow_bias[k], 1.0);
+    let beyond = select(c.z <= 0.0, c.z >= 1.0, reverse);
+    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || beyond) { return 1.0; }
+    let z = clamp(select(c.z - camera.shadow_bias[k], c.z + camera.shadow_bias[k], reverse),
+                  0.0, 1.0);
     let d = 0.5 / camera.shadow_params.y;
     var lit = textureSampleCompareLevel(shadow_map, shadow_sampler, uv + vec2<f32>(-d, -d), k, z);
     lit = lit + textureSampleCompareLevel(shadow_map, shadow_sampler, uv + vec2<f32>(d, -d), k, z);

@@ -118,6 +118,7 @@ pub(crate) fn gpu_camera(
     let mut g = GpuCamera {
         view_proj: m.to_cols_array_2d(),
         eye: eye.extend(epsilon).to_array(),
+        form_eye: eye.extend(0.0).to_array(),
         forward: forward.extend(0.0).to_array(),
         viewport: [viewport.0 as f32, viewport.1 as f32, 0.0, 0.0],
         planes: frustum_planes(m),

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 
 /// The camera, the frame's light and its sun's shadow cascades: the only data written to the
-/// GPU per frame (608 bytes; a stream with shadows writes one per light view after it, in the
+/// GPU per frame (624 bytes; a stream with shadows writes one per light view after it, in the
 /// same write, see [`crate::shadow`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -43,8 +43,13 @@ pub struct GpuCamera {
     /// Each cascade's depth bias (shadow-clip depth units, subtracted from a receiver's).
     pub shadow_bias: [f32; 4],
     /// `x`: cascades in use (0: no shadows); `y`: the map's side in texels; `z`: the
-    /// receivers' offset towards the sun and along their normal, in texels; `w` unused.
+    /// receivers' offset towards the sun and along their normal, in texels; `w`: 1 when the
+    /// maps are reverse-Z (a host's), else 0.
     pub shadow_params: [f32; 4],
+    /// The eye (world) whose distances choose each tree's form and level of detail: the
+    /// view's own eye, and in a light view the eye of the view it casts for, so that every
+    /// tree casts with the form it is drawn in ([`crate::shadow::light_camera`]); `w` unused.
+    pub form_eye: [f32; 4],
 }
 
 impl GpuCamera {

@@ -157,7 +157,7 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     // Trees drawn as geometry alone (the hybrid method) have no quads.
     if crate::forms::quad_share(
         cam.forms,
-        xyz(cam.eye).distance(centre),
+        xyz(cam.form_eye).distance(centre),
         sp.switch_unit * inst.scale,
         inst_id,
     ) == 0

@@ -242,6 +242,19 @@ pub fn fit_cascades(view: &ViewSlice, sun: Vec3, opts: &ShadowOptions) -> Vec<Ca
 
 /// Write the cascades into the view's camera uniform (what its receivers look up).
 pub fn write_receivers(g: &mut GpuCamera, cascades: &[Cascade], opts: &ShadowOptions) {
+    write_receivers_of(g, cascades, opts.resolution, opts.offset_texels, false);
+}
+
+/// [`write_receivers`] for any maps (a host's): each cascade's matrix, far split, texel and
+/// depth range are read; `resolution` is the maps' side in texels, `offset_texels` the
+/// receivers' offset, `reverse_z` the maps' depth convention.
+pub fn write_receivers_of(
+    g: &mut GpuCamera,
+    cascades: &[Cascade],
+    resolution: u32,
+    offset_texels: f32,
+    reverse_z: bool,
+) {
     let n = cascades.len().min(MAX_CASCADES as usize);
     for (i, c) in cascades.iter().take(n).enumerate() {
         g.shadow[i] = c.view_proj.to_cols_array_2d();
@@ -250,7 +263,86 @@ pub fn write_receivers(g: &mut GpuCamera, cascades: &[Cascade], opts: &ShadowOpt
         // Half a texel of slope at 45° plus the depth quantum: the comparison's own rounding.
         g.shadow_bias[i] = 0.5 * c.texel / c.depth_range + 1e-6;
     }
-    g.shadow_params = [n as f32, opts.resolution as f32, opts.offset_texels, 0.0];
+    g.shadow_params = [
+        n as f32,
+        resolution as f32,
+        offset_texels,
+        if reverse_z { 1.0 } else { 0.0 },
+    ];
+}
+
+/// A host's light view, for the forest to cast into the host's own shadow map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightParams {
+    /// World → the host's shadow clip (orthographic for a sun; wgpu depth 0..1, standard or
+    /// reverse-Z as the casting stream's [`crate::RendererOptions`] say).
+    pub view_proj: Mat4,
+    /// Unit direction towards the light (world): it picks each tree's aspects.
+    pub to_light: Vec3,
+    /// The map's size in texels.
+    pub resolution: (u32, u32),
+    /// The refinement threshold ε, in texels.
+    pub epsilon: f32,
+    /// The eye of the view the shadows are for: each tree casts in the form that view draws
+    /// it in (the hybrid's forms are measured from it).
+    pub view_eye: Vec3,
+}
+
+impl LightParams {
+    /// Check every field; the error names the bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.view_proj.is_finite() && self.view_proj.determinant().abs() > f32::MIN_POSITIVE) {
+            return Err("the light's view-projection must be finite and invertible".into());
+        }
+        if !self.to_light.is_finite() || (self.to_light.length() - 1.0).abs() >= 1e-3 {
+            return Err(format!(
+                "the direction towards the light {} must be a unit vector",
+                self.to_light
+            ));
+        }
+        if self.resolution.0 == 0 || self.resolution.1 == 0 {
+            return Err(format!("the light's map {:?} is empty", self.resolution));
+        }
+        if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
+            return Err(format!("light epsilon {} must be positive", self.epsilon));
+        }
+        if !self.view_eye.is_finite() {
+            return Err("the view's eye must be finite".into());
+        }
+        Ok(())
+    }
+
+    /// The light camera a stream casts with: the host's matrix, the eye far along the light
+    /// from the middle of the light's box (so every tree is seen from the light's direction),
+    /// ε in texels, forms chosen from the view's eye, no composited far trees.
+    pub fn camera(&self, stream: crate::options::StreamOptions) -> GpuCamera {
+        let inv = self.view_proj.inverse();
+        let centre = inv.project_point3(Vec3::new(0.0, 0.0, 0.5));
+        let reach = [
+            (-1.0, -1.0, 0.0),
+            (1.0, 1.0, 1.0),
+            (-1.0, 1.0, 0.0),
+            (1.0, -1.0, 1.0),
+        ]
+        .iter()
+        .map(|&(x, y, z)| inv.project_point3(Vec3::new(x, y, z)).distance(centre))
+        .fold(1.0f32, f32::max);
+        let to_light = self.to_light.normalize_or(Vec3::Y);
+        let mut g = crate::frame::gpu_camera(
+            self.view_proj,
+            centre + to_light * (1e4 * reach),
+            -to_light,
+            self.resolution,
+            self.epsilon,
+        );
+        crate::options::StreamOptions {
+            far_nearest: false,
+            ..stream
+        }
+        .apply(&mut g);
+        g.form_eye = self.view_eye.extend(0.0).to_array();
+        g
+    }
 }
 
 /// The camera a cascade's light-view stream culls, refines and draws with: the cascade's
@@ -281,6 +373,22 @@ pub fn light_camera(
     g
 }
 
+/// [`light_camera`] for the view `view`: its forms, and the distances that choose them
+/// measured from its eye, so that each tree casts in the form the view draws it in.
+pub fn light_camera_for(
+    view: &GpuCamera,
+    c: &Cascade,
+    light: &forest_format::shading::Lighting,
+    opts: &ShadowOptions,
+    stream: crate::options::StreamOptions,
+) -> GpuCamera {
+    let mut l = light_camera(c, light.sun_dir, opts, stream);
+    l.set_light(light);
+    l.forms = view.forms;
+    l.form_eye = view.form_eye;
+    l
+}
+
 /// The frame's cameras with shadows: `view` (the view's camera, light and options already in
 /// it) with its cascades written in, then each cascade's light camera under `light`. What a
 /// stream with shadows writes in its one upload.
@@ -298,11 +406,11 @@ pub fn cameras(
     let cascades = fit_cascades(&slice, light.sun_dir, opts);
     let mut out = vec![*view];
     write_receivers(&mut out[0], &cascades, opts);
-    out.extend(cascades.iter().map(|c| {
-        let mut l = light_camera(c, light.sun_dir, opts, stream);
-        l.set_light(light);
-        l
-    }));
+    out.extend(
+        cascades
+            .iter()
+            .map(|c| light_camera_for(view, c, light, opts, stream)),
+    );
     out
 }
 

@@ -82,11 +82,26 @@ fn receiver_group(
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
     });
+    receivers_of(device, layout, &view, false)
+}
+
+/// The receivers' group over a depth array `view` (a host's maps too), compared as
+/// standard depth or reverse-Z.
+pub fn receivers_of(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    view: &wgpu::TextureView,
+    reverse_z: bool,
+) -> wgpu::BindGroup {
     let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("shadow compare"),
         mag_filter: wgpu::FilterMode::Linear,
         min_filter: wgpu::FilterMode::Linear,
-        compare: Some(wgpu::CompareFunction::LessEqual),
+        compare: Some(if reverse_z {
+            wgpu::CompareFunction::GreaterEqual
+        } else {
+            wgpu::CompareFunction::LessEqual
+        }),
         ..Default::default()
     });
     device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -95,7 +110,7 @@ fn receiver_group(
         entries: &[
             wgpu::BindGroupEntry {
                 binding: 0,
-                resource: wgpu::BindingResource::TextureView(&view),
+                resource: wgpu::BindingResource::TextureView(view),
             },
             wgpu::BindGroupEntry {
                 binding: 1,
@@ -111,24 +126,30 @@ pub fn no_shadows(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu
     receiver_group(device, layout, &depth_array(device, 1, 1))
 }
 
-/// The shadow maps of one view and the light-view streams that fill them.
-pub struct ShadowMaps {
+/// Casters besides the quad stream's that draw into the maps (the geometry renderer's light
+/// views): for cascade `k`, their compute work before its pass, then their draws in it.
+pub trait Caster {
+    /// Record cascade `k`'s compute passes (after its light camera is in place).
+    fn encode_light(&self, encoder: &mut wgpu::CommandEncoder, k: usize);
+    /// Draw into cascade `k`'s depth-only pass.
+    fn record_light(&self, pass: &mut wgpu::RenderPass, k: usize);
+}
+
+/// The maps themselves: a depth layer per cascade, each drawn into by its own pass, and the
+/// receivers' group that reads them all. Shared by the renderers that cast into them (the
+/// quad stream's light views and the geometry renderer's, in the hybrid).
+pub struct ShadowTargets {
     opts: ShadowOptions,
     layers: Vec<wgpu::TextureView>,
     receivers: wgpu::BindGroup,
-    streams: Vec<QuadStream>,
-    cast: CastPass,
-    /// Bytes of the maps.
-    map_bytes: u64,
+    bytes: u64,
 }
 
-impl ShadowMaps {
-    /// The maps and light-view streams of `opts` over `scene`; `layout` is the receivers'
-    /// layout of the stream that will read them. Sizes are checked against the device
-    /// before anything is allocated.
+impl ShadowTargets {
+    /// The maps of `opts` (checked, and against the device, before anything is allocated),
+    /// read through `layout` (the receivers' layout, [`receiver_layout`]).
     pub fn new(
         device: &wgpu::Device,
-        scene: Arc<GpuScene>,
         opts: &ShadowOptions,
         layout: &wgpu::BindGroupLayout,
     ) -> Result<Self, RenderError> {
@@ -159,6 +180,72 @@ impl ShadowMaps {
                 })
             })
             .collect();
+        Ok(Self {
+            opts: *opts,
+            layers,
+            receivers: receiver_group(device, layout, &texture),
+            bytes: u64::from(opts.resolution).pow(2) * 4 * u64::from(opts.cascades),
+        })
+    }
+
+    /// The options the maps were built for.
+    pub fn options(&self) -> &ShadowOptions {
+        &self.opts
+    }
+
+    /// The receivers' bind group (group 2 of every draw that reads the maps).
+    pub fn receivers(&self) -> &wgpu::BindGroup {
+        &self.receivers
+    }
+
+    /// Bytes of the maps.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Begin cascade `k`'s depth-only pass, its layer cleared to the far depth.
+    pub fn begin_cascade<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        k: usize,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow cascade"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.layers[k],
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+}
+
+/// The shadow maps of one view and the light-view streams that fill them.
+pub struct ShadowMaps {
+    targets: Arc<ShadowTargets>,
+    streams: Vec<QuadStream>,
+    cast: CastPass,
+}
+
+impl ShadowMaps {
+    /// The maps and light-view streams of `opts` over `scene`; `layout` is the receivers'
+    /// layout of the stream that will read them. Sizes are checked against the device
+    /// before anything is allocated.
+    pub fn new(
+        device: &wgpu::Device,
+        scene: Arc<GpuScene>,
+        opts: &ShadowOptions,
+        layout: &wgpu::BindGroupLayout,
+    ) -> Result<Self, RenderError> {
+        let targets = Arc::new(ShadowTargets::new(device, opts, layout)?);
         let stream_opts = RendererOptions {
             viewport: (opts.resolution, opts.resolution),
             min_epsilon: opts.epsilon,
@@ -168,25 +255,26 @@ impl ShadowMaps {
         let streams = (0..opts.cascades)
             .map(|_| QuadStream::new(device, scene.clone(), &stream_opts))
             .collect::<Result<Vec<_>, _>>()?;
-        let map_bytes = u64::from(opts.resolution).pow(2) * 4 * u64::from(opts.cascades);
         Ok(Self {
-            opts: *opts,
-            layers,
-            receivers: receiver_group(device, layout, &texture),
+            targets,
             streams,
             cast: CastPass::new(device),
-            map_bytes,
         })
     }
 
     /// The options the maps were built for.
     pub fn options(&self) -> &ShadowOptions {
-        &self.opts
+        self.targets.options()
     }
 
     /// The receivers' bind group (group 2 of the draw).
     pub fn receivers(&self) -> &wgpu::BindGroup {
-        &self.receivers
+        self.targets.receivers()
+    }
+
+    /// The maps, to share with another renderer casting into them and reading them.
+    pub fn targets(&self) -> &Arc<ShadowTargets> {
+        &self.targets
     }
 
     /// The light-view streams, one per cascade (their counters: [`Self::stats`]).
@@ -196,7 +284,7 @@ impl ShadowMaps {
 
     /// Bytes on the GPU: the maps and the light-view streams' own buffers.
     pub fn bytes(&self) -> u64 {
-        self.map_bytes + self.streams.iter().map(|s| s.view_bytes()).sum::<u64>()
+        self.targets.bytes() + self.streams.iter().map(|s| s.view_bytes()).sum::<u64>()
     }
 
     /// Record every cascade: copy its light camera from slot `k + 1` of `cameras` (the view's
@@ -204,35 +292,56 @@ impl ShadowMaps {
     /// its layer, cleared first to the far depth. Each stream times its passes as a view's
     /// stream does (its counters' `draw_ms` is the casting pass).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, cameras: &wgpu::Buffer) {
+        self.encode_with(encoder, cameras, true, None);
+    }
+
+    /// [`Self::encode`] with the quad stream's casting when `quads`, and `extra`'s.
+    pub fn encode_with(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        cameras: &wgpu::Buffer,
+        quads: bool,
+        extra: Option<&dyn Caster>,
+    ) {
         let size = std::mem::size_of::<GpuCamera>() as u64;
-        for (k, (stream, layer)) in self.streams.iter().zip(&self.layers).enumerate() {
-            encoder.copy_buffer_to_buffer(
-                cameras,
-                size * (k as u64 + 1),
-                stream.camera_buffer(),
-                0,
-                size,
-            );
-            stream.encode_compute(encoder);
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow cascade"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: layer,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: stream.draw_timestamps(),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            let (group, args) = stream.cast_parts();
-            self.cast.record(&mut pass, group, args);
+        for (k, stream) in self.streams.iter().enumerate() {
+            if quads {
+                encoder.copy_buffer_to_buffer(
+                    cameras,
+                    size * (k as u64 + 1),
+                    stream.camera_buffer(),
+                    0,
+                    size,
+                );
+                stream.encode_view_compute(encoder);
+            }
+            if let Some(c) = extra {
+                c.encode_light(encoder, k);
+            }
+            let ts = if quads {
+                stream.draw_timestamps()
+            } else {
+                None
+            };
+            let mut pass = self.targets.begin_cascade(encoder, k, ts);
+            if quads {
+                let (group, args) = stream.cast_parts();
+                self.cast.record(&mut pass, group, args);
+            }
+            if let Some(c) = extra {
+                c.record_light(&mut pass, k);
+            }
             drop(pass);
-            stream.resolve_times(encoder);
+            if quads {
+                stream.resolve_times(encoder);
+            }
+        }
+    }
+
+    /// Refine the light views (the quad stream) or not (static impostors).
+    pub fn set_refine(&mut self, refine: bool) {
+        for s in &mut self.streams {
+            s.set_refine(refine);
         }
     }
 

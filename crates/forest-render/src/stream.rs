@@ -106,8 +106,23 @@ pub struct QuadStream {
     light: forest_format::shading::Lighting,
     /// The sun's shadow maps, when on ([`Self::set_shadows`]).
     shadows: Option<crate::shadow_maps::ShadowMaps>,
+    /// The last maps switched off, kept for switching them on again.
+    parked: Option<crate::shadow_maps::ShadowMaps>,
     /// The receivers' group while shadows are off.
     no_shadows: wgpu::BindGroup,
+    /// A host's shadow maps the forest receives ([`Self::receive_host_shadows`]).
+    host_shadows: Option<HostShadows>,
+    /// The casting pipeline into a host's map ([`Self::prepare_light`]).
+    host_cast: Option<crate::passes::cast::CastPass>,
+}
+
+/// A host's shadow maps as the forest's receivers read them.
+struct HostShadows {
+    group: wgpu::BindGroup,
+    resolution: u32,
+    reverse_z: bool,
+    offset_texels: f32,
+    cascades: Vec<crate::shadow::Cascade>,
 }
 
 /// Bytes of the camera buffer: the view's camera, then a light-view camera per cascade
@@ -249,33 +264,165 @@ impl QuadStream {
             forms: crate::forms::FORMS_QUADS,
             light: opts.lighting,
             shadows: None,
+            parked: None,
             no_shadows,
+            host_shadows: None,
+            host_cast: None,
         })
     }
 
+    /// Receive a host's sun shadows instead of casting the forest's own: `maps` is the host's
+    /// depth array (a layer per cascade, `resolution`² texels, standard depth or reverse-Z),
+    /// read through the receivers' filter and bias; `None` stops. Each frame's cascades
+    /// come from [`Self::set_host_cascades`]. The forest's own shadows are switched off.
+    pub fn receive_host_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        maps: Option<(&wgpu::TextureView, u32, bool)>,
+    ) {
+        self.host_shadows = maps.map(|(view, resolution, reverse_z)| {
+            self.shadows = None;
+            HostShadows {
+                group: crate::shadow_maps::receivers_of(
+                    device,
+                    &self.passes.draw.shadow_layout,
+                    view,
+                    reverse_z,
+                ),
+                resolution,
+                reverse_z,
+                offset_texels: crate::shadow::ShadowOptions::default().offset_texels,
+                cascades: Vec::new(),
+            }
+        });
+    }
+
+    /// The host's cascades for the next frames' receivers (see
+    /// [`Self::receive_host_shadows`]): each one's world → shadow clip matrix, the view depth
+    /// where it ends (`split.1`), its texel and its depth range (metres); at most
+    /// [`crate::shadow::MAX_CASCADES`], finite.
+    pub fn set_host_cascades(
+        &mut self,
+        cascades: &[crate::shadow::Cascade],
+    ) -> Result<(), RenderError> {
+        if cascades.len() > crate::shadow::MAX_CASCADES as usize {
+            return Err(RenderError::Parameter(format!(
+                "{} shadow cascades: at most {}",
+                cascades.len(),
+                crate::shadow::MAX_CASCADES
+            )));
+        }
+        if cascades.iter().any(|c| {
+            !(c.view_proj.is_finite()
+                && c.split.1.is_finite()
+                && c.texel > 0.0
+                && c.depth_range > 0.0)
+        }) {
+            return Err(RenderError::Parameter(
+                "a shadow cascade's matrix, split, texel or depth range is not finite and \
+                 positive"
+                    .into(),
+            ));
+        }
+        match &mut self.host_shadows {
+            Some(h) => h.cascades = cascades.to_vec(),
+            None => {
+                return Err(RenderError::Parameter(
+                    "host cascades without host shadow maps: call receive_host_shadows first"
+                        .into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Write a host's light view (the frame's upload for this stream): from here on the stream
+    /// casts into the host's shadow map, culled and refined from the light, drawn depth-only
+    /// with [`Self::render_depth`] after [`Self::encode_compute`]. The stream's depth format
+    /// and convention ([`RendererOptions`]) are the map's.
+    pub fn prepare_light(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        light: &crate::shadow::LightParams,
+    ) -> Result<(), RenderError> {
+        light.validate().map_err(RenderError::Parameter)?;
+        if self.host_cast.is_none() {
+            let compare = if self.opts.reverse_z {
+                wgpu::CompareFunction::Greater
+            } else {
+                wgpu::CompareFunction::Less
+            };
+            self.host_cast = Some(crate::passes::cast::CastPass::into(
+                device,
+                (self.opts.depth_format, compare),
+            ));
+        }
+        let g = light.camera(self.options);
+        crate::camera::upload(queue, &self.camera, &g, &mut self.writes);
+        self.prepared = true;
+        Ok(())
+    }
+
+    /// Draw the light view's quads depth-only into the host's pass (its shadow map's layer),
+    /// after [`Self::prepare_light`] and [`Self::encode_compute`].
+    pub fn render_depth(&self, pass: &mut wgpu::RenderPass) {
+        if let Some(cast) = &self.host_cast {
+            let (group, args) = self.cast_parts();
+            cast.record(pass, group, args);
+        }
+    }
+
     /// Cast and receive the sun's shadows with `opts` from the next frame on, or not
-    /// (`None`). The maps and their light-view streams are built here (kept while the
-    /// options stay the same); refused, with nothing changed, when the options are out of
-    /// range or the device cannot hold the maps.
+    /// (`None`). The maps and their light-view streams are built here, and kept while the
+    /// options stay the same (the last ones switched off too, for switching them on again);
+    /// refused, with nothing changed, when the options are out of range or the device cannot
+    /// hold the maps.
     pub fn set_shadows(
         &mut self,
         device: &wgpu::Device,
         opts: Option<crate::shadow::ShadowOptions>,
     ) -> Result<(), RenderError> {
         match opts {
-            None => self.shadows = None,
+            None => {
+                if let Some(s) = self.shadows.take() {
+                    self.parked = Some(s);
+                }
+            }
             Some(o) => {
-                if self.shadows.as_ref().map(|s| *s.options()) != Some(o) {
-                    self.shadows = Some(crate::shadow_maps::ShadowMaps::new(
+                self.host_shadows = None;
+                if self.shadows.as_ref().map(|s| *s.options()) == Some(o) {
+                    return Ok(());
+                }
+                if self.parked.as_ref().map(|s| *s.options()) == Some(o) {
+                    let mut maps = self.parked.take();
+                    if let Some(m) = &mut maps {
+                        m.set_refine(self.iterations > 0);
+                    }
+                    self.parked = self.shadows.take();
+                    self.shadows = maps;
+                } else {
+                    let mut maps = crate::shadow_maps::ShadowMaps::new(
                         device,
                         self.scene.clone(),
                         &o,
                         &self.passes.draw.shadow_layout,
-                    )?);
+                    )?;
+                    maps.set_refine(self.iterations > 0);
+                    self.shadows = Some(maps);
                 }
             }
         }
         Ok(())
+    }
+
+    /// Grow the shadow maps' light-view streams whose last frame overflowed (waits for the
+    /// GPU); whether any grew, so that the frame should be drawn again.
+    pub fn fit_shadows(&mut self, ctx: &GpuContext) -> Result<bool, RenderError> {
+        match &mut self.shadows {
+            Some(sh) => sh.fit(ctx),
+            None => Ok(false),
+        }
     }
 
     /// The shadow maps, when shadows are on.
@@ -688,13 +835,17 @@ impl QuadStream {
         self.light
     }
 
-    /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only).
+    /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only),
+    /// in the shadow maps' light views too (each method casts as it draws).
     pub fn set_refine(&mut self, refine: bool) {
         self.iterations = if refine {
             self.levels.saturating_sub(1)
         } else {
             0
         };
+        if let Some(sh) = &mut self.shadows {
+            sh.set_refine(refine);
+        }
     }
 
     fn bindings(&self) -> crate::passes::StreamBindings<'_> {
@@ -728,6 +879,15 @@ impl QuadStream {
         self.options.apply(&mut g);
         g.forms = self.forms;
         g.set_light(&self.light);
+        if let Some(h) = &self.host_shadows {
+            crate::shadow::write_receivers_of(
+                &mut g,
+                &h.cascades,
+                h.resolution,
+                h.offset_texels,
+                h.reverse_z,
+            );
+        }
         let cameras = match &self.shadows {
             Some(sh) => crate::shadow::cameras(&g, &self.light, sh.options(), self.options),
             None => vec![g],
@@ -772,10 +932,7 @@ impl QuadStream {
         loop {
             self.render_frame(ctx, camera, target)?;
             let stats = self.read_stats(ctx);
-            let mut grew = self.fit(&ctx.device, &stats)?;
-            if let Some(sh) = &mut self.shadows {
-                grew |= sh.fit(ctx)?;
-            }
+            let grew = self.fit(&ctx.device, &stats)? | self.fit_shadows(ctx)?;
             if !grew {
                 return Ok(stats);
             }
@@ -820,9 +977,25 @@ impl QuadStream {
     /// after the sun's shadow maps when shadows are on (each cascade's cull, refine and
     /// casting pass, [`crate::shadow_maps::ShadowMaps::encode`]).
     pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.encode_shadows(encoder, true, None);
+        self.encode_view_compute(encoder);
+    }
+
+    /// The shadow maps' passes alone, when shadows are on: the quad stream's light views
+    /// when `quads`, and `extra`'s (the geometry renderer's, for the methods it draws).
+    pub fn encode_shadows(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        quads: bool,
+        extra: Option<&dyn crate::shadow_maps::Caster>,
+    ) {
         if let Some(sh) = &self.shadows {
-            sh.encode(encoder, &self.camera);
+            sh.encode_with(encoder, &self.camera, quads, extra);
         }
+    }
+
+    /// The view's own cull and refine, without the shadow maps' passes.
+    pub fn encode_view_compute(&self, encoder: &mut wgpu::CommandEncoder) {
         let ts = |b: u32| {
             self.queries
                 .as_ref()
@@ -907,9 +1080,11 @@ impl QuadStream {
         let draws = self.passes.draw.record(
             pass,
             &self.sized.bg_draw[(self.iterations % 2) as usize],
-            self.shadows
-                .as_ref()
-                .map_or(&self.no_shadows, |s| s.receivers()),
+            match (&self.shadows, &self.host_shadows) {
+                (Some(s), _) => s.receivers(),
+                (None, Some(h)) => &h.group,
+                (None, None) => &self.no_shadows,
+            },
             &self.sized.args,
             (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,

@@ -13,6 +13,7 @@
 //! space, as the bake shades the atlases.
 
 mod layout;
+mod light;
 mod params;
 mod prepare;
 mod renderer;

@@ -11,6 +11,7 @@ use forest_render::gpu_types::GpuCamera;
 use forest_render::options::RendererOptions;
 use forest_render::options::{Atmosphere, Background};
 use forest_render::passes::draw::draw_pipeline;
+use forest_render::shadow_maps::{Caster, ShadowTargets};
 use forest_render::stats::PassTimes;
 use forest_render::target::Target;
 use forest_render::work::{self, FrameWork, StatisticsQueries};
@@ -71,6 +72,147 @@ pub struct GeometryRenderer {
     pub figures: Vec<SpeciesFigures>,
     /// Bytes of GPU memory the renderer allocated (buffers and textures).
     pub gpu_bytes: u64,
+    /// Layout of the draw's group 2, the sun's shadow maps.
+    shadow_layout: wgpu::BindGroupLayout,
+    /// The receivers' group while shadows are off.
+    no_shadows: wgpu::BindGroup,
+    /// The light views and the maps' receivers' group while shadows are on.
+    shadows: Option<super::light::LightViews>,
+    /// The last light views switched off, kept for switching them on again.
+    parked: Option<super::light::LightViews>,
+    /// What every view of the renderer binds (its own lists aside).
+    shared: Shared,
+}
+
+/// The renderer's tables, textures and layouts that every view binds, the main view and the
+/// shadow cascades' light views alike.
+pub(super) struct Shared {
+    instances: wgpu::Buffer,
+    species: wgpu::Buffer,
+    consts: wgpu::Buffer,
+    method: wgpu::Buffer,
+    leaf_end: wgpu::Buffer,
+    vertices: wgpu::Buffer,
+    materials: wgpu::Buffer,
+    material_view: wgpu::TextureView,
+    sampler: wgpu::Sampler,
+    billboard_surface_view: wgpu::TextureView,
+    environment: wgpu::Buffer,
+    leaf_centre: wgpu::Buffer,
+    billboard_view: wgpu::TextureView,
+    heights: wgpu::Buffer,
+    opacity_view: wgpu::TextureView,
+    opacity_sampler: wgpu::Sampler,
+    compute_layout: wgpu::BindGroupLayout,
+    pub(super) draw_layout: wgpu::BindGroupLayout,
+    /// Draw segments (bands × species) and trees listed.
+    segments: usize,
+    listed: usize,
+}
+
+/// One view's own buffers and its two groups: its camera (the view's, then each cascade's
+/// light camera after it), the per-frame lists and indirect arguments.
+pub(super) struct View {
+    pub(super) camera: wgpu::Buffer,
+    pub(super) args: wgpu::Buffer,
+    pub(super) compute_bg: wgpu::BindGroup,
+    pub(super) draw_bg: wgpu::BindGroup,
+    /// Bytes of the view's buffers.
+    pub(super) bytes: u64,
+}
+
+impl Shared {
+    /// A view's buffers (zeroed) and groups.
+    pub(super) fn view(&self, device: &wgpu::Device, label: &str) -> View {
+        use wgpu::BufferUsages as U;
+        let zeros = |what: &str, bytes: usize, usage: U| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&format!("{label} {what}")),
+                contents: &vec![0u8; bytes.max(16)],
+                usage,
+            })
+        };
+        let camera_bytes =
+            std::mem::size_of::<GpuCamera>() * (1 + forest_render::shadow::MAX_CASCADES as usize);
+        let camera = zeros(
+            "camera",
+            camera_bytes,
+            U::UNIFORM | U::COPY_DST | U::COPY_SRC,
+        );
+        let keys = zeros("segment keys", self.listed * 4, U::STORAGE);
+        let counts = zeros(
+            "segment counts",
+            self.segments * 4,
+            U::STORAGE | U::COPY_SRC,
+        );
+        let cursor = zeros("segment cursors", self.segments * 4, U::STORAGE);
+        let visible = zeros("visible instances", self.listed * 4, U::STORAGE);
+        let args = zeros(
+            "draw args",
+            self.segments * 16,
+            U::STORAGE | U::INDIRECT | U::COPY_SRC,
+        );
+        let bytes = [&camera, &keys, &counts, &cursor, &visible, &args]
+            .iter()
+            .map(|b| b.size())
+            .sum();
+        let compute_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &self.compute_layout,
+            entries: &forest_render::passes::numbered(vec![
+                camera.as_entire_binding(),
+                self.instances.as_entire_binding(),
+                self.species.as_entire_binding(),
+                keys.as_entire_binding(),
+                counts.as_entire_binding(),
+                cursor.as_entire_binding(),
+                visible.as_entire_binding(),
+                args.as_entire_binding(),
+                self.consts.as_entire_binding(),
+                self.method.as_entire_binding(),
+                self.leaf_end.as_entire_binding(),
+            ]),
+        });
+        let resources = vec![
+            (0, camera.as_entire_binding()),
+            (1, self.instances.as_entire_binding()),
+            (2, self.vertices.as_entire_binding()),
+            (3, visible.as_entire_binding()),
+            (4, self.materials.as_entire_binding()),
+            (5, wgpu::BindingResource::TextureView(&self.material_view)),
+            (6, wgpu::BindingResource::Sampler(&self.sampler)),
+            (
+                7,
+                wgpu::BindingResource::TextureView(&self.billboard_surface_view),
+            ),
+            (8, self.environment.as_entire_binding()),
+            (9, self.species.as_entire_binding()),
+            (10, self.method.as_entire_binding()),
+            (11, self.leaf_centre.as_entire_binding()),
+            (12, wgpu::BindingResource::TextureView(&self.billboard_view)),
+            (
+                forest_render::terrain::HEIGHTS_BINDING,
+                self.heights.as_entire_binding(),
+            ),
+            (14, wgpu::BindingResource::TextureView(&self.opacity_view)),
+            (15, wgpu::BindingResource::Sampler(&self.opacity_sampler)),
+        ];
+        let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &self.draw_layout,
+            entries: &resources
+                .into_iter()
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+                .collect::<Vec<_>>(),
+        });
+        View {
+            camera,
+            args,
+            compute_bg,
+            draw_bg,
+            bytes,
+        }
+    }
 }
 
 impl GeometryRenderer {
@@ -154,11 +296,6 @@ impl GeometryRenderer {
             })
         };
         let zeros = |label: &str, bytes: usize, usage: U| init(label, &vec![0u8; bytes], usage);
-        let camera = zeros(
-            "geometry camera",
-            std::mem::size_of::<GpuCamera>(),
-            U::UNIFORM | U::COPY_DST,
-        );
         let method = MeshMethod::default();
         let method_buf = init(
             "geometry method",
@@ -195,15 +332,6 @@ impl GeometryRenderer {
             "geometry constants",
             bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
             U::UNIFORM,
-        );
-        let keys = zeros("segment keys", listed * 4, U::STORAGE);
-        let counts = zeros("segment counts", segments * 4, U::STORAGE | U::COPY_SRC);
-        let cursor = zeros("segment cursors", segments * 4, U::STORAGE);
-        let visible = zeros("visible instances", listed * 4, U::STORAGE);
-        let args = zeros(
-            "geometry draw args",
-            segments * 16,
-            U::STORAGE | U::INDIRECT | U::COPY_SRC,
         );
 
         let (material_view, material_bytes) = layered_texture(
@@ -285,30 +413,14 @@ impl GeometryRenderer {
                 cache: None,
             })
         };
-        let compute_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("geometry cull"),
-            layout: &compute_layout,
-            entries: &forest_render::passes::numbered(vec![
-                camera.as_entire_binding(),
-                inst_buf.as_entire_binding(),
-                species_buf.as_entire_binding(),
-                keys.as_entire_binding(),
-                counts.as_entire_binding(),
-                cursor.as_entire_binding(),
-                visible.as_entire_binding(),
-                args.as_entire_binding(),
-                consts.as_entire_binding(),
-                method_buf.as_entire_binding(),
-                leaf_end_buf.as_entire_binding(),
-            ]),
-        });
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("geometry draw"),
             entries: &draw_entries(),
         });
+        let shadow_layout = forest_render::shadow_maps::receiver_layout(device);
         let draw_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("geometry draw"),
-            bind_group_layouts: &[Some(&draw_layout)],
+            bind_group_layouts: &[Some(&draw_layout), None, Some(&shadow_layout)],
             immediate_size: 0,
         });
         let render_pipeline = |vs: &str, fs: &str, topology, layout: &wgpu::PipelineLayout| {
@@ -344,38 +456,30 @@ impl GeometryRenderer {
             )),
             U::UNIFORM,
         );
-        let resources = vec![
-            (0, camera.as_entire_binding()),
-            (1, inst_buf.as_entire_binding()),
-            (2, vertex_buf.as_entire_binding()),
-            (3, visible.as_entire_binding()),
-            (4, material_buf.as_entire_binding()),
-            (5, wgpu::BindingResource::TextureView(&material_view)),
-            (6, wgpu::BindingResource::Sampler(&sampler)),
-            (
-                7,
-                wgpu::BindingResource::TextureView(&billboard_surface_view),
-            ),
-            (8, environment_buf.as_entire_binding()),
-            (9, species_buf.as_entire_binding()),
-            (10, method_buf.as_entire_binding()),
-            (11, leaf_centre_buf.as_entire_binding()),
-            (12, wgpu::BindingResource::TextureView(&billboard_view)),
-            (
-                forest_render::terrain::HEIGHTS_BINDING,
-                terrain.heights.as_entire_binding(),
-            ),
-            (14, wgpu::BindingResource::TextureView(&opacity_view)),
-            (15, wgpu::BindingResource::Sampler(&opacity_sampler)),
-        ];
-        let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("geometry draw"),
-            layout: &draw_layout,
-            entries: &resources
-                .into_iter()
-                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
-                .collect::<Vec<_>>(),
-        });
+        let shared = Shared {
+            instances: inst_buf,
+            species: species_buf,
+            consts,
+            method: method_buf.clone(),
+            leaf_end: leaf_end_buf,
+            vertices: vertex_buf,
+            materials: material_buf,
+            material_view,
+            sampler,
+            billboard_surface_view,
+            environment: environment_buf,
+            leaf_centre: leaf_centre_buf,
+            billboard_view,
+            heights: terrain.heights.clone(),
+            opacity_view,
+            opacity_sampler,
+            compute_layout,
+            draw_layout: draw_layout.clone(),
+            segments,
+            listed,
+        };
+        let view = shared.view(device, "geometry");
+        gpu_bytes.set(gpu_bytes.get() + view.bytes);
         let queries = device
             .features()
             .contains(wgpu::Features::TIMESTAMP_QUERY)
@@ -389,7 +493,7 @@ impl GeometryRenderer {
                 (set, resolve, f64::from(ctx.queue.get_timestamp_period()))
             });
         let statistics = StatisticsQueries::new(device);
-        let mut sources = vec![(args.clone(), u64::from(cap.segments) * 16)];
+        let mut sources = vec![(view.args.clone(), u64::from(cap.segments) * 16)];
         if let Some((_, resolve, _)) = &queries {
             sources.push((resolve.clone(), 32));
         }
@@ -397,8 +501,9 @@ impl GeometryRenderer {
             sources.push((q.resolve.clone(), work::STATISTICS_BYTES));
         }
         let ring = forest_render::stats::StatsRing::new(device, sources);
+        let no_shadows = forest_render::shadow_maps::no_shadows(device, &shadow_layout);
         Ok(Self {
-            camera,
+            camera: view.camera,
             method_buf,
             method,
             forms: forest_render::forms::FORMS_GEOMETRY,
@@ -419,9 +524,14 @@ impl GeometryRenderer {
             fragment_counts: None,
             terrain,
             atmosphere: opts.atmosphere,
-            compute_bg,
-            draw_bg,
-            args,
+            compute_bg: view.compute_bg,
+            draw_bg: view.draw_bg,
+            args: view.args,
+            shadow_layout,
+            no_shadows,
+            shadows: None,
+            parked: None,
+            shared,
             queries,
             statistics,
             count_work: false,
@@ -488,6 +598,7 @@ impl GeometryRenderer {
         depth: &wgpu::TextureView,
     ) -> Result<(), CameraError> {
         self.set_camera(ctx, camera)?;
+        self.encode_shadows(encoder);
         self.encode_compute(encoder);
         {
             let targets = Targets::cleared(
@@ -531,11 +642,91 @@ impl GeometryRenderer {
         Ok(())
     }
 
-    /// Write a camera uniform with the renderer's `forms` and light.
+    /// Write a camera uniform with the renderer's `forms` and light, and each shadow
+    /// cascade's light camera after it while shadows are on (one write).
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
         g.forms = self.forms;
         g.set_light(&self.light);
-        forest_render::camera::upload(queue, &self.camera, &g, &mut self.writes);
+        let cameras = match &self.shadows {
+            Some(lv) => forest_render::shadow::cameras(
+                &g,
+                &self.light,
+                lv.targets.options(),
+                Default::default(),
+            ),
+            None => vec![g],
+        };
+        forest_render::camera::upload_all(queue, &self.camera, &cameras, &mut self.writes);
+    }
+
+    /// Cast and receive the sun's shadows with `opts` from the next frame on, in maps of the
+    /// renderer's own, or not (`None`); refused, with nothing changed, when the options are
+    /// out of range or the device cannot hold the maps.
+    pub fn set_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        opts: Option<forest_render::shadow::ShadowOptions>,
+    ) -> Result<(), RenderError> {
+        let same =
+            |s: &Option<super::light::LightViews>| s.as_ref().map(|s| *s.targets.options()) == opts;
+        let targets = match opts {
+            Some(_) if same(&self.shadows) => return Ok(()),
+            Some(_) if same(&self.parked) => self.parked.as_ref().map(|p| p.targets.clone()),
+            Some(o) => Some(std::sync::Arc::new(ShadowTargets::new(
+                device,
+                &o,
+                &self.shadow_layout,
+            )?)),
+            None => None,
+        };
+        self.share_shadows(device, targets);
+        Ok(())
+    }
+
+    /// Cast into and read `targets`, maps another renderer made (the quad stream's, so that
+    /// the hybrid's two forms share them), or stop (`None`). Only the quad stream's passes
+    /// then draw into them: see [`forest_render::shadow_maps::Caster`].
+    pub fn share_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        targets: Option<std::sync::Arc<ShadowTargets>>,
+    ) {
+        let same = |s: &Option<super::light::LightViews>, t: &std::sync::Arc<ShadowTargets>| {
+            s.as_ref()
+                .is_some_and(|s| std::sync::Arc::ptr_eq(&s.targets, t))
+        };
+        match targets {
+            None => {
+                if let Some(s) = self.shadows.take() {
+                    self.parked = Some(s);
+                }
+            }
+            Some(t) if same(&self.shadows, &t) => {}
+            Some(t) if same(&self.parked, &t) => {
+                std::mem::swap(&mut self.shadows, &mut self.parked);
+            }
+            Some(t) => {
+                self.parked = self.shadows.take();
+                self.shadows = Some(super::light::LightViews::new(device, &self.shared, t));
+            }
+        }
+    }
+
+    /// Whether shadows are on.
+    pub fn shadows(&self) -> bool {
+        self.shadows.is_some()
+    }
+
+    /// The shadow maps' passes of a frame when shadows are on: each cascade's cull, then its
+    /// trees drawn depth-only into its layer (after [`Self::set_camera`]).
+    pub fn encode_shadows(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(lv) = &self.shadows {
+            for k in 0..lv.views.len() {
+                self.encode_light(encoder, k);
+                let mut pass = lv.targets.begin_cascade(encoder, k, None);
+                self.record_light(&mut pass, k);
+            }
+        }
     }
 
     /// Write the camera from the host's matrices (as `QuadStream::prepare`); then
@@ -572,7 +763,18 @@ impl GeometryRenderer {
         if let Some(q) = self.counting() {
             pass.begin_pipeline_statistics_query(&q.set, work::CULL);
         }
-        pass.set_bind_group(0, &self.compute_bg, &[]);
+        self.record_cull(&mut pass, &self.compute_bg);
+        if let Some(q) = self.counting() {
+            pass.end_pipeline_statistics_query();
+            // No refine pass: its query is written empty, so every query is resolved.
+            pass.begin_pipeline_statistics_query(&q.set, work::REFINE);
+            pass.end_pipeline_statistics_query();
+        }
+    }
+
+    /// The four cull dispatches of a view (its compute group `group`).
+    fn record_cull(&self, pass: &mut wgpu::ComputePass, group: &wgpu::BindGroup) {
+        pass.set_bind_group(0, group, &[]);
         let segments = BANDS * self.species;
         pass.set_pipeline(&self.reset);
         pass.dispatch_workgroups(segments.div_ceil(RESET_WG).max(1), 1, 1);
@@ -590,12 +792,6 @@ impl GeometryRenderer {
             1,
             1,
         );
-        if let Some(q) = self.counting() {
-            pass.end_pipeline_statistics_query();
-            // No refine pass: its query is written empty, so every query is resolved.
-            pass.begin_pipeline_statistics_query(&q.set, work::REFINE);
-            pass.end_pipeline_statistics_query();
-        }
     }
 
     /// Count the trees' fragments into `counter` from the next frame on
@@ -610,7 +806,11 @@ impl GeometryRenderer {
             let counts = forest_render::fragments::bind_layout(device);
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("counted geometry draw"),
-                bind_group_layouts: &[Some(&self.draw_layout), Some(&counts)],
+                bind_group_layouts: &[
+                    Some(&self.draw_layout),
+                    Some(&counts),
+                    Some(&self.shadow_layout),
+                ],
                 immediate_size: 0,
             });
             let source =
@@ -644,6 +844,13 @@ impl GeometryRenderer {
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
         let ground = ground && self.background == Background::Sky;
         pass.set_bind_group(0, &self.draw_bg, &[]);
+        pass.set_bind_group(
+            2,
+            self.shadows
+                .as_ref()
+                .map_or(&self.no_shadows, |s| s.targets.receivers()),
+            &[],
+        );
         let environment = if ground {
             self.terrain
                 .record_ground(pass, &self.environment, &self.terrain_pipeline)
@@ -661,6 +868,24 @@ impl GeometryRenderer {
             }
             _ => [&self.draw, &self.billboard],
         };
+        self.record_bands(pass, &self.args, [draw, billboard]);
+        if self.counting().is_some() {
+            pass.end_pipeline_statistics_query();
+        }
+        self.draws.store(
+            BANDS * self.species + environment,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+    }
+
+    /// Draw every band × species segment of a view's `args`, nearest band first, meshes with
+    /// `pipelines[0]` and billboards with `pipelines[1]`.
+    fn record_bands(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        args: &wgpu::Buffer,
+        [draw, billboard]: [&wgpu::RenderPipeline; 2],
+    ) {
         let first_billboard = self.method.first_billboard_band();
         for band in 0..BANDS {
             if band == 0 {
@@ -670,16 +895,9 @@ impl GeometryRenderer {
                 pass.set_pipeline(billboard);
             }
             for s in 0..self.species {
-                pass.draw_indirect(&self.args, u64::from(band * self.species + s) * 16);
+                pass.draw_indirect(args, u64::from(band * self.species + s) * 16);
             }
         }
-        if self.counting().is_some() {
-            pass.end_pipeline_statistics_query();
-        }
-        self.draws.store(
-            BANDS * self.species + environment,
-            std::sync::atomic::Ordering::Relaxed,
-        );
     }
 
     /// Resolve the frame's pass times: the cull pass's, and the draw pass's when `draw` (the
@@ -785,8 +1003,32 @@ impl GeometryRenderer {
             passes: statistics
                 .filter(|_| self.count_work)
                 .and_then(work::decode),
-            bytes: self.gpu_bytes,
+            bytes: self.gpu_bytes + self.shadows.as_ref().map_or(0, |s| s.bytes()),
         };
         stats
+    }
+}
+
+impl forest_render::shadow_maps::Caster for GeometryRenderer {
+    /// Copy cascade `k`'s light camera into its light view and classify its trees.
+    fn encode_light(&self, encoder: &mut wgpu::CommandEncoder, k: usize) {
+        let Some(lv) = &self.shadows else { return };
+        let size = std::mem::size_of::<GpuCamera>() as u64;
+        let view = &lv.views[k];
+        encoder.copy_buffer_to_buffer(&self.camera, size * (k as u64 + 1), &view.camera, 0, size);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("geometry light view"),
+            timestamp_writes: None,
+        });
+        self.record_cull(&mut pass, &view.compute_bg);
+    }
+
+    /// Draw cascade `k`'s trees depth-only.
+    fn record_light(&self, pass: &mut wgpu::RenderPass, k: usize) {
+        let Some(lv) = &self.shadows else { return };
+        let view = &lv.views[k];
+        pass.set_bind_group(0, &view.draw_bg, &[]);
+        let [a, b] = &lv.cast;
+        self.record_bands(pass, &view.args, [a, b]);
     }
 }

@@ -10,6 +10,7 @@ mod lighting;
 mod path;
 mod report;
 mod shadowing;
+mod shadows;
 mod stability;
 mod storage;
 mod table1;
@@ -33,10 +34,11 @@ use forest_render::work::FrameWork;
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 
 /// The suites, in the order `all` runs them.
-pub const SUITES: [&str; 9] = [
+pub const SUITES: [&str; 10] = [
     "storage",
     "shadowing",
     "lighting",
+    "shadows",
     "table1",
     "path",
     "accuracy",
@@ -48,12 +50,12 @@ pub const SUITES: [&str; 9] = [
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Suite: storage, shadowing, lighting, table1, path, accuracy, stability, budget,
-    /// fidelity, or all. Every run
+    /// Suite: storage, shadowing, lighting, shadows, table1, path, accuracy, stability,
+    /// budget, fidelity, or all. Every run
     /// updates REPORT.md with the sections of all suites run into the results folder so far.
     #[arg(value_parser = [
-        "storage", "shadowing", "lighting", "table1", "path", "accuracy", "stability", "budget",
-        "fidelity", "all",
+        "storage", "shadowing", "lighting", "shadows", "table1", "path", "accuracy", "stability",
+        "budget", "fidelity", "all",
     ])]
     pub suite: String,
     /// Species atlases (comma-separated).
@@ -645,6 +647,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "storage" => storage::run(&b)?,
             "shadowing" => shadowing::run(&b)?,
             "lighting" => lighting::run(&b)?,
+            "shadows" => shadows::run(&b)?,
             "table1" => table1::run(&b)?,
             "path" => path::run(&b)?,
             "accuracy" if args.redraw => accuracy::redraw(&b)?,

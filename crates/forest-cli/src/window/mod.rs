@@ -114,6 +114,8 @@ pub struct Settings {
     /// The time of day the HUD starts at (hours, 6–18): `--time`, else noon. The light is
     /// the one the renderers were built with until the time is first changed.
     pub hour: f32,
+    /// The sun's shadows (`None`: off).
+    pub shadows: Option<forest_render::shadow::ShadowOptions>,
     /// A camera path to play from the start (P replays it).
     pub path: Option<CameraPath>,
     /// Where R saves a recorded path.
@@ -139,6 +141,7 @@ pub struct Viewer {
     hour: f32,
     /// Whether `hour` changed since the renderer's light was last set.
     hour_changed: bool,
+    shadows: Option<forest_render::shadow::ShadowOptions>,
     extent: f32,
     fov_deg: f32,
     methods: Vec<Method>,
@@ -198,6 +201,7 @@ impl Viewer {
             terrain: st.terrain,
             epsilon: st.epsilon,
             hour: st.hour.clamp(HOURS.0, HOURS.1),
+            shadows: st.shadows,
             hour_changed: false,
             extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),
@@ -304,6 +308,7 @@ impl Viewer {
             self.debug,
             (self.build_stream)(&ctx, format, self.sized.0, self.sized.1)?,
             (self.build_geometry)(&ctx, format)?,
+            self.shadows,
         )?;
         let egui = egui::Context::default();
         // egui bundles no font by default: the HUD uses the one the charts embed.
@@ -506,9 +511,11 @@ fn assemble(
     debug: DebugView,
     stream: QuadStream,
     geometry: Option<GeometryRenderer>,
+    shadows: Option<forest_render::shadow::ShadowOptions>,
 ) -> Result<ForestRenderer> {
     let mut r = ForestRenderer::new(stream, geometry);
     r.set_method(ctx, method)?;
+    r.set_shadows(&ctx.device, shadows)?;
     r.stream.set_debug_view(debug);
     Ok(r)
 }

@@ -25,6 +25,16 @@ pub fn atlases() -> &'static [Atlas] {
     })
 }
 
+/// Bush and pine baked with `params` (not cached); [`species_of`] decodes them.
+pub fn atlases_with(params: &BakeParams) -> Vec<Atlas> {
+    bake(params)
+}
+
+/// Decoded atlases, ready to upload.
+pub fn species_of(atlases: &[Atlas]) -> Vec<SpeciesData> {
+    atlases.iter().map(species_data).collect()
+}
+
 /// Bush and pine baked with `params`.
 fn bake(params: &BakeParams) -> Vec<Atlas> {
     ["bush", "pine"]
@@ -326,4 +336,32 @@ pub fn cleared_pass<'e>(
         occlusion_query_set: None,
         multiview_mask: None,
     })
+}
+
+/// Both forms of `species` (and their geometry, `prepared`) for `forest`: the quad stream and
+/// the geometry renderer behind one `ForestRenderer`, drawing `viewport` over `background`.
+pub fn forest_renderer(
+    ctx: &GpuContext,
+    species: &[SpeciesData],
+    prepared: &forest_baselines::geometry::PreparedGeometry,
+    forest: &Forest,
+    viewport: (u32, u32),
+    background: forest_render::options::Background,
+    atmosphere: forest_render::options::Atmosphere,
+) -> forest_baselines::methods::ForestRenderer {
+    let scene = forest_render::GpuScene::new(ctx, species, forest).unwrap();
+    let opts = forest_render::options::RendererOptions {
+        format: forest_render::target::TARGET_FORMAT,
+        viewport,
+        background,
+        atmosphere,
+        ..Default::default()
+    };
+    let geometry =
+        forest_baselines::geometry::GeometryRenderer::with_targets(ctx, prepared, forest, &opts)
+            .unwrap();
+    forest_baselines::methods::ForestRenderer::new(
+        forest_render::QuadStream::new(&ctx.device, scene, &opts).unwrap(),
+        Some(geometry),
+    )
 }

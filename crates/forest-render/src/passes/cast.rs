@@ -6,14 +6,71 @@ use super::draw::bind_entries;
 /// Depth format of the shadow maps.
 pub const SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// A casting pipeline: `entries` (vertex, fragment) of `module` drawing depth only into a
+/// shadow map ([`SHADOW_FORMAT`], nearest wins), no face culling. The quad stream's and the
+/// geometry renderer's casting pipelines are all built here.
+pub fn cast_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    topology: wgpu::PrimitiveTopology,
+    entries: [&str; 2],
+) -> wgpu::RenderPipeline {
+    cast_pipeline_into(
+        device,
+        layout,
+        module,
+        topology,
+        entries,
+        (SHADOW_FORMAT, wgpu::CompareFunction::Less),
+    )
+}
+
+/// [`cast_pipeline`] into a host's map: its depth format and its test (less for standard
+/// depth, greater for reverse-Z).
+pub fn cast_pipeline_into(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    topology: wgpu::PrimitiveTopology,
+    [vs, fs]: [&str; 2],
+    (format, compare): (wgpu::TextureFormat, wgpu::CompareFunction),
+) -> wgpu::RenderPipeline {
+    super::draw::render_pipeline(
+        device,
+        layout,
+        module,
+        topology,
+        [vs, fs],
+        wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        },
+        Default::default(),
+        &[],
+    )
+}
+
 /// The casting pipeline (built once per set of shadow maps).
 pub struct CastPass {
     pipeline: wgpu::RenderPipeline,
 }
 
 impl CastPass {
-    /// The pipeline over the draw pass's group 0 (a light-view stream's draw bind group).
+    /// The pipeline over the draw pass's group 0 (a light-view stream's draw bind group),
+    /// into the forest's own maps.
     pub fn new(device: &wgpu::Device) -> Self {
+        Self::into(device, (SHADOW_FORMAT, wgpu::CompareFunction::Less))
+    }
+
+    /// The pipeline into maps of depth `format` tested with `compare` (a host's).
+    pub fn into(
+        device: &wgpu::Device,
+        depth: (wgpu::TextureFormat, wgpu::CompareFunction),
+    ) -> Self {
         let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cast"),
             entries: &bind_entries(),
@@ -28,37 +85,14 @@ impl CastPass {
             label: Some("cast"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("cast"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_cast"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleStrip,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: SHADOW_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_cast"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = cast_pipeline_into(
+            device,
+            &layout,
+            &module,
+            wgpu::PrimitiveTopology::TriangleStrip,
+            ["vs_cast", "fs_cast"],
+            depth,
+        );
         Self { pipeline }
     }
 

@@ -295,6 +295,35 @@ pub fn draw_pipeline(
     blend: Option<wgpu::BlendState>,
     depth_write: bool,
 ) -> wgpu::RenderPipeline {
+    render_pipeline(
+        device,
+        layout,
+        module,
+        topology,
+        [vs, fs],
+        opts.depth_stencil(depth_write),
+        opts.multisample(),
+        &[Some(wgpu::ColorTargetState {
+            format: opts.format,
+            blend,
+            write_mask: wgpu::ColorWrites::ALL,
+        })],
+    )
+}
+
+/// A pipeline of `entries` (vertex, fragment) of `module` with no vertex buffers and no face
+/// culling, into `targets` and the depth `depth` (every draw and casting pipeline).
+#[allow(clippy::too_many_arguments)]
+pub fn render_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    topology: wgpu::PrimitiveTopology,
+    [vs, fs]: [&str; 2],
+    depth: wgpu::DepthStencilState,
+    multisample: wgpu::MultisampleState,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(vs),
         layout: Some(layout),
@@ -309,17 +338,13 @@ pub fn draw_pipeline(
             cull_mode: None,
             ..Default::default()
         },
-        depth_stencil: Some(opts.depth_stencil(depth_write)),
-        multisample: opts.multisample(),
+        depth_stencil: Some(depth),
+        multisample,
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(fs),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format: opts.format,
-                blend,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
+            targets,
         }),
         multiview_mask: None,
         cache: None,

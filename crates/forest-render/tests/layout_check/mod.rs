@@ -67,6 +67,7 @@ pub fn shared() -> Vec<Expect> {
                 ("shadow_texel", offset_of!(GpuCamera, shadow_texel)),
                 ("shadow_bias", offset_of!(GpuCamera, shadow_bias)),
                 ("shadow_params", offset_of!(GpuCamera, shadow_params)),
+                ("form_eye", offset_of!(GpuCamera, form_eye)),
             ],
         ),
         (
