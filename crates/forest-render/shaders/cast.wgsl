@@ -1,6 +1,6 @@
-// The light views' casting pass (appended to the draw module): a light-view stream's plain
-// quads (its camera asks for no composited far trees) as depth only into one cascade's layer
-// of the shadow map. Each quad lies on its plane, as in the draw. A fragment is kept where the
+// The light views' casting pass (appended to the draw module): a light-view stream's quads as
+// depth only into one cascade's layer of the shadow map: far trees' composited quads
+// (vs_cast_composite, fs_cast_composite), then the plain ones (vs_cast, fs_cast). Each quad lies on its plane, as in the draw. A fragment is kept where the
 // slab image's coverage exceeds an ordered-dither threshold (a screen door: a texel of
 // coverage a casts in a share a of the map's texels, which the receivers' filter averages
 // back into a shadow of strength a), and a tree's aspects combine as the draw combines them:
@@ -46,4 +46,31 @@ fn fs_cast(in: CastOut) {
         let door = (f32(dither_threshold(in.clip.yx, salt)) + 0.5) / f32(WEIGHT_ONE);
         if (a * alpha <= door) { discard; }
     }
+}
+
+// A far tree's composited quad: its slabs' coverage "over" each other along the light's
+// parallax (as fs_composite composites them), through the same coverage door.
+@vertex
+fn vs_cast_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32)
+    -> CompositeOut {
+    let v = quad_vertex(vi, qi, false);
+    return CompositeOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right,
+                        v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back, v.species,
+                        v.sphere, v.sun_obj, v.tree);
+}
+
+@fragment
+fn fs_cast_composite(in: CompositeOut) {
+    var a = 0.0;
+    for (var k = 0u; k < in.ids.w; k++) {
+        let uv = slab_uv(in, k);
+        let b = textureSampleLevel(colour, colour_sampler, uv, in.ids.x + k, in.depths.w).a;
+        a = a + b * inside_image(uv) * (1.0 - a);
+    }
+    if (in.share.w < WEIGHT_ONE && form_threshold(in.clip.xy, in.share.z) >= in.share.w) {
+        discard;
+    }
+    let door = (f32(dither_threshold(in.clip.yx, in.share.z ^ 0x27d4eb2du)) + 0.5)
+        / f32(WEIGHT_ONE);
+    if (a <= door) { discard; }
 }

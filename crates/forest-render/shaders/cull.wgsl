@@ -114,8 +114,12 @@ fn far_tree(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> bool {
     if ((stream_flags(camera) & FLAG_FAR_BLEND) != 0u) { return false; }
     let m = camera.view_proj;
     // The nearest a level-0 quad's corner can be: the slab squares' corners lie within
-    // √3 r of the centre.
-    let w = m[0].w * c.x + m[1].w * c.y + m[2].w * c.z + m[3].w - SQRT3 * r;
+    // √3 r of the centre. An orthographic view (a light's: no row of w depends on the point)
+    // sees every point at its one scale.
+    var w = m[3].w;
+    if (m[0].w != 0.0 || m[1].w != 0.0 || m[2].w != 0.0) {
+        w = m[0].w * c.x + m[1].w * c.y + m[2].w * c.z + m[3].w - SQRT3 * r;
+    }
     if (w <= 0.0) { return false; }
     let fy = m[0].y * m[0].y + m[1].y * m[1].y + m[2].y * m[2].y;
     let half = camera.viewport.y * 0.5;

@@ -119,7 +119,11 @@ fn far_tree(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> bool {
         return false;
     }
     let m = &cam.view_proj;
-    let w = m[0][3] * c.x + m[1][3] * c.y + m[2][3] * c.z + m[3][3] - SQRT3 * r;
+    let w = if m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 {
+        m[0][3] * c.x + m[1][3] * c.y + m[2][3] * c.z + m[3][3] - SQRT3 * r
+    } else {
+        m[3][3]
+    };
     if w <= 0.0 {
         return false;
     }

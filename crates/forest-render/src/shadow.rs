@@ -314,7 +314,7 @@ impl LightParams {
 
     /// The light camera a stream casts with: the host's matrix, the eye far along the light
     /// from the middle of the light's box (so every tree is seen from the light's direction),
-    /// ε in texels, forms chosen from the view's eye, no composited far trees.
+    /// ε in texels, forms chosen from the view's eye, far trees as the stream's options say.
     pub fn camera(&self, stream: crate::options::StreamOptions) -> GpuCamera {
         let inv = self.view_proj.inverse();
         let centre = inv.project_point3(Vec3::new(0.0, 0.0, 0.5));
@@ -335,11 +335,7 @@ impl LightParams {
             self.resolution,
             self.epsilon,
         );
-        crate::options::StreamOptions {
-            far_nearest: false,
-            ..stream
-        }
-        .apply(&mut g);
+        stream.apply(&mut g);
         g.form_eye = self.view_eye.extend(0.0).to_array();
         g
     }
@@ -347,8 +343,8 @@ impl LightParams {
 
 /// The camera a cascade's light-view stream culls, refines and draws with: the cascade's
 /// matrix, the eye far along the sun (so every tree is seen from the sun's direction and
-/// picks its aspects by it), ε in texels, and the stream's options with far trees left to
-/// the plain stream (no composited quads: the casting pipeline draws plain quads).
+/// picks its aspects by it), ε in texels, and the stream's options (far trees, narrower than
+/// the far span in texels, cast as one composited quad of their nearest aspect).
 pub fn light_camera(
     c: &Cascade,
     sun: Vec3,
@@ -365,11 +361,7 @@ pub fn light_camera(
         (opts.resolution, opts.resolution),
         opts.epsilon,
     );
-    crate::options::StreamOptions {
-        far_nearest: false,
-        ..stream
-    }
-    .apply(&mut g);
+    stream.apply(&mut g);
     g
 }
 
@@ -537,7 +529,10 @@ mod tests {
         assert!((eye - cascades[0].centre).normalize().dot(sun) > 0.999_999);
         assert_eq!(g.viewport[0], opts.resolution as f32);
         assert_eq!(g.eye[3], opts.epsilon);
-        assert_ne!(g.viewport[3] as u32 & crate::options::FLAG_FAR_BLEND, 0);
+        assert_eq!(
+            g.viewport[3] as u32,
+            crate::options::StreamOptions::default().flags()
+        );
     }
 
     #[test]

@@ -350,6 +350,26 @@ impl ShadowMaps {
         self.streams.iter().map(|s| s.read_stats(ctx)).collect()
     }
 
+    /// Each cascade's counters of a recent frame without waiting (`None` until one arrives),
+    /// growing a light-view stream whose frame overflowed for the frames after (a frame
+    /// loop's [`Self::fit`]).
+    pub fn poll(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<Vec<Option<FrameStats>>, RenderError> {
+        self.streams
+            .iter_mut()
+            .map(|s| {
+                let stats = s.poll_stats(device, queue);
+                if let Some(st) = &stats {
+                    s.fit(device, st)?;
+                }
+                Ok(stats)
+            })
+            .collect()
+    }
+
     /// Grow every light-view stream whose last frame overflowed (see [`QuadStream::fit`]);
     /// whether any grew (the frame should then be drawn again).
     pub fn fit(&mut self, ctx: &crate::GpuContext) -> Result<bool, RenderError> {

@@ -430,6 +430,11 @@ impl QuadStream {
         self.shadows.as_ref()
     }
 
+    /// The shadow maps, when shadows are on (to poll and grow their light views).
+    pub fn shadows_mut(&mut self) -> Option<&mut crate::shadow_maps::ShadowMaps> {
+        self.shadows.as_mut()
+    }
+
     /// The camera buffer (a light-view stream's is filled by copies, see
     /// [`crate::shadow_maps`]).
     pub(crate) fn camera_buffer(&self) -> &wgpu::Buffer {

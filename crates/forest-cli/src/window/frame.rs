@@ -135,6 +135,19 @@ impl Viewer {
                 g.renderer.fit(&g.ctx.device, &stats)?;
                 self.stats = stats;
             }
+            // The shadow cascades' light views likewise (the HUD shows their work).
+            match g.renderer.stream.shadows_mut() {
+                Some(sh) => {
+                    let polled = sh.poll(&g.ctx.device, &g.ctx.queue)?;
+                    self.shadow_stats.resize(polled.len(), Default::default());
+                    for (k, s) in polled.into_iter().enumerate() {
+                        if let Some(s) = s {
+                            self.shadow_stats[k] = s;
+                        }
+                    }
+                }
+                None => self.shadow_stats.clear(),
+            }
             g.ctx.check_reported_errors()?;
             if self.first_frame {
                 self.first_frame = false;

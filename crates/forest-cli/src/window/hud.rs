@@ -70,6 +70,20 @@ impl Viewer {
                     w.draws,
                     w.bytes as f64 / 1e6
                 ));
+                if !self.shadow_stats.is_empty() {
+                    let c = &self.shadow_stats;
+                    let join = |f: &dyn Fn(&forest_render::FrameStats) -> String| {
+                        c.iter().map(f).collect::<Vec<_>>().join(" / ")
+                    };
+                    ui.label(format!(
+                        "shadows, {} cascades: quads {}; cull + refine + cast {} ms",
+                        c.len(),
+                        join(&|s| s.quads.to_string()),
+                        join(&|s| s.times.map_or("?".into(), |t| {
+                            format!("{:.1}", t.cull_ms + t.refine_ms + t.draw_ms)
+                        })),
+                    ));
+                }
                 if !s.per_level.is_empty() {
                     let levels: Vec<String> = s
                         .per_level

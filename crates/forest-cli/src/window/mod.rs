@@ -160,6 +160,8 @@ pub struct Viewer {
     last: Instant,
     frame_ms: f64,
     stats: MethodStats,
+    /// Each shadow cascade's light-view counters (the quad stream's), while shadows are on.
+    shadow_stats: Vec<forest_render::FrameStats>,
     recording: Option<CameraPath>,
     record_to: PathBuf,
     shots: u32,
@@ -219,6 +221,7 @@ impl Viewer {
             last: Instant::now(),
             frame_ms: 0.0,
             stats: MethodStats::default(),
+            shadow_stats: Vec::new(),
             recording: None,
             record_to: st.record_to,
             shots: 0,

@@ -5,6 +5,12 @@
 //! Per frame: the host writes its own uniform, `QuadStream::prepare` writes the forest's camera
 //! (its one upload), `encode_compute` records cull and refine, and the host's own render pass
 //! draws the ground and then `render`s the trees into it.
+//!
+//! With its sun's shadows on, the host owns a reverse-Z shadow map (one cascade around the
+//! view, fitted with the library's `fit_cascades`): a second stream casts the forest into it
+//! (`prepare_light`, `encode_compute`, `render_depth` in the host's depth-only pass), the
+//! host's ground reads it, and the forest's trees receive it (`receive_host_shadows`,
+//! `set_host_cascades`).
 
 use std::sync::Arc;
 
@@ -19,8 +25,15 @@ pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The host's ground: a square around the eye, soil and moss in the library's pattern
 /// (`ground_moss` from [`forest_render::passes::GROUND_WGSL`], prepended).
 const HOST_GROUND_WGSL: &str = r#"
-struct Host { view_proj: mat4x4<f32>, colour: vec4<f32>, moss: vec4<f32>, eye: vec4<f32> }
+struct Host {
+    view_proj: mat4x4<f32>, colour: vec4<f32>, moss: vec4<f32>, eye: vec4<f32>,
+    // The sun's shadow map (reverse-Z): its matrix, the shadowed soil and moss, and in
+    // `shade.x` 1 when the map is in use.
+    shadow: mat4x4<f32>, soil_shadowed: vec4<f32>, moss_shadowed: vec4<f32>, shade: vec4<f32>,
+}
 @group(0) @binding(0) var<uniform> host: Host;
+@group(0) @binding(1) var shadow_map: texture_depth_2d_array;
+@group(0) @binding(2) var shadow_compare: sampler_comparison;
 struct Out { @builtin(position) clip: vec4<f32>, @location(0) xz: vec2<f32> }
 
 @vertex
@@ -33,12 +46,24 @@ fn vs(@builtin(vertex_index) vi: u32) -> Out {
 
 @fragment
 fn fs(in: Out) -> @location(0) vec4<f32> {
-    return vec4<f32>(mix(host.colour.xyz, host.moss.xyz, ground_moss(in.xz)), 1.0);
+    let m = ground_moss(in.xz);
+    let lit = mix(host.colour.xyz, host.moss.xyz, m);
+    var sun = 1.0;
+    if (host.shade.x != 0.0) {
+        let c = host.shadow * vec4<f32>(in.xz.x, 0.0, in.xz.y, 1.0);
+        let uv = vec2<f32>(0.5 + 0.5 * c.x, 0.5 - 0.5 * c.y);
+        if (all(uv > vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0))) {
+            sun = textureSampleCompareLevel(shadow_map, shadow_compare, uv, 0, c.z + 1e-4);
+        }
+    }
+    let shadowed = mix(host.soil_shadowed.xyz, host.moss_shadowed.xyz, m);
+    return vec4<f32>(mix(shadowed, lit, sun), 1.0);
 }
 "#;
 
 /// The host's uniform: its view-projection, the ground's soil colour and half side, its moss
-/// colour, the eye.
+/// colour, the eye; its shadow map's matrix, the soil and moss in shadow, and whether the map
+/// is in use.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct HostUniform {
@@ -46,6 +71,30 @@ struct HostUniform {
     colour: [f32; 4],
     moss: [f32; 4],
     eye: [f32; 4],
+    shadow: [[f32; 4]; 4],
+    soil_shadowed: [f32; 4],
+    moss_shadowed: [f32; 4],
+    shade: [f32; 4],
+}
+
+/// Side of the host's shadow map (texels).
+const SHADOW_SIZE: u32 = 1024;
+
+/// The host's sun shadow map: one reverse-Z layer, and the stream that casts the forest into it.
+struct Sun {
+    layer: wgpu::TextureView,
+    caster: QuadStream,
+    options: forest_render::shadow::ShadowOptions,
+}
+
+/// World → clip with depth 1 − z: reverse-Z.
+fn reverse_z(m: Mat4) -> Mat4 {
+    Mat4::from_cols(
+        glam::Vec4::X,
+        glam::Vec4::Y,
+        glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+    ) * m
 }
 
 /// A host renderer: sky (its clear colour), ground (its own pipeline), then the forest.
@@ -55,7 +104,10 @@ pub struct Host {
     bind: wgpu::BindGroup,
     ground_colour: [f32; 4],
     moss_colour: [f32; 4],
+    soil_shadowed: [f32; 4],
+    moss_shadowed: [f32; 4],
     depth: wgpu::TextureView,
+    sun: Option<Sun>,
     /// The forest of this view.
     pub forest: QuadStream,
 }
@@ -99,13 +151,15 @@ fn depth_view(device: &wgpu::Device, size: (u32, u32)) -> wgpu::TextureView {
 
 impl Host {
     /// The host's pipelines and a forest stream over `scene` for `format` targets of `size`,
-    /// refined down to `min_epsilon` pixels at most (both size the stream).
+    /// refined down to `min_epsilon` pixels at most (both size the stream); with `shadows`,
+    /// the host's sun shadow map, which the forest casts into and receives.
     pub fn new(
         device: &wgpu::Device,
         scene: Arc<GpuScene>,
         format: wgpu::TextureFormat,
         size: (u32, u32),
         min_epsilon: f32,
+        shadows: bool,
     ) -> Result<Self, RenderError> {
         let opts = RendererOptions {
             format,
@@ -123,7 +177,66 @@ impl Host {
             .shade(GROUND_MOSS, Vec3::Y, 1.0, 1.0, 0.0)
             .extend(0.0)
             .to_array();
-        let forest = QuadStream::new(device, scene, &opts)?;
+        let mut forest = QuadStream::new(device, scene.clone(), &opts)?;
+        let map = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("host shadow map"),
+            size: wgpu::Extent3d {
+                width: if shadows { SHADOW_SIZE } else { 1 },
+                height: if shadows { SHADOW_SIZE } else { 1 },
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let array = map.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let sun = if shadows {
+            forest.receive_host_shadows(device, Some((&array, SHADOW_SIZE, true)));
+            let options = forest_render::shadow::ShadowOptions {
+                cascades: 1,
+                resolution: SHADOW_SIZE,
+                distance: 120.0,
+                ..Default::default()
+            };
+            // The caster draws into the host's map: its depth format and convention.
+            let caster = QuadStream::new(
+                device,
+                scene,
+                &RendererOptions {
+                    depth_format: DEPTH,
+                    reverse_z: true,
+                    viewport: (SHADOW_SIZE, SHADOW_SIZE),
+                    min_epsilon: options.epsilon,
+                    overdraw: 0.25,
+                    ..Default::default()
+                },
+            )?;
+            Some(Sun {
+                layer: map.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    ..Default::default()
+                }),
+                caster,
+                options,
+            })
+        } else {
+            None
+        };
+        // Soil and moss out of the sun (sky light alone).
+        let shadowed = |albedo| {
+            opts.lighting
+                .shade(albedo, Vec3::Y, 0.0, 1.0, 0.0)
+                .extend(0.0)
+                .to_array()
+        };
+        let soil_shadowed = shadowed(forest_render::options::GROUND_ALBEDO);
+        let moss_shadowed = shadowed(GROUND_MOSS);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("host ground"),
             source: wgpu::ShaderSource::Wgsl(
@@ -169,16 +282,37 @@ impl Host {
                 colour: ground_colour,
                 moss: moss_colour,
                 eye: [0.0; 4],
+                shadow: Mat4::IDENTITY.to_cols_array_2d(),
+                soil_shadowed,
+                moss_shadowed,
+                shade: [0.0; 4],
             }),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let compare = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("host shadow compare"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::GreaterEqual),
+            ..Default::default()
         });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("host"),
             layout: &ground.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniform.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&array),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&compare),
+                },
+            ],
         });
         Ok(Self {
             ground,
@@ -186,7 +320,10 @@ impl Host {
             bind,
             ground_colour,
             moss_colour,
+            soil_shadowed,
+            moss_shadowed,
             depth: depth_view(device, size),
+            sun,
             forest,
         })
     }
@@ -207,15 +344,66 @@ impl Host {
         frame: &FrameParams,
     ) -> Result<(), RenderError> {
         let eye = frame.eye();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let mut shadow = (Mat4::IDENTITY, 0.0);
+        if let Some(sun) = &mut self.sun {
+            // The host's cascade (fitted as the forest fits its own), in reverse-Z.
+            let view = forest_render::shadow::ViewSlice {
+                view_proj: frame.proj * frame.view,
+                eye,
+                forward: frame.forward(),
+            };
+            let to_light = frame.light.sun_dir;
+            let cascades: Vec<_> =
+                forest_render::shadow::fit_cascades(&view, to_light, &sun.options)
+                    .into_iter()
+                    .map(|c| forest_render::shadow::Cascade {
+                        view_proj: reverse_z(c.view_proj),
+                        ..c
+                    })
+                    .collect();
+            let light = forest_render::shadow::LightParams {
+                view_proj: cascades[0].view_proj,
+                to_light,
+                resolution: (SHADOW_SIZE, SHADOW_SIZE),
+                epsilon: sun.options.epsilon,
+                view_eye: eye,
+            };
+            sun.caster.prepare_light(device, queue, &light)?;
+            sun.caster.encode_compute(&mut encoder);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("host shadow map"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &sun.layer,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            // The host's own casters would draw here too.
+            sun.caster.render_depth(&mut pass);
+            drop(pass);
+            self.forest.set_host_cascades(&cascades)?;
+            shadow = (cascades[0].view_proj, 1.0);
+        }
         let host = HostUniform {
             view_proj: (frame.proj * frame.view).to_cols_array_2d(),
             colour: self.ground_colour,
             moss: self.moss_colour,
             eye: eye.extend(1.0).to_array(),
+            shadow: shadow.0.to_cols_array_2d(),
+            soil_shadowed: self.soil_shadowed,
+            moss_shadowed: self.moss_shadowed,
+            shade: [shadow.1, 0.0, 0.0, 0.0],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&host));
         self.forest.prepare(queue, frame)?;
-        let mut encoder = device.create_command_encoder(&Default::default());
         self.forest.encode_compute(&mut encoder);
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -44,10 +44,23 @@ pub fn headless(
     size: (u32, u32),
     epsilon: f32,
 ) -> Result<image::RgbaImage, Error> {
+    headless_with(forest, eye, target, size, epsilon, false)
+}
+
+/// [`headless`], with the host's sun shadow map (the forest casting into it and receiving it)
+/// when `shadows`.
+pub fn headless_with(
+    forest: &Path,
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    epsilon: f32,
+    shadows: bool,
+) -> Result<image::RgbaImage, Error> {
     let ctx = GpuContext::headless()?;
     let scene = load(&ctx, forest)?;
     let out = Target::new(&ctx, size.0, size.1);
-    let mut host = host::Host::new(&ctx.device, scene, out.format, size, epsilon)?;
+    let mut host = host::Host::new(&ctx.device, scene, out.format, size, epsilon, shadows)?;
     let frame = host::frame(eye, target, size, epsilon);
     host.draw(&ctx.device, &ctx.queue, &out.colour_view, &frame)?;
     let img = out.read(&ctx);
@@ -61,6 +74,7 @@ struct App {
     target: Vec3,
     size: (u32, u32),
     epsilon: f32,
+    shadows: bool,
     start: std::time::Instant,
     gfx: Option<(
         Arc<Window>,
@@ -100,6 +114,7 @@ impl App {
             config.format,
             (config.width, config.height),
             self.epsilon,
+            self.shadows,
         )?;
         self.gfx = Some((window, surface, config, ctx, host));
         Ok(())
@@ -191,7 +206,7 @@ fn run() -> Result<(), Error> {
     let mut args = std::env::args().skip(1);
     let mut forest = None;
     let (mut eye, mut target) = (Vec3::new(0.0, 30.0, 60.0), Vec3::ZERO);
-    let (mut size, mut epsilon, mut headless_out) = ((960, 540), 4.0, None);
+    let (mut size, mut epsilon, mut headless_out, mut shadows) = ((960, 540), 4.0, None, false);
     while let Some(a) = args.next() {
         let mut value = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
@@ -199,6 +214,8 @@ fn run() -> Result<(), Error> {
             "--target" => target = vec3(&value()?)?,
             "--epsilon" => epsilon = value()?.parse()?,
             "--headless" => headless_out = Some(PathBuf::from(value()?)),
+            // The host's sun shadow map, which the forest casts into and receives.
+            "--shadows" => shadows = true,
             "--size" => {
                 let v = value()?;
                 let (w, h) = v.split_once('x').ok_or(format!("{v:?} is not WxH"))?;
@@ -208,9 +225,10 @@ fn run() -> Result<(), Error> {
             _ => return Err(format!("unexpected argument {a:?}").into()),
         }
     }
-    let forest = forest.ok_or("usage: embed FOREST [--headless OUT.png] [--eye X,Y,Z] …")?;
+    let forest =
+        forest.ok_or("usage: embed FOREST [--headless OUT.png] [--shadows] [--eye X,Y,Z] …")?;
     if let Some(out) = headless_out {
-        headless(&forest, eye, target, size, epsilon)?.save(&out)?;
+        headless_with(&forest, eye, target, size, epsilon, shadows)?.save(&out)?;
         println!("wrote {}", out.display());
         return Ok(());
     }
@@ -220,6 +238,7 @@ fn run() -> Result<(), Error> {
         target,
         size,
         epsilon,
+        shadows,
         start: std::time::Instant::now(),
         gfx: None,
         error: None,

@@ -56,7 +56,9 @@ pub fn cast_pipeline_into(
 
 /// The casting pipeline (built once per set of shadow maps).
 pub struct CastPass {
-    pipeline: wgpu::RenderPipeline,
+    /// Far trees' composited quads (drawn first).
+    composite: wgpu::RenderPipeline,
+    quads: wgpu::RenderPipeline,
 }
 
 impl CastPass {
@@ -85,27 +87,34 @@ impl CastPass {
             label: Some("cast"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let pipeline = cast_pipeline_into(
-            device,
-            &layout,
-            &module,
-            wgpu::PrimitiveTopology::TriangleStrip,
-            ["vs_cast", "fs_cast"],
-            depth,
-        );
-        Self { pipeline }
+        let pipeline = |entries| {
+            cast_pipeline_into(
+                device,
+                &layout,
+                &module,
+                wgpu::PrimitiveTopology::TriangleStrip,
+                entries,
+                depth,
+            )
+        };
+        Self {
+            composite: pipeline(["vs_cast_composite", "fs_cast_composite"]),
+            quads: pipeline(["vs_cast", "fs_cast"]),
+        }
     }
 
-    /// Draw a light-view stream's plain quads (its draw group and indirect arguments) into
-    /// the pass's depth attachment.
+    /// Draw a light-view stream's quads (its draw group and indirect arguments) into the
+    /// pass's depth attachment: the composited far trees, then the plain quads.
     pub fn record(
         &self,
         pass: &mut wgpu::RenderPass,
         bind_group: &wgpu::BindGroup,
         args_buf: &wgpu::Buffer,
     ) {
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind_group, &[]);
+        pass.set_pipeline(&self.composite);
+        pass.draw_indirect(args_buf, super::args::DRAW_COMPOSITE);
+        pass.set_pipeline(&self.quads);
         pass.draw_indirect(args_buf, super::args::DRAW);
     }
 }
