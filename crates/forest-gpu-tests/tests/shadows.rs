@@ -415,21 +415,7 @@ fn a_hosts_reverse_z_shadow_map_gives_the_forests_own_shadows() {
             array_layer_count: Some(1),
             ..Default::default()
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host shadow map"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &layer,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = forest_render::shadow_maps::depth_pass(&mut encoder, &layer, 0.0, None);
         caster.render_depth(&mut pass);
     }
     ctx.queue.submit([encoder.finish()]);

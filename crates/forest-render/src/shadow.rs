@@ -327,15 +327,14 @@ impl LightParams {
         .iter()
         .map(|&(x, y, z)| inv.project_point3(Vec3::new(x, y, z)).distance(centre))
         .fold(1.0f32, f32::max);
-        let to_light = self.to_light.normalize_or(Vec3::Y);
-        let mut g = crate::frame::gpu_camera(
+        let mut g = towards(
             self.view_proj,
-            centre + to_light * (1e4 * reach),
-            -to_light,
+            (centre, reach),
+            self.to_light,
             self.resolution,
             self.epsilon,
+            stream,
         );
-        stream.apply(&mut g);
         g.form_eye = self.view_eye.extend(0.0).to_array();
         g
     }
@@ -351,15 +350,34 @@ pub fn light_camera(
     opts: &ShadowOptions,
     stream: crate::options::StreamOptions,
 ) -> GpuCamera {
-    let sun = sun.normalize_or(Vec3::Y);
-    // Far enough that the direction to any tree in the box is the sun's within 1e-4 rad.
-    let eye = c.centre + sun * (1e4 * (c.radius + opts.reach).max(1.0));
-    let mut g = crate::frame::gpu_camera(
+    towards(
         c.view_proj,
-        eye,
-        -sun,
+        (c.centre, (c.radius + opts.reach).max(1.0)),
+        sun,
         (opts.resolution, opts.resolution),
         opts.epsilon,
+        stream,
+    )
+}
+
+/// A light view's camera: matrix `view_proj`, the eye 10⁴ × `reach` along `to_light` from
+/// `centre` (far enough that the direction to any tree within `reach` of it is the light's
+/// within 1e-4 rad), ε in texels, the stream's options.
+fn towards(
+    view_proj: Mat4,
+    (centre, reach): (Vec3, f32),
+    to_light: Vec3,
+    resolution: (u32, u32),
+    epsilon: f32,
+    stream: crate::options::StreamOptions,
+) -> GpuCamera {
+    let to_light = to_light.normalize_or(Vec3::Y);
+    let mut g = crate::frame::gpu_camera(
+        view_proj,
+        centre + to_light * (1e4 * reach),
+        -to_light,
+        resolution,
+        epsilon,
     );
     stream.apply(&mut g);
     g

@@ -371,21 +371,8 @@ impl Host {
             };
             sun.caster.prepare_light(device, queue, &light)?;
             sun.caster.encode_compute(&mut encoder);
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("host shadow map"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &sun.layer,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass =
+                forest_render::shadow_maps::depth_pass(&mut encoder, &sun.layer, 0.0, None);
             // The host's own casters would draw here too.
             sun.caster.render_depth(&mut pass);
             drop(pass);
