@@ -175,25 +175,47 @@ def write_ply(path, pos, uv, nrm):
         f.write(faces.tobytes())
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("model")
+def view_arguments(ap, size, spp, cuts):
+    """The arguments both Mitsuba scripts take: the sun, the camera, samples and alpha cuts."""
     ap.add_argument("--sun", required=True, help="AZ,EL degrees")
     ap.add_argument("--eye", required=True)
     ap.add_argument("--target", required=True)
     ap.add_argument("--fov", type=float, default=60.0)
-    ap.add_argument("--size", default="320x240")
-    ap.add_argument("--spp", type=int, default=64)
-    ap.add_argument("--cuts", type=int, default=48,
+    ap.add_argument("--size", default=size)
+    ap.add_argument("--spp", type=int, default=spp)
+    ap.add_argument("--cuts", type=int, default=cuts,
                     help="sub-triangles per edge of an alpha-tested triangle")
     ap.add_argument("-o", "--output", required=True, help="output stem (no extension)")
-    a = ap.parse_args()
-    mi.set_variant("scalar_rgb")
+
+
+def parse_view(a):
+    """The unit direction towards the sun (as forest_format::shading::sun_direction), its
+    elevation (radians), and the Mitsuba sensor of the parsed arguments `a`."""
     az, el = (math.radians(float(x)) for x in a.sun.split(","))
     sun_dir = [math.cos(el) * math.sin(az), math.sin(el), math.cos(el) * math.cos(az)]
     w, h = (int(x) for x in a.size.split("x"))
     eye = [float(x) for x in a.eye.split(",")]
     target = [float(x) for x in a.target.split(",")]
+    sensor = {
+        "type": "perspective",
+        "fov": a.fov,
+        "fov_axis": "y",
+        "near_clip": 0.05,
+        "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=target, up=[0, 1, 0]),
+        "film": {"type": "hdrfilm", "width": w, "height": h, "pixel_format": "rgba",
+                 "rfilter": {"type": "box"}},
+        "sampler": {"type": "independent", "sample_count": a.spp},
+    }
+    return sun_dir, el, sensor
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("model")
+    view_arguments(ap, "320x240", 64, 48)
+    a = ap.parse_args()
+    mi.set_variant("scalar_rgb")
+    sun_dir, _, sensor = parse_view(a)
     model_dir = os.path.dirname(os.path.abspath(a.model))
     with tempfile.TemporaryDirectory() as tmp:
         tris, mtllib = read_obj(a.model)
@@ -205,16 +227,7 @@ def main():
         scene = {
             "type": "scene",
             "integrator": {"type": "path", "max_depth": 2, "hide_emitters": True},
-            "sensor": {
-                "type": "perspective",
-                "fov": a.fov,
-                "fov_axis": "y",
-                "near_clip": 0.05,
-                "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=target, up=[0, 1, 0]),
-                "film": {"type": "hdrfilm", "width": w, "height": h, "pixel_format": "rgba",
-                         "rfilter": {"type": "box"}},
-                "sampler": {"type": "independent", "sample_count": a.spp},
-            },
+            "sensor": sensor,
         }
         for name, t in tris.items():
             m = mats.get(name, {"Kd": (0.5, 0.5, 0.5)})

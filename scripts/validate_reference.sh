@@ -8,17 +8,7 @@
 # `pip install mitsuba numpy pillow` (set PYTHON to that interpreter). About a minute.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PYTHON=${PYTHON:-python3}
-"$PYTHON" -c "import mitsuba, numpy, PIL" 2>/dev/null || {
-  echo "needs Mitsuba 3: pip install mitsuba numpy pillow (then PYTHON=that/python $0)" >&2
-  exit 1
-}
-# FOREST: a forest binary to use instead of building one.
-if [ -z "${FOREST:-}" ]; then
-  cargo build --release --locked -p forest-cli
-  FOREST=${CARGO_TARGET_DIR:-target}/release/forest
-fi
-forest=$FOREST
+source scripts/mitsuba_env.sh
 out=results/mitsuba
 mkdir -p "$out"
 work=$(mktemp -d)

@@ -36,6 +36,11 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
             return;
         }
     }
+    // In a light view, trees whose shadow cannot reach the view's receivers.
+    if (!casts_into(c, r)) {
+        keys[i] = NONE;
+        return;
+    }
     // Trees drawn as quads alone (the hybrid method) are not drawn here.
     if (quad_share(camera.forms, distance(camera.form_eye.xyz, c), sp.switch_unit * inst.scale, i)
         == WEIGHT_ONE) {

@@ -77,6 +77,28 @@ pub struct ForestRenderer {
     /// The geometry-based methods, when the species' models were prepared.
     pub geometry: Option<GeometryRenderer>,
     method: Method,
+    /// The shadows asked for ([`Self::set_shadows`]); the reference draws them finer.
+    shadows: Option<forest_render::shadow::ShadowOptions>,
+}
+
+/// How much finer the reference's shadow maps are than the other methods' (per side).
+pub const REFERENCE_SHADOW_SCALE: u32 = 2;
+
+/// The shadows `method` draws when `asked` are asked for: the reference's maps have
+/// [`REFERENCE_SHADOW_SCALE`] times the texels per side (up to the largest map), so that
+/// metrics measure every method's shadows against finer ones.
+pub fn shadows_for(
+    method: Method,
+    asked: Option<forest_render::shadow::ShadowOptions>,
+) -> Option<forest_render::shadow::ShadowOptions> {
+    asked.map(|mut o| {
+        if method == Method::Mesh(MeshMethod::Reference) {
+            o.resolution = (o.resolution * REFERENCE_SHADOW_SCALE)
+                .min(forest_render::shadow::RESOLUTION_RANGE.1)
+                .max(o.resolution);
+        }
+        o
+    })
 }
 
 impl ForestRenderer {
@@ -87,6 +109,7 @@ impl ForestRenderer {
             stream,
             geometry,
             method: Method::Quads,
+            shadows: None,
         }
     }
 
@@ -175,13 +198,27 @@ impl ForestRenderer {
 
     /// Cast and receive the sun's shadows with `opts` from the next frame on, or not
     /// (`None`), for every method: one set of maps, the quad stream's, which the geometry
-    /// renderer casts into and reads as well (so the hybrid's two forms share them).
+    /// renderer casts into and reads as well (so the hybrid's two forms share them). The
+    /// reference draws them in finer maps ([`shadows_for`]).
     pub fn set_shadows(
         &mut self,
         device: &wgpu::Device,
         opts: Option<forest_render::shadow::ShadowOptions>,
     ) -> Result<(), RenderError> {
-        self.stream.set_shadows(device, opts)?;
+        self.apply_shadows(device, self.method, opts)?;
+        self.shadows = opts;
+        Ok(())
+    }
+
+    /// Make the maps `method` draws with `asked` shadows, shared by both renderers.
+    fn apply_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        method: Method,
+        asked: Option<forest_render::shadow::ShadowOptions>,
+    ) -> Result<(), RenderError> {
+        self.stream
+            .set_shadows(device, shadows_for(method, asked))?;
         if let Some(g) = &mut self.geometry {
             g.share_shadows(device, self.stream.shadows().map(|s| s.targets().clone()));
         }
@@ -215,6 +252,9 @@ impl ForestRenderer {
         self.stream.set_forms(FORMS_QUADS);
         if let Some(g) = &mut self.geometry {
             g.set_forms(FORMS_GEOMETRY);
+        }
+        if shadows_for(method, self.shadows) != shadows_for(self.method, self.shadows) {
+            self.apply_shadows(&ctx.device, method, self.shadows)?;
         }
         self.method = method;
         Ok(())

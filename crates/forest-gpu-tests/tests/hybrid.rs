@@ -129,6 +129,71 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
 
+/// Casting into each cascade only the trees whose shadow can reach its slice of the view
+/// changes no pixel, for the quad stream, the hybrid and full geometry, and drops casters.
+#[test]
+fn culling_casters_by_their_receivers_changes_no_shadow() {
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    let mut r = renderer_in(
+        &ctx,
+        &forest,
+        (160, 120),
+        Background::Sky,
+        Atmosphere::CLEAR,
+    );
+    let (mut with, mut without) = (0, 0);
+    for method in [
+        Method::Quads,
+        hybrid_at(8.0),
+        Method::Mesh(MeshMethod::Full { depth_sort: true }),
+    ] {
+        for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
+            let mut shot = |cull: bool, trees: &mut u32| {
+                let opts = forest_render::shadow::ShadowOptions {
+                    resolution: 256,
+                    epsilon: 8.0,
+                    cull_casters: cull,
+                    ..Default::default()
+                };
+                r.set_shadows(&ctx.device, Some(opts)).unwrap();
+                r.set_method(&ctx, method).unwrap();
+                // Fitted: the light views grow to hold every caster, culled or not.
+                let target = Target::new(&ctx, cam.viewport.0, cam.viewport.1);
+                r.render_fitted(&ctx, &cam, &target).unwrap();
+                let img = target.read(&ctx);
+                let stats = r.stream.shadows().unwrap().stats(&ctx);
+                *trees += stats.iter().map(|s| s.visible_trees).sum::<u32>();
+                img
+            };
+            let culled = shot(true, &mut with);
+            let all = shot(false, &mut without);
+            if culled != all {
+                save(
+                    &format!("cull-casters-{name}"),
+                    &[("all", &all), ("culled", &culled)],
+                );
+                panic!("{name} {method:?}: culling casters changed the image");
+            }
+        }
+    }
+    assert!(
+        with < without,
+        "the cull kept {with} of {without} light-view trees"
+    );
+    // The reference casts into finer maps, and the others go back to theirs.
+    let side = |r: &ForestRenderer| r.stream.shadows().unwrap().options().resolution;
+    r.set_method(&ctx, Method::Mesh(MeshMethod::Reference))
+        .unwrap();
+    assert_eq!(
+        side(&r),
+        256 * forest_baselines::methods::REFERENCE_SHADOW_SCALE
+    );
+    r.set_method(&ctx, Method::Quads).unwrap();
+    assert_eq!(side(&r), 256);
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
 /// The tree's bounding sphere in the world (centre, crown radius) and its switch unit (times
 /// its scale), as the GPU computes them.
 fn tree_sphere(r: &ForestRenderer, instance: usize) -> (Vec3, f32, f32) {

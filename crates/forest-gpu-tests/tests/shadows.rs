@@ -28,7 +28,13 @@ fn light_view_streams_equal_the_cpu_reference() {
     let (mut compared, mut composites) = (0, 0);
     for (name, cam) in common::cameras(forest.extent()) {
         stream.render_frame(&ctx, &cam, &target).unwrap();
-        let light = cameras(&cam.to_gpu(), &stream.light(), &opts, stream.options());
+        let light = cameras(
+            &cam.to_gpu(),
+            &stream.light(),
+            &opts,
+            stream.options(),
+            stream.scene.terrain.floor,
+        );
         assert_eq!(light.len(), 1 + opts.cascades as usize);
         let sh = stream.shadows().unwrap();
         for (k, s) in sh.streams().iter().enumerate() {

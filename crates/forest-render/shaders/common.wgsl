@@ -42,6 +42,27 @@ struct Camera {
     // xyz: the eye whose distances choose each tree's form and level of detail (eye, except in
     // a light view: the eye of the view it casts for); w unused.
     form_eye: vec4<f32>,
+    // A light view's receiver region: planes (xyz·p + w >= 0 inside) of the view slice its
+    // map serves; x of caster_floor: the lowest receiver's height, y: the longest sweep
+    // (metres). All zero: every tree casts (casts_into, forest_render::shadow::caster_planes).
+    casters: array<vec4<f32>, 6>,
+    caster_floor: vec4<f32>,
+}
+
+// Whether a caster's bounding sphere (world centre `c`, radius `r`) can shadow the light
+// view's receiver region (camera.casters, camera.caster_floor): swept from `c` away from the
+// sun until its top is below the lowest receiver, or caster_floor.y metres at most, it stays
+// inside every plane; each plane's test is offset by the sweep's reach across it. A view
+// camera's zero planes pass every tree (forest_render::shadow::casts_into is the CPU mirror).
+fn casts_into(c: vec3<f32>, r: f32) -> bool {
+    let sun = camera.sun.xyz;
+    var sweep = camera.caster_floor.y;
+    if (sun.y > 1e-3) { sweep = min(sweep, max(c.y + r - camera.caster_floor.x, 0.0) / sun.y); }
+    for (var k = 0u; k < 6u; k++) {
+        let pl = camera.casters[k];
+        if (dot(pl.xyz, c) + pl.w + sweep * max(-dot(pl.xyz, sun), 0.0) < -r) { return false; }
+    }
+    return true;
 }
 
 // The project's one shading model (mirrors forest_format::shading::Lighting::shade): albedo

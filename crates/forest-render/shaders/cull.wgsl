@@ -89,7 +89,8 @@ fn instance_in_order(i: u32) -> u32 {
     return textureLoad(presort, vec2<u32>(idx % PRESORT_TEX_WIDTH, idx / PRESORT_TEX_WIDTH), 0).x;
 }
 
-// Whether the instance's bounding sphere touches the frustum.
+// Whether the instance's bounding sphere touches the frustum (and, in a light view, whether
+// its shadow can reach the view's receivers).
 fn visible(inst: Instance, sp: Species) -> bool {
     let c = to_world(inst, sp.sphere.xyz);
     let r = sp.sphere.w * inst.scale;
@@ -97,7 +98,7 @@ fn visible(inst: Instance, sp: Species) -> bool {
         let pl = camera.planes[k];
         if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) { return false; }
     }
-    return true;
+    return casts_into(c, r);
 }
 
 const SQRT3: f32 = 1.7320508;

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 
 /// The camera, the frame's light and its sun's shadow cascades: the only data written to the
-/// GPU per frame (624 bytes; a stream with shadows writes one per light view after it, in the
+/// GPU per frame (736 bytes; a stream with shadows writes one per light view after it, in the
 /// same write, see [`crate::shadow`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -50,6 +50,15 @@ pub struct GpuCamera {
     /// view's own eye, and in a light view the eye of the view it casts for, so that every
     /// tree casts with the form it is drawn in ([`crate::shadow::light_camera`]); `w` unused.
     pub form_eye: [f32; 4],
+    /// A light view's receiver region (see [`crate::shadow::caster_planes`]): planes
+    /// `n·p + d ≥ 0` of the view slice whose shadows this light view casts, unit normals. A
+    /// tree casts only when its bounding sphere, swept away from the sun (`sun`) down to
+    /// `caster_floor.x`, stays inside every one; all zero (a view camera, a host's light)
+    /// passes every tree.
+    pub casters: [[f32; 4]; 6],
+    /// `x`: the lowest receiver (world height, metres): no shadow falls below it; `y`: the
+    /// longest sweep (metres), whatever the sun's height; `z`, `w` unused.
+    pub caster_floor: [f32; 4],
 }
 
 impl GpuCamera {

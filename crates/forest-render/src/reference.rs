@@ -151,6 +151,7 @@ fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> bool {
     cam.planes
         .iter()
         .all(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] >= -r)
+        && crate::shadow::casts_into(cam, c, r)
 }
 
 /// Level-0 quads of one tree (see `tree_quads` in `shaders/cull.wgsl`).

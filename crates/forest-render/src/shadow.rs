@@ -40,6 +40,10 @@ pub struct ShadowOptions {
     /// Receivers look their shadow up this many texels towards the sun and along their normal
     /// (the bias against acne; it also bounds the peter-panning, see `docs/rendering.md`).
     pub offset_texels: f32,
+    /// Cast, into each cascade, only the trees whose shadow can reach that cascade's slice of
+    /// the view ([`caster_planes`]); off, every tree in the cascade's box casts. The maps'
+    /// lookups are the same either way; off is for checking that.
+    pub cull_casters: bool,
 }
 
 impl Default for ShadowOptions {
@@ -53,6 +57,7 @@ impl Default for ShadowOptions {
             epsilon: 32.0,
             reach: 120.0,
             offset_texels: 1.5,
+            cull_casters: true,
         }
     }
 }
@@ -384,29 +389,80 @@ fn towards(
 }
 
 /// [`light_camera`] for the view `view`: its forms, and the distances that choose them
-/// measured from its eye, so that each tree casts in the form the view draws it in.
+/// measured from its eye, so that each tree casts in the form the view draws it in; and the
+/// cascade's receiver region ([`caster_planes`]) over ground no lower than `floor` (metres).
 pub fn light_camera_for(
     view: &GpuCamera,
     c: &Cascade,
     light: &forest_format::shading::Lighting,
     opts: &ShadowOptions,
     stream: crate::options::StreamOptions,
+    floor: f32,
 ) -> GpuCamera {
     let mut l = light_camera(c, light.sun_dir, opts, stream);
     l.set_light(light);
     l.forms = view.forms;
     l.form_eye = view.form_eye;
+    (l.casters, l.caster_floor) = caster_planes(view, c, opts, floor);
     l
 }
 
+/// The region whose shadows cascade `c` of `view` serves, for culling its casters: the
+/// view's four side planes and the slice's two depth planes, each moved out by 4 of the
+/// cascade's texels (the receivers' offset and filter taps reach less far); receivers no
+/// lower than `floor` (world height, metres); sweeps of at most the cascade box's own reach
+/// (`opts.reach` plus the sphere's diameter), so that nothing the box holds and a receiver
+/// can see is ever dropped. A tree's receivers look up at most its sphere's diameter towards
+/// the sun from a visible point, on the ray a caster's shadow follows, so they are covered.
+pub fn caster_planes(
+    view: &GpuCamera,
+    c: &Cascade,
+    opts: &ShadowOptions,
+    floor: f32,
+) -> ([[f32; 4]; 6], [f32; 4]) {
+    let eye = Vec3::from_slice(&view.eye[..3]);
+    let forward = Vec3::from_slice(&view.forward[..3]).normalize_or(Vec3::NEG_Z);
+    let margin = 4.0 * c.texel;
+    let at = forward.dot(eye);
+    let planes = [
+        view.planes[0],
+        view.planes[1],
+        view.planes[2],
+        view.planes[3],
+        forward.extend(-at - c.split.0).to_array(),
+        (-forward).extend(at + c.split.1).to_array(),
+    ]
+    .map(|p| [p[0], p[1], p[2], p[3] + margin]);
+    if !opts.cull_casters {
+        return Default::default();
+    }
+    (planes, [floor, opts.reach + 2.0 * c.radius, 0.0, 0.0])
+}
+
+/// Whether a caster's bounding sphere (world centre `c`, radius `r`) can shadow the receiver
+/// region of light camera `cam` (its `casters` and `caster_floor`; every sphere when they are
+/// zero): the CPU mirror of `casts_into` in `shaders/common.wgsl`.
+pub fn casts_into(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
+    let sun = Vec3::from_slice(&cam.sun[..3]);
+    let mut sweep = cam.caster_floor[1];
+    if sun.y > 1e-3 {
+        sweep = sweep.min((c.y + r - cam.caster_floor[0]).max(0.0) / sun.y);
+    }
+    cam.casters.iter().all(|pl| {
+        let n = Vec3::new(pl[0], pl[1], pl[2]);
+        n.dot(c) + pl[3] + sweep * (-n.dot(sun)).max(0.0) >= -r
+    })
+}
+
 /// The frame's cameras with shadows: `view` (the view's camera, light and options already in
-/// it) with its cascades written in, then each cascade's light camera under `light`. What a
-/// stream with shadows writes in its one upload.
+/// it) with its cascades written in, then each cascade's light camera under `light`, over
+/// ground no lower than `floor` (metres). What a stream with shadows writes in its one upload.
 pub fn cameras(
     view: &GpuCamera,
     light: &forest_format::shading::Lighting,
     opts: &ShadowOptions,
     stream: crate::options::StreamOptions,
+    floor: f32,
 ) -> Vec<GpuCamera> {
     let slice = ViewSlice {
         view_proj: Mat4::from_cols_array_2d(&view.view_proj),
@@ -419,7 +475,7 @@ pub fn cameras(
     out.extend(
         cascades
             .iter()
-            .map(|c| light_camera_for(view, c, light, opts, stream)),
+            .map(|c| light_camera_for(view, c, light, opts, stream, floor)),
     );
     out
 }
@@ -502,6 +558,88 @@ mod tests {
             let beyond = c.centre + sun * (c.radius + opts.reach * 1.01);
             assert!(c.view_proj.project_point3(beyond).z < 0.0);
         }
+    }
+
+    /// A caster culled from a cascade has no point of its swept sphere over any receiver
+    /// of the cascade's slice (sampled: points of the slice above the floor, the sweep down
+    /// to the floor), for seeded random views, suns and casters; and the cull drops some.
+    #[test]
+    fn culled_casters_cannot_shadow_the_slice() {
+        let mut seed = 0x9e37_79b9_u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        };
+        let opts = ShadowOptions::default();
+        let floor = -2.0;
+        let (mut culled, mut kept) = (0, 0);
+        for _ in 0..12 {
+            let eye = Vec3::new(rnd() * 40.0 - 20.0, 1.0 + rnd() * 60.0, rnd() * 40.0 - 20.0);
+            let look = Vec3::new(rnd() * 2.0 - 1.0, -rnd() * 0.8, rnd() * 2.0 - 1.0);
+            let cam = crate::Camera {
+                eye,
+                target: eye + look,
+                fov_y_deg: 50.0,
+                near: 0.5,
+                far: 2000.0,
+                viewport: (160, 90),
+                epsilon: 4.0,
+            };
+            let light =
+                forest_format::shading::Lighting::with_sun(rnd() * 360.0, 8.0 + rnd() * 80.0);
+            let g = cam.to_gpu();
+            let all = cameras(&g, &light, &opts, Default::default(), floor);
+            let inv = cam.view_proj().inverse();
+            let forward = cam.forward();
+            for (k, l) in all[1..].iter().enumerate() {
+                let split = (
+                    if k == 0 {
+                        0.0
+                    } else {
+                        all[0].shadow_splits[k - 1]
+                    },
+                    all[0].shadow_splits[k],
+                );
+                // Receivers: points of the view slice above the floor.
+                let mut receivers = Vec::new();
+                for _ in 0..3000 {
+                    let ray =
+                        inv.project_point3(Vec3::new(rnd() * 2.0 - 1.0, rnd() * 2.0 - 1.0, 0.5))
+                            - eye;
+                    let d = split.0 + rnd() * (split.1 - split.0);
+                    let p = eye + ray * (d / ray.dot(forward));
+                    if p.y >= floor {
+                        receivers.push(p);
+                    }
+                }
+                for _ in 0..200 {
+                    let c = eye
+                        + Vec3::new(rnd() - 0.5, rnd() * 0.5 - 0.2, rnd() - 0.5)
+                            * (2.0 * split.1 + 40.0);
+                    let c = Vec3::new(c.x, c.y.max(floor), c.z);
+                    let r = 1.0 + rnd() * 8.0;
+                    if casts_into(l, c, r) {
+                        kept += 1;
+                        continue;
+                    }
+                    culled += 1;
+                    let sun = light.sun_dir;
+                    let len = l.caster_floor[1].min((c.y + r - floor).max(0.0) / sun.y);
+                    for p in &receivers {
+                        // Distance from p to the segment c → c − len·sun.
+                        let t = (c - *p).dot(sun).clamp(0.0, len);
+                        let q = c - sun * t;
+                        assert!(
+                            q.distance(*p) > r,
+                            "cascade {k}: culled caster {c} r {r} shadows {p}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(culled > 500 && kept > 500, "culled {culled}, kept {kept}");
     }
 
     #[test]

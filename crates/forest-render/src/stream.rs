@@ -894,7 +894,13 @@ impl QuadStream {
             );
         }
         let cameras = match &self.shadows {
-            Some(sh) => crate::shadow::cameras(&g, &self.light, sh.options(), self.options),
+            Some(sh) => crate::shadow::cameras(
+                &g,
+                &self.light,
+                sh.options(),
+                self.options,
+                self.scene.terrain.floor,
+            ),
             None => vec![g],
         };
         crate::camera::upload_all(queue, &self.camera, &cameras, &mut self.writes);

@@ -53,6 +53,9 @@ pub struct GpuTerrain {
     pub grid: TerrainGrid,
     /// Heights in metres, row after row (`shaders/environment.wgsl`'s binding 13).
     pub heights: wgpu::Buffer,
+    /// The lowest ground (metres): the terrain's lowest sample, or the flat ground's 0 around
+    /// it (no shadow falls lower; see [`crate::shadow::caster_planes`]).
+    pub floor: f32,
 }
 
 impl GpuTerrain {
@@ -77,7 +80,12 @@ impl GpuTerrain {
             contents: bytemuck::cast_slice(heights),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        Ok(Self { grid, heights })
+        let floor = terrain.map_or(0.0, |t| t.height_range().0.min(0.0));
+        Ok(Self {
+            grid,
+            heights,
+            floor,
+        })
     }
 
     /// Bytes on the GPU.

@@ -653,6 +653,7 @@ impl GeometryRenderer {
                 &self.light,
                 lv.targets.options(),
                 Default::default(),
+                self.terrain.floor,
             ),
             None => vec![g],
         };

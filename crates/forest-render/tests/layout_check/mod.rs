@@ -68,6 +68,8 @@ pub fn shared() -> Vec<Expect> {
                 ("shadow_bias", offset_of!(GpuCamera, shadow_bias)),
                 ("shadow_params", offset_of!(GpuCamera, shadow_params)),
                 ("form_eye", offset_of!(GpuCamera, form_eye)),
+                ("casters", offset_of!(GpuCamera, casters)),
+                ("caster_floor", offset_of!(GpuCamera, caster_floor)),
             ],
         ),
         (
