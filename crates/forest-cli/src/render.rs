@@ -1052,7 +1052,11 @@ fn render_geometry(
     let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
     let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
-    geo.set_shadows(&ctx.device, args.shadow.options(false)?)?;
+    // The reference's maps are finer, as in every suite (ForestRenderer::set_shadows).
+    geo.set_shadows(
+        &ctx.device,
+        forest_baselines::methods::shadows_for(Method::Mesh(method), args.shadow.options(false)?),
+    )?;
     geo.set_pipeline_statistics(args.json);
     render_views(args, ctx, cameras, |cam, target| {
         geo.render_frame(ctx, cam, target)?;

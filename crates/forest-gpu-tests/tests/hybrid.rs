@@ -187,7 +187,7 @@ fn culling_casters_by_their_receivers_changes_no_shadow() {
         .unwrap();
     assert_eq!(
         side(&r),
-        256 * forest_baselines::methods::REFERENCE_SHADOW_SCALE
+        forest_baselines::methods::REFERENCE_SHADOW_RESOLUTION
     );
     r.set_method(&ctx, Method::Quads).unwrap();
     assert_eq!(side(&r), 256);

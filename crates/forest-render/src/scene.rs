@@ -296,6 +296,9 @@ pub struct GpuScene {
     pub presort_dirs: wgpu::Buffer,
     /// The forest's terrain (its heights; a single zero without one).
     pub terrain: crate::terrain::GpuTerrain,
+    /// The heights between which the forest's shadow receivers lie (its trees over its
+    /// ground; the shadow cascades are fitted to it).
+    pub band: crate::shadow::ReceiverBand,
     /// Bytes of all the above on the GPU.
     pub bytes: u64,
     /// Whether colour is BC7 (else RGBA8).
@@ -502,7 +505,11 @@ impl GpuScene {
                 + std::mem::size_of_val(tables.roots.as_slice())
                 + std::mem::size_of_val(tables.presort_dirs.as_slice())) as u64
             + terrain.bytes();
+        let spheres: Vec<[f32; 4]> = tables.species.iter().map(|s| s.sphere).collect();
+        let band =
+            crate::shadow::ReceiverBand::of(&tables.instances, &spheres, forest.terrain.as_ref());
         Ok(Self {
+            band,
             instances: storage(ctx, "instances", &tables.instances),
             species: storage(ctx, "species", &tables.species),
             frames: storage(ctx, "frames", &tables.frames),

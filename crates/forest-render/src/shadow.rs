@@ -166,6 +166,91 @@ impl ViewSlice {
         }
         (near, far, k)
     }
+
+    /// The view depths within `[near, end]` where the view's cross-section meets `band`
+    /// (widened by 0.5 m and 1 %), or `[near, end]` when it never does. Each corner ray's
+    /// height is linear in depth, so the set's bounds are among the depths where a corner ray
+    /// crosses the band's edges.
+    fn band_depths(&self, band: ReceiverBand, near: f32, end: f32) -> (f32, f32) {
+        if band == ReceiverBand::ANY {
+            return (near, end);
+        }
+        let pad = |h: f32| 0.5 + 0.01 * h.abs();
+        let (floor, top) = (band.floor - pad(band.floor), band.top + pad(band.top));
+        let inv = self.view_proj.inverse();
+        let slopes: Vec<f32> = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
+            .iter()
+            .filter_map(|&(x, y)| {
+                let h = inv * Vec4::new(x, y, 0.5, 1.0);
+                let r = h.truncate() / h.w - self.eye;
+                let r = if h.w < 0.0 { -r } else { r };
+                let along = r.dot(self.forward);
+                (along > 1e-9).then(|| r.y / along)
+            })
+            .collect();
+        if slopes.len() < 4 {
+            return (near, end);
+        }
+        let y = self.eye.y;
+        let meets = |d: f32| {
+            let (lo, hi) = slopes.iter().fold((f32::MAX, f32::MIN), |(lo, hi), s| {
+                (lo.min(y + d * s), hi.max(y + d * s))
+            });
+            lo <= top && hi >= floor
+        };
+        let mut candidates = vec![near, end];
+        for s in &slopes {
+            if s.abs() > 1e-9 {
+                for h in [floor, top] {
+                    candidates.push(((h - y) / s).clamp(near, end));
+                }
+            }
+        }
+        let hits: Vec<f32> = candidates.into_iter().filter(|&d| meets(d)).collect();
+        let lo = hits.iter().copied().fold(f32::MAX, f32::min);
+        let hi = hits.iter().copied().fold(f32::MIN, f32::max);
+        if hi > lo { (lo, hi) } else { (near, end) }
+    }
+}
+
+/// The heights (world y, metres) between which anything can receive a shadow: the lowest
+/// ground and the highest tree top or ground. Cascades cover only the part of the view between
+/// them, and nothing casts below `floor`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReceiverBand {
+    /// The lowest ground: the terrain's lowest sample, or the flat ground's 0 around it.
+    pub floor: f32,
+    /// The highest point of a tree's bounding sphere or of the ground.
+    pub top: f32,
+}
+
+impl ReceiverBand {
+    /// Every height: cascades cover the whole view up to the shadow distance.
+    pub const ANY: Self = Self {
+        floor: f32::MIN,
+        top: f32::MAX,
+    };
+
+    /// The band of a forest: its trees (`instances`, with their species' object-space
+    /// bounding `spheres`, centre and radius) over its `terrain`.
+    pub fn of(
+        instances: &[crate::gpu_types::GpuInstance],
+        spheres: &[[f32; 4]],
+        terrain: Option<&forest_format::terrain::Terrain>,
+    ) -> Self {
+        let (lo, hi) = terrain.map_or((0.0, 0.0), |t| t.height_range());
+        let top = instances
+            .iter()
+            .filter_map(|i| {
+                let s = spheres.get(i.species as usize)?;
+                Some(i.position[1] + (s[1] + s[3]) * i.scale)
+            })
+            .fold(hi.max(0.0), f32::max);
+        Self {
+            floor: lo.min(0.0),
+            top,
+        }
+    }
 }
 
 /// The view depths where the cascades split: `n + 1` values from `near` to `end`, blending
@@ -200,11 +285,18 @@ pub fn light_rotation(sun: Vec3) -> Mat4 {
     glam::camera::rh::view::look_at_mat4(Vec3::ZERO, -sun, up)
 }
 
-/// The cascades of `view` under a sun in unit direction `sun` (towards the sun).
-pub fn fit_cascades(view: &ViewSlice, sun: Vec3, opts: &ShadowOptions) -> Vec<Cascade> {
+/// The cascades of `view` under a sun in unit direction `sun` (towards the sun), over the
+/// part of the view (up to the shadow distance) where receivers in `band` can be.
+pub fn fit_cascades(
+    view: &ViewSlice,
+    sun: Vec3,
+    opts: &ShadowOptions,
+    band: ReceiverBand,
+) -> Vec<Cascade> {
     let sun = sun.normalize_or(Vec3::Y);
     let (near, far, k) = view.extent();
     let end = opts.distance.min(far).max(near * 1.001);
+    let (near, end) = view.band_depths(band, near, end);
     let splits = split_depths(near, end, opts.cascades, opts.split_lambda);
     let rot = light_rotation(sun);
     let res = opts.resolution as f32;
@@ -455,21 +547,22 @@ pub fn casts_into(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
 }
 
 /// The frame's cameras with shadows: `view` (the view's camera, light and options already in
-/// it) with its cascades written in, then each cascade's light camera under `light`, over
-/// ground no lower than `floor` (metres). What a stream with shadows writes in its one upload.
+/// it) with its cascades written in, then each cascade's light camera under `light`, for
+/// receivers in `band`. What a stream with shadows writes in its one upload.
 pub fn cameras(
     view: &GpuCamera,
     light: &forest_format::shading::Lighting,
     opts: &ShadowOptions,
     stream: crate::options::StreamOptions,
-    floor: f32,
+    band: ReceiverBand,
 ) -> Vec<GpuCamera> {
     let slice = ViewSlice {
         view_proj: Mat4::from_cols_array_2d(&view.view_proj),
         eye: Vec3::from_slice(&view.eye[..3]),
         forward: Vec3::from_slice(&view.forward[..3]),
     };
-    let cascades = fit_cascades(&slice, light.sun_dir, opts);
+    let cascades = fit_cascades(&slice, light.sun_dir, opts, band);
+    let floor = band.floor.max(-1e30);
     let mut out = vec![*view];
     write_receivers(&mut out[0], &cascades, opts);
     out.extend(
@@ -527,7 +620,7 @@ mod tests {
         let v = view(Vec3::new(3.0, 1.7, -4.0), Vec3::new(40.0, 4.0, 30.0));
         let sun = Vec3::new(0.4, 0.5, 0.3).normalize();
         let opts = ShadowOptions::default();
-        let cascades = fit_cascades(&v, sun, &opts);
+        let cascades = fit_cascades(&v, sun, &opts, ReceiverBand::ANY);
         assert_eq!(cascades.len(), 3);
         let inv = v.view_proj.inverse();
         for c in &cascades {
@@ -590,7 +683,11 @@ mod tests {
             let light =
                 forest_format::shading::Lighting::with_sun(rnd() * 360.0, 8.0 + rnd() * 80.0);
             let g = cam.to_gpu();
-            let all = cameras(&g, &light, &opts, Default::default(), floor);
+            let band = ReceiverBand {
+                floor,
+                top: f32::MAX,
+            };
+            let all = cameras(&g, &light, &opts, Default::default(), band);
             let inv = cam.view_proj().inverse();
             let forward = cam.forward();
             for (k, l) in all[1..].iter().enumerate() {
@@ -642,6 +739,46 @@ mod tests {
         assert!(culled > 500 && kept > 500, "culled {culled}, kept {kept}");
     }
 
+    /// Cascades cover only the depths where the view meets the receivers' heights: looking
+    /// straight down from 50 m on trees up to 20 m, the depths 29.3 to 50.5 m; a walker's
+    /// view meets them everywhere and keeps the cascades it has without a band.
+    #[test]
+    fn cascades_cover_only_the_depths_where_receivers_can_be() {
+        let opts = ShadowOptions::default();
+        let sun = Vec3::new(0.3, 0.8, 0.2).normalize();
+        let band = ReceiverBand {
+            floor: 0.0,
+            top: 20.0,
+        };
+        let down = view(Vec3::new(0.0, 50.0, 0.0), Vec3::new(0.0, 0.0, 0.01));
+        let c = fit_cascades(&down, sun, &opts, band);
+        let (pad_top, pad_floor) = (0.5 + 0.2, 0.5);
+        assert!(
+            (c[0].split.0 - (30.0 - pad_top)).abs() < 0.05,
+            "{:?}",
+            c[0].split
+        );
+        let last = c.last().unwrap().split.1;
+        assert!((last - (50.0 + pad_floor)).abs() < 0.05, "ends at {last}");
+        // The ground's cascade, 49 m down, is finer than without the band, and its sphere is
+        // within 10 % of the view's cross-section there (half its diagonal: no fit is smaller).
+        let all = fit_cascades(&down, sun, &opts, ReceiverBand::ANY);
+        let ground = |cs: &[Cascade]| *cs.iter().find(|c| c.split.1 >= 49.0).unwrap();
+        assert!(ground(&c).texel < 0.8 * ground(&all).texel);
+        let t = 30f32.to_radians().tan();
+        let half_diagonal = 50.5 * (t * t + (t * 16.0 / 9.0).powi(2)).sqrt();
+        assert!(
+            ground(&c).radius < 1.1 * half_diagonal,
+            "{} vs {half_diagonal}",
+            ground(&c).radius
+        );
+        let walk = view(Vec3::new(3.0, 1.7, 2.0), Vec3::new(40.0, 3.0, 60.0));
+        assert_eq!(
+            fit_cascades(&walk, sun, &opts, band),
+            fit_cascades(&walk, sun, &opts, ReceiverBand::ANY)
+        );
+    }
+
     #[test]
     fn turning_or_moving_the_camera_moves_cascades_by_whole_texels() {
         let sun = Vec3::new(-0.3, 0.6, 0.5).normalize();
@@ -650,11 +787,13 @@ mod tests {
             &view(Vec3::new(0.0, 2.0, 0.0), Vec3::new(10.0, 2.0, 30.0)),
             sun,
             &opts,
+            ReceiverBand::ANY,
         );
         let b = fit_cascades(
             &view(Vec3::new(0.37, 2.0, 0.11), Vec3::new(-20.0, 3.0, 25.0)),
             sun,
             &opts,
+            ReceiverBand::ANY,
         );
         let rot = light_rotation(sun);
         for (a, b) in a.iter().zip(&b) {
@@ -679,6 +818,7 @@ mod tests {
             &view(Vec3::ZERO + Vec3::Y, Vec3::new(0.0, 1.0, 10.0)),
             sun,
             &opts,
+            ReceiverBand::ANY,
         );
         let g = light_camera(&cascades[0], sun, &opts, Default::default());
         let eye = Vec3::from_slice(&g.eye[..3]);

@@ -140,6 +140,7 @@ pub trait Caster {
 /// quad stream's light views and the geometry renderer's, in the hybrid).
 pub struct ShadowTargets {
     opts: ShadowOptions,
+    band: crate::shadow::ReceiverBand,
     layers: Vec<wgpu::TextureView>,
     receivers: wgpu::BindGroup,
     bytes: u64,
@@ -147,11 +148,13 @@ pub struct ShadowTargets {
 
 impl ShadowTargets {
     /// The maps of `opts` (checked, and against the device, before anything is allocated),
-    /// read through `layout` (the receivers' layout, [`receiver_layout`]).
+    /// read through `layout` (the receivers' layout, [`receiver_layout`]), for receivers in
+    /// `band` (every renderer casting into the maps fits its cascades to it).
     pub fn new(
         device: &wgpu::Device,
         opts: &ShadowOptions,
         layout: &wgpu::BindGroupLayout,
+        band: crate::shadow::ReceiverBand,
     ) -> Result<Self, RenderError> {
         opts.validate().map_err(RenderError::Parameter)?;
         let limits = device.limits();
@@ -182,6 +185,7 @@ impl ShadowTargets {
             .collect();
         Ok(Self {
             opts: *opts,
+            band,
             layers,
             receivers: receiver_group(device, layout, &texture),
             bytes: u64::from(opts.resolution).pow(2) * 4 * u64::from(opts.cascades),
@@ -191,6 +195,11 @@ impl ShadowTargets {
     /// The options the maps were built for.
     pub fn options(&self) -> &ShadowOptions {
         &self.opts
+    }
+
+    /// The heights the maps' receivers lie between.
+    pub fn band(&self) -> crate::shadow::ReceiverBand {
+        self.band
     }
 
     /// The receivers' bind group (group 2 of every draw that reads the maps).
@@ -256,7 +265,7 @@ impl ShadowMaps {
         opts: &ShadowOptions,
         layout: &wgpu::BindGroupLayout,
     ) -> Result<Self, RenderError> {
-        let targets = Arc::new(ShadowTargets::new(device, opts, layout)?);
+        let targets = Arc::new(ShadowTargets::new(device, opts, layout, scene.band)?);
         let stream_opts = RendererOptions {
             viewport: (opts.resolution, opts.resolution),
             min_epsilon: opts.epsilon,

@@ -899,7 +899,7 @@ impl QuadStream {
                 &self.light,
                 sh.options(),
                 self.options,
-                self.scene.terrain.floor,
+                sh.targets().band(),
             ),
             None => vec![g],
         };

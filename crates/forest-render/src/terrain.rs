@@ -53,9 +53,6 @@ pub struct GpuTerrain {
     pub grid: TerrainGrid,
     /// Heights in metres, row after row (`shaders/environment.wgsl`'s binding 13).
     pub heights: wgpu::Buffer,
-    /// The lowest ground (metres): the terrain's lowest sample, or the flat ground's 0 around
-    /// it (no shadow falls lower; see [`crate::shadow::caster_planes`]).
-    pub floor: f32,
 }
 
 impl GpuTerrain {
@@ -80,12 +77,7 @@ impl GpuTerrain {
             contents: bytemuck::cast_slice(heights),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let floor = terrain.map_or(0.0, |t| t.height_range().0.min(0.0));
-        Ok(Self {
-            grid,
-            heights,
-            floor,
-        })
+        Ok(Self { grid, heights })
     }
 
     /// Bytes on the GPU.

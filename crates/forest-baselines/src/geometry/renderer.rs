@@ -74,6 +74,8 @@ pub struct GeometryRenderer {
     pub gpu_bytes: u64,
     /// Layout of the draw's group 2, the sun's shadow maps.
     shadow_layout: wgpu::BindGroupLayout,
+    /// The heights between which the forest's receivers lie (its own maps are fitted to it).
+    band: forest_render::shadow::ReceiverBand,
     /// The receivers' group while shadows are off.
     no_shadows: wgpu::BindGroup,
     /// The light views and the maps' receivers' group while shadows are on.
@@ -528,6 +530,11 @@ impl GeometryRenderer {
             draw_bg: view.draw_bg,
             args: view.args,
             shadow_layout,
+            band: forest_render::shadow::ReceiverBand::of(
+                &instances,
+                &geo_species.iter().map(|s| s.sphere).collect::<Vec<_>>(),
+                forest.terrain.as_ref(),
+            ),
             no_shadows,
             shadows: None,
             parked: None,
@@ -653,7 +660,7 @@ impl GeometryRenderer {
                 &self.light,
                 lv.targets.options(),
                 Default::default(),
-                self.terrain.floor,
+                lv.targets.band(),
             ),
             None => vec![g],
         };
@@ -677,6 +684,7 @@ impl GeometryRenderer {
                 device,
                 &o,
                 &self.shadow_layout,
+                self.band,
             )?)),
             None => None,
         };

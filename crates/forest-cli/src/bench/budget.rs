@@ -120,7 +120,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             ..Default::default()
         };
         let stream = forest_render::QuadStream::new(&b.ctx.device, scene, &opts)?;
-        let mut r = forest_baselines::methods::ForestRenderer::new(stream, None);
+        let mut r = b.shadowed(forest_baselines::methods::ForestRenderer::new(stream, None))?;
         // The quads the scene needs: the most any of its views (the nearest, and the accuracy
         // suite's mid-range and bird's-eye) draws; a quarter more is the suggested capacity.
         let mut most = 0u64;
@@ -246,6 +246,34 @@ pub fn run(b: &Bench) -> Result<Section> {
             ms(t),
         ]);
     }
+    // What each shadow cascade cost in the last frame (the quad stream's light views).
+    let cascades = match r.stream.shadows() {
+        Some(sh) => {
+            let costs: Vec<String> = sh
+                .stats(&b.ctx)
+                .iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    format!(
+                        "cascade {k}: {} trees, {} quads, cull + refine + cast {}",
+                        s.visible_trees,
+                        s.quads,
+                        s.times.map_or("not timed".into(), |t| {
+                            format!("{:.2} ms", t.cull_ms + t.refine_ms + t.draw_ms)
+                        })
+                    )
+                })
+                .collect();
+            println!("budget: shadows: {}", costs.join("; "));
+            format!(
+                " With the sun's shadows on, the last hybrid row's cascades cost: {}; the maps \
+                 and light views take {:.1} MB.",
+                costs.join("; "),
+                sh.bytes() as f64 / 1e6
+            )
+        }
+        None => String::new(),
+    };
     drop(r);
     b.write("budget.csv", &table.csv())?;
     b.chart(
@@ -278,7 +306,7 @@ pub fn run(b: &Bench) -> Result<Section> {
          the fidelity suite). The \"hybrid\" rows draw trees nearer than the switch distance \
          as full geometry: their storage adds the models (disk: their folders; GPU: the \
          geometry renderer's vertices, textures and buffers) to the default atlases; at the \
-         nearest view: {}.",
+         nearest view: {}.{cascades}",
         viewport.0,
         viewport.1,
         2.0 * radius * focal / near,

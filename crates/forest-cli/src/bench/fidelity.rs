@@ -312,7 +312,7 @@ fn scratch_renderer(
         ..Default::default()
     };
     let stream = QuadStream::new(&b.ctx.device, scene, &opts)?;
-    Ok((ForestRenderer::new(stream, None), gpu))
+    Ok((b.shadowed(ForestRenderer::new(stream, None))?, gpu))
 }
 
 fn mean(v: impl Iterator<Item = f64>) -> Option<f64> {

@@ -90,6 +90,10 @@ pub struct BenchArgs {
     /// Accuracy suite: measure only these methods (comma-separated; default: all).
     #[arg(long, value_delimiter = ',', value_parser = ["quads", "impostor", "geometry", "stochastic", "lods", "hybrid"])]
     pub methods: Vec<String>,
+    /// The sun's shadows in every suite's frames (off unless `--shadows on`; the shadows
+    /// suite draws frames with and without them whatever this says).
+    #[command(flatten)]
+    pub shadow: crate::render::ShadowArgs,
 }
 
 /// What every suite works with.
@@ -119,6 +123,8 @@ pub struct Bench {
     pub views: Vec<String>,
     /// Accuracy suite: the methods to measure (empty: all).
     pub methods: Vec<String>,
+    /// The sun's shadows every suite's renderers draw (`--shadows`), or none.
+    pub shadows: Option<forest_render::shadow::ShadowOptions>,
 }
 
 /// Every method at its default parameters, in the order the suites report them.
@@ -206,6 +212,7 @@ impl Bench {
             frames: if args.quick { 1 } else { args.frames.max(1) },
             views: args.views.clone(),
             methods: args.methods.clone(),
+            shadows: args.shadow.options(false)?,
         })
     }
 
@@ -349,7 +356,13 @@ impl Bench {
         } else {
             None
         };
-        Ok(ForestRenderer::new(stream, geo))
+        self.shadowed(ForestRenderer::new(stream, geo))
+    }
+
+    /// `r` drawing the shadows the suites were asked for (`--shadows`).
+    pub fn shadowed(&self, mut r: ForestRenderer) -> Result<ForestRenderer> {
+        r.set_shadows(&self.ctx.device, self.shadows)?;
+        Ok(r)
     }
 
     /// Render `frames` + 1 frames of `method` (the first unmeasured: pipelines may compile

@@ -49,7 +49,7 @@ pub fn write(b: &Bench, suite: &str, section: &Section) -> anyhow::Result<()> {
 fn header(b: &Bench) -> String {
     format!(
         "# forest bench report\n\nDevice: {}{}. Species: {}. Times are GPU timestamps \
-             (cull + refine + draw), medians of {} frame(s) after one warm-up frame{}.\n\n",
+             (cull + refine + draw), medians of {} frame(s) after one warm-up frame{}. {}\n\n",
         b.device,
         if b.cpu {
             " — a CPU rasteriser: absolute times are a CPU emulating a GPU; compare \
@@ -67,6 +67,18 @@ fn header(b: &Bench) -> String {
             ". QUICK MODE: tiny scenes, the figures only prove the suites run"
         } else {
             ""
+        },
+        match b.shadows {
+            Some(o) => format!(
+                "The sun's shadows are on in every suite: {} cascades of {}² texels over {} m, \
+                 light views at ε {} texels (the reference's maps {}²).",
+                o.cascades,
+                o.resolution,
+                o.distance,
+                o.epsilon,
+                forest_baselines::methods::REFERENCE_SHADOW_RESOLUTION
+            ),
+            None => "The sun's shadows are off (but in the shadows suite).".to_string(),
         }
     )
 }

@@ -347,21 +347,26 @@ impl Host {
         let mut encoder = device.create_command_encoder(&Default::default());
         let mut shadow = (Mat4::IDENTITY, 0.0);
         if let Some(sun) = &mut self.sun {
-            // The host's cascade (fitted as the forest fits its own), in reverse-Z.
+            // The host's cascade (fitted as the forest fits its own, over every height: the
+            // host's ground and objects receive too), in reverse-Z.
             let view = forest_render::shadow::ViewSlice {
                 view_proj: frame.proj * frame.view,
                 eye,
                 forward: frame.forward(),
             };
             let to_light = frame.light.sun_dir;
-            let cascades: Vec<_> =
-                forest_render::shadow::fit_cascades(&view, to_light, &sun.options)
-                    .into_iter()
-                    .map(|c| forest_render::shadow::Cascade {
-                        view_proj: reverse_z(c.view_proj),
-                        ..c
-                    })
-                    .collect();
+            let cascades: Vec<_> = forest_render::shadow::fit_cascades(
+                &view,
+                to_light,
+                &sun.options,
+                forest_render::shadow::ReceiverBand::ANY,
+            )
+            .into_iter()
+            .map(|c| forest_render::shadow::Cascade {
+                view_proj: reverse_z(c.view_proj),
+                ..c
+            })
+            .collect();
             let light = forest_render::shadow::LightParams {
                 view_proj: cascades[0].view_proj,
                 to_light,
