@@ -82,10 +82,10 @@ fn light_view_streams_equal_the_cpu_reference() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
 
-/// Ground points (x, z) the shadow of one pine covers under a sun in direction `sun`: pixels
-/// darker with shadows than without, seen by a camera high above the origin; and one screen
-/// pixel's width on the ground (metres).
-fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f32) {
+/// Ground points (x, z) the shadow of one tree (`atlas`) covers under a sun in direction
+/// `sun`: pixels darker with shadows than without, seen by a camera high above the origin;
+/// one screen pixel's width on the ground and the ground's shadow-map texel (metres).
+fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f32, f32) {
     let ctx = common::ctx();
     let forest = forest_format::forest::Forest::new(
         vec!["pine".into()],
@@ -100,6 +100,7 @@ fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f
     let species =
         forest_render::SpeciesData::decode(atlas.clone(), std::path::Path::new("pine")).unwrap();
     let scene = GpuScene::new(&ctx, &[species], &forest).unwrap();
+    let band = scene.band;
     let size = 320;
     let opts = RendererOptions {
         viewport: (size, size),
@@ -121,13 +122,24 @@ fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f
         stream.render_fitted(&ctx, &cam, &target).unwrap();
         target.read(&ctx)
     };
-    let off = shot(None);
-    let on = shot(Some(ShadowOptions {
+    let shadows = ShadowOptions {
         resolution: 1024,
         epsilon: 4.0,
         ..Default::default()
-    }));
+    };
+    let off = shot(None);
+    let on = shot(Some(shadows));
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    // The texel of the cascade the ground (60 m down) falls in.
+    let view = forest_render::shadow::ViewSlice {
+        view_proj: cam.view_proj(),
+        eye: cam.eye,
+        forward: cam.forward(),
+    };
+    let texel = forest_render::shadow::fit_cascades(&view, sun, &shadows, band)
+        .iter()
+        .find(|c| c.split.1 >= 59.0)
+        .map_or(f32::MAX, |c| c.texel);
     let inv = cam.view_proj().inverse();
     let lum = |c: &image::Rgba<u8>| u32::from(c[0]) + u32::from(c[1]) + u32::from(c[2]);
     let mut pts = Vec::new();
@@ -146,7 +158,65 @@ fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f
             pts.push((g.x, g.z));
         }
     }
-    (pts, 2.0 * 60.0 * 15f32.to_radians().tan() / size as f32)
+    (
+        pts,
+        2.0 * 60.0 * 15f32.to_radians().tan() / size as f32,
+        texel,
+    )
+}
+
+/// One opaque square card, 2 m across, lying 3 m above flat ground: under a low and a high
+/// sun its shadow's edges lie where the card's edges project along the sun, within a texel of
+/// the shadow map, a texel of the atlas and a pixel of the image that measures them.
+#[test]
+fn a_cards_shadow_lands_where_the_sun_projects_it() {
+    let dir = common::root().join("target/test-output/card");
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("card.obj");
+    std::fs::write(
+        &obj,
+        "v -1 3 -1\nv 1 3 -1\nv 1 3 1\nv -1 3 1\nf 1 2 3\nf 1 3 4\nf 3 2 1\nf 4 3 1\n",
+    )
+    .unwrap();
+    let params = forest_format::BakeParams {
+        directions: 15,
+        resolution: 64,
+        min_quad: 4,
+        spp: 2,
+        ..Default::default()
+    };
+    let atlas = &forest_bake::bake_file(&obj, &params, &|_, _| {})
+        .unwrap()
+        .atlas;
+    let atlas_texel =
+        2.0 * atlas.manifest.bounding_sphere.radius / atlas.manifest.params.resolution as f32;
+    for (az, el) in [(35.0f32, 30.0f32), (200.0, 65.0)] {
+        let sun = forest_format::shading::Lighting::with_sun(az, el).sun_dir;
+        let (pts, pixel, texel) = shadow_points(atlas, sun);
+        assert!(pts.len() > 50, "sun {sun}: {} shadowed pixels", pts.len());
+        // The card's shadow: the square moved 3 m along the sun's ray down to the ground.
+        let shift = -3.0 * Vec3::new(sun.x, 0.0, sun.z) / sun.y;
+        let (x0, x1) = pts
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        let (z0, z1) = pts
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        let tolerance = texel + atlas_texel + pixel;
+        for (what, got, want) in [
+            ("x min", x0, shift.x - 1.0),
+            ("x max", x1, shift.x + 1.0),
+            ("z min", z0, shift.z - 1.0),
+            ("z max", z1, shift.z + 1.0),
+        ] {
+            assert!(
+                (got - want).abs() <= tolerance,
+                "sun {az}°, {el}°: the shadow's {what} edge at {got:.3} m, the card's projects \
+                 to {want:.3} m (± {tolerance:.3}: map texel {texel:.3}, atlas texel \
+                 {atlas_texel:.3}, pixel {pixel:.3})"
+            );
+        }
+    }
 }
 
 #[test]
@@ -181,7 +251,7 @@ fn a_trees_shadow_falls_where_its_silhouette_projects_along_the_sun() {
     let texel =
         2.0 * atlas.manifest.bounding_sphere.radius / atlas.manifest.params.resolution as f32;
     for sun in [dirs[0], dirs[dirs.len() - 1]] {
-        let (pts, pixel) = shadow_points(atlas, sun);
+        let (pts, pixel, _) = shadow_points(atlas, sun);
         assert!(
             pts.len() > 50,
             "sun {sun}: only {} shadowed pixels",
