@@ -48,6 +48,8 @@ pub fn run(b: &Bench) -> Result<Section> {
         "frame_ms_off",
         "frame_ms_on",
         "ratio",
+        "view_trees",
+        "view_primitives",
         "cascade_trees",
         "cascade_quads",
         "maps_mb",
@@ -75,6 +77,8 @@ pub fn run(b: &Bench) -> Result<Section> {
                 }
             }
             b.ctx.check_errors()?;
+            // The view's own work in the last (shadowed) frame, beside the cascades'.
+            let view_stats = r.read_stats(&b.ctx);
             let cascades = r
                 .stream
                 .shadows()
@@ -97,6 +101,8 @@ pub fn run(b: &Bench) -> Result<Section> {
                 format!("{off:.1}"),
                 format!("{on:.1}"),
                 format!("{ratio:.2}"),
+                view_stats.visible_trees.to_string(),
+                view_stats.primitives.to_string(),
                 join(&|c| c.visible_trees),
                 join(&|c| c.quads),
                 format!("{mb:.1}"),
@@ -133,8 +139,10 @@ pub fn run(b: &Bench) -> Result<Section> {
          light views refined to ε {} texels): frames with shadows off and on drawn alternately \
          in one run, {frames} of each per view after a warm-up, timed from submission to \
          completion (the cascades' cull, refine and casting passes are inside the frame), \
-         medians. `cascade_trees` and `cascade_quads` are each cascade's light-view work \
-         (the quad stream's; the hybrid's near trees cast as geometry besides). The maps take \
+         medians. `view_trees` and `view_primitives` are the view's own work (its visible \
+         trees; quads, or for the hybrid quads and triangles), `cascade_trees` and \
+         `cascade_quads` each cascade's light-view work (the quad stream's; the hybrid's near \
+         trees cast as geometry besides). The maps take \
          `maps_mb` (with the light views' stream buffers).",
         opts.cascades, opts.resolution, opts.distance, opts.epsilon
     );
