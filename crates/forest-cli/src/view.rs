@@ -228,7 +228,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             .with_context(|| format!("{}: key {i}", path_file.display()))?;
         ctx.check_errors()?;
         let t = stats.times.unwrap_or_default();
-        total_ms += t.cull_ms + t.refine_ms + t.draw_ms;
+        total_ms += t.total_ms();
         write_png(&target.read(&ctx), &frame_file(i))?;
     }
     println!(

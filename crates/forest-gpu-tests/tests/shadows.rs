@@ -165,6 +165,24 @@ fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f
     )
 }
 
+/// `obj` baked small with 15 sampling directions (a ring of them at 45°), and one of the
+/// atlas's texels across the model (metres).
+fn bake_15(obj: &std::path::Path) -> (forest_format::Atlas, f32) {
+    let params = forest_format::BakeParams {
+        directions: 15,
+        resolution: 64,
+        min_quad: 4,
+        spp: 2,
+        ..Default::default()
+    };
+    let atlas = forest_bake::bake_file(obj, &params, &|_, _| {})
+        .unwrap()
+        .atlas;
+    let texel =
+        2.0 * atlas.manifest.bounding_sphere.radius / atlas.manifest.params.resolution as f32;
+    (atlas, texel)
+}
+
 /// One opaque square card, 2 m across, lying 3 m above flat ground: under a low and a high
 /// sun its shadow's edges lie where the card's edges project along the sun, within a texel of
 /// the shadow map, a texel of the atlas and a pixel of the image that measures them.
@@ -178,18 +196,8 @@ fn a_cards_shadow_lands_where_the_sun_projects_it() {
         "v -1 3 -1\nv 1 3 -1\nv 1 3 1\nv -1 3 1\nf 1 2 3\nf 1 3 4\nf 3 2 1\nf 4 3 1\n",
     )
     .unwrap();
-    let params = forest_format::BakeParams {
-        directions: 15,
-        resolution: 64,
-        min_quad: 4,
-        spp: 2,
-        ..Default::default()
-    };
-    let atlas = &forest_bake::bake_file(&obj, &params, &|_, _| {})
-        .unwrap()
-        .atlas;
-    let atlas_texel =
-        2.0 * atlas.manifest.bounding_sphere.radius / atlas.manifest.params.resolution as f32;
+    let (atlas, atlas_texel) = bake_15(&obj);
+    let atlas = &atlas;
     for (az, el) in [(35.0f32, 30.0f32), (200.0, 65.0)] {
         let sun = forest_format::shading::Lighting::with_sun(az, el).sun_dir;
         let (pts, pixel, texel) = shadow_points(atlas, sun);
@@ -225,16 +233,8 @@ fn a_trees_shadow_falls_where_its_silhouette_projects_along_the_sun() {
     // so the caster is the baked silhouette itself), low and high: 15 directions have a ring
     // at 45°.
     let pine = common::root().join("assets/trees/pine/pine.obj");
-    let params = forest_format::BakeParams {
-        directions: 15,
-        resolution: 64,
-        min_quad: 4,
-        spp: 2,
-        ..Default::default()
-    };
-    let atlas = &forest_bake::bake_file(&pine, &params, &|_, _| {})
-        .unwrap()
-        .atlas;
+    let (atlas, texel) = bake_15(&pine);
+    let atlas = &atlas;
     let mut dirs: Vec<Vec3> = atlas
         .manifest
         .directions
@@ -248,8 +248,6 @@ fn a_trees_shadow_falls_where_its_silhouette_projects_along_the_sun() {
         "no sampling direction between 17° and 72°: {dirs:?}"
     );
     let mesh = forest_bake::Mesh::load(&pine).unwrap();
-    let texel =
-        2.0 * atlas.manifest.bounding_sphere.radius / atlas.manifest.params.resolution as f32;
     for sun in [dirs[0], dirs[dirs.len() - 1]] {
         let (pts, pixel, _) = shadow_points(atlas, sun);
         assert!(

@@ -142,29 +142,42 @@ impl ViewSlice {
     /// infinite), and the widest lateral offset of the frustum's edges per metre of depth.
     fn extent(&self) -> (f32, f32, f32) {
         let inv = self.view_proj.inverse();
-        let depth_at = |x: f32, y: f32, z: f32| -> (f32, Vec3) {
-            let h = inv * Vec4::new(x, y, z, 1.0);
-            if h.w.abs() < 1e-12 {
-                return (f32::INFINITY, h.truncate());
-            }
-            let p = h.truncate() / h.w;
-            (self.forward.dot(p - self.eye), p - self.eye)
-        };
-        let (d0, _) = depth_at(0.0, 0.0, 0.0);
-        let (d1, _) = depth_at(0.0, 0.0, 1.0);
+        let (d0, _) = self.depth_at(inv, 0.0, 0.0, 0.0);
+        let (d1, _) = self.depth_at(inv, 0.0, 0.0, 1.0);
         let near = d0.min(d1).max(1e-3);
         let far = d0.max(d1);
-        let mut k = 0.0f32;
-        for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
-            // A point halfway through the depth range lies on the corner's ray.
-            let (d, r) = depth_at(x, y, 0.5);
-            let r = if d < 0.0 { -r } else { r };
-            let along = r.dot(self.forward);
-            if along > 1e-9 {
-                k = k.max((r / along - self.forward).length());
-            }
-        }
+        let k = self
+            .corner_rays(inv)
+            .iter()
+            .map(|r| (*r - self.forward).length())
+            .fold(0.0f32, f32::max);
         (near, far, k)
+    }
+
+    /// The view depth of clip point (x, y, z) and its offset from the eye (for a point at
+    /// infinity, an infinite depth and its direction); `inv` is the inverse of `view_proj`.
+    fn depth_at(&self, inv: Mat4, x: f32, y: f32, z: f32) -> (f32, Vec3) {
+        let h = inv * Vec4::new(x, y, z, 1.0);
+        if h.w.abs() < 1e-12 {
+            return (f32::INFINITY, h.truncate());
+        }
+        let p = h.truncate() / h.w;
+        (self.forward.dot(p - self.eye), p - self.eye)
+    }
+
+    /// The frustum's four corner rays, each scaled to advance one metre along the view
+    /// (those that do not advance are left out); `inv` is the inverse of `view_proj`.
+    fn corner_rays(&self, inv: Mat4) -> Vec<Vec3> {
+        [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
+            .iter()
+            .filter_map(|&(x, y)| {
+                // A point halfway through the depth range lies on the corner's ray.
+                let (d, r) = self.depth_at(inv, x, y, 0.5);
+                let r = if d < 0.0 { -r } else { r };
+                let along = r.dot(self.forward);
+                (along > 1e-9).then(|| r / along)
+            })
+            .collect()
     }
 
     /// The view depths within `[near, end]` where the view's cross-section meets `band`
@@ -177,16 +190,11 @@ impl ViewSlice {
         }
         let pad = |h: f32| 0.5 + 0.01 * h.abs();
         let (floor, top) = (band.floor - pad(band.floor), band.top + pad(band.top));
-        let inv = self.view_proj.inverse();
-        let slopes: Vec<f32> = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
+        // Each corner ray's height gained per metre of depth.
+        let slopes: Vec<f32> = self
+            .corner_rays(self.view_proj.inverse())
             .iter()
-            .filter_map(|&(x, y)| {
-                let h = inv * Vec4::new(x, y, 0.5, 1.0);
-                let r = h.truncate() / h.w - self.eye;
-                let r = if h.w < 0.0 { -r } else { r };
-                let along = r.dot(self.forward);
-                (along > 1e-9).then(|| r.y / along)
-            })
+            .map(|r| r.y)
             .collect();
         if slopes.len() < 4 {
             return (near, end);
@@ -512,6 +520,9 @@ pub fn caster_planes(
     opts: &ShadowOptions,
     floor: f32,
 ) -> ([[f32; 4]; 6], [f32; 4]) {
+    if !opts.cull_casters {
+        return Default::default();
+    }
     let eye = Vec3::from_slice(&view.eye[..3]);
     let forward = Vec3::from_slice(&view.forward[..3]).normalize_or(Vec3::NEG_Z);
     let margin = 4.0 * c.texel;
@@ -525,9 +536,6 @@ pub fn caster_planes(
         (-forward).extend(at + c.split.1).to_array(),
     ]
     .map(|p| [p[0], p[1], p[2], p[3] + margin]);
-    if !opts.cull_casters {
-        return Default::default();
-    }
     (planes, [floor, opts.reach + 2.0 * c.radius, 0.0, 0.0])
 }
 

@@ -24,6 +24,13 @@ pub struct PassTimes {
     pub draw_ms: f64,
 }
 
+impl PassTimes {
+    /// The three passes together (milliseconds).
+    pub fn total_ms(&self) -> f64 {
+        self.cull_ms + self.refine_ms + self.draw_ms
+    }
+}
+
 /// Counters of the last frame.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameStats {

@@ -259,7 +259,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                         s.visible_trees,
                         s.quads,
                         s.times.map_or("not timed".into(), |t| {
-                            format!("{:.2} ms", t.cull_ms + t.refine_ms + t.draw_ms)
+                            format!("{:.2} ms", t.total_ms())
                         })
                     )
                 })

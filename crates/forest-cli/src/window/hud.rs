@@ -79,9 +79,9 @@ impl Viewer {
                         "shadows, {} cascades: quads {}; cull + refine + cast {} ms",
                         c.len(),
                         join(&|s| s.quads.to_string()),
-                        join(&|s| s.times.map_or("?".into(), |t| {
-                            format!("{:.1}", t.cull_ms + t.refine_ms + t.draw_ms)
-                        })),
+                        join(&|s| s
+                            .times
+                            .map_or("?".into(), |t| { format!("{:.1}", t.total_ms()) })),
                     ));
                 }
                 if !s.per_level.is_empty() {
