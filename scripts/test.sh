@@ -18,3 +18,14 @@ cargo clippy --locked --workspace --all-targets -- -D warnings
 # in every library crate's lib.rs.
 RUSTDOCFLAGS="-D warnings" cargo doc --locked --workspace --no-deps
 cargo test --locked --workspace
+
+# The Bevy plugin lives in its own workspace with its own lock (integrations/forest-bevy):
+# Bevy 0.20 declares Rust 1.97.1 and builds on this toolchain with --ignore-rust-version.
+# Its first build takes most of this script's time (see integrations/forest-bevy/README.md).
+(
+  cd integrations/forest-bevy
+  cargo fmt -- --check
+  cargo clippy --locked --ignore-rust-version --all-targets -- -D warnings
+  RUSTDOCFLAGS="-D warnings" cargo doc --locked --ignore-rust-version --no-deps
+  cargo test --locked --ignore-rust-version
+)

@@ -364,3 +364,63 @@ fn the_geometry_renderer_draws_into_reverse_z_msaa_targets() {
     assert!(flip < 0.05, "FLIP {flip}");
     assert!(img != reference, "4x MSAA changed the edges");
 }
+
+/// With `write_depth`, the quads leave the host their depth where they are opaque and nothing
+/// where no tree is, and the colour is the same as without it; without it, no depth is
+/// written at all (reverse-Z, cleared to 0).
+#[test]
+fn write_depth_leaves_the_trees_opaque_depth_to_the_host() {
+    let ctx = common::ctx();
+    let scene = scene(&ctx);
+    let cam = inside();
+    let frame = reverse_z_frame(&cam);
+    let draw = |write_depth: bool| {
+        let opts = RendererOptions {
+            reverse_z: true,
+            write_depth,
+            ..opts(Background::Transparent)
+        };
+        let mut stream = QuadStream::new(&ctx.device, scene.clone(), &opts).unwrap();
+        let target = Target::new(&ctx, SIZE.0, SIZE.1);
+        stream.prepare(&ctx.queue, &frame).unwrap();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        stream.encode_into(
+            &mut enc,
+            &Targets::cleared(
+                &target.colour_view,
+                &target.depth_view,
+                wgpu::Color::TRANSPARENT,
+                0.0,
+            ),
+        );
+        ctx.queue.submit([enc.finish()]);
+        (target.read(&ctx), target.read_depth(&ctx))
+    };
+    let (plain, no_depth) = draw(false);
+    let (with, depth) = draw(true);
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    assert!(plain == with, "writing depth changed the colour");
+    assert!(
+        no_depth.iter().all(|&d| d == 0.0),
+        "depth written without write_depth"
+    );
+    let (mut empty, mut opaque, mut opaque_written) = (0, 0, 0);
+    for (p, &d) in with.pixels().zip(&depth) {
+        if p.0 == [0; 4] {
+            assert_eq!(d, 0.0, "depth written where no tree is");
+            empty += 1;
+        } else if p.0[3] == 255 {
+            opaque += 1;
+            opaque_written += usize::from(d > 0.0 && d <= 1.0);
+        }
+    }
+    assert!(
+        empty > 500 && opaque > 500,
+        "{empty} empty, {opaque} opaque pixels"
+    );
+    let share = opaque_written as f32 / opaque as f32;
+    assert!(
+        share > 0.9,
+        "only {share} of the opaque pixels have the trees' depth"
+    );
+}

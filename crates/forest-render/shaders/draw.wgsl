@@ -398,6 +398,30 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 
 @fragment
 fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
+    return quad_colour(in);
+}
+
+// The host's depth after the blended quads (`RendererOptions::write_depth`): the same
+// fragments, colour writes off, kept where the quad is at least half opaque.
+@fragment
+fn fs_quad_depth(in: QuadOut) -> @location(0) vec4<f32> {
+    let c = quad_colour(in);
+    if (c.a < DEPTH_WRITE_ALPHA) { discard; }
+    return c;
+}
+
+@fragment
+fn fs_composite_depth(in: CompositeOut) -> @location(0) vec4<f32> {
+    let c = composite_colour(in);
+    if (c.a < DEPTH_WRITE_ALPHA) { discard; }
+    return c;
+}
+
+// Coverage from which the depth pass writes a fragment's depth (mirrors
+// passes::draw::DEPTH_WRITE_ALPHA).
+const DEPTH_WRITE_ALPHA: f32 = 0.5;
+
+fn quad_colour(in: QuadOut) -> vec4<f32> {
     count_enter(in.clip);
     let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
     let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
@@ -411,6 +435,10 @@ fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
+    return composite_colour(in);
+}
+
+fn composite_colour(in: CompositeOut) -> vec4<f32> {
     count_enter(in.clip);
     // The slabs "over" each other from the front (premultiplied), at the quad's mip level.
     // Albedo and surface attributes are composited with the same weights, then lit once.

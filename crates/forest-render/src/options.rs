@@ -61,6 +61,11 @@ pub struct RendererOptions {
     /// Refine the stream (the method). `false` draws the level-0 quads only: the static
     /// impostor baseline (each tree as its 1–3 blended slab images, never subdivided).
     pub refine: bool,
+    /// After the blended quads, draw them again with colour writes off to write the depth of
+    /// their fragments at least [`crate::passes::draw::DEPTH_WRITE_ALPHA`] opaque, so that
+    /// a host's later passes (transparent objects, depth-of-field, fog) see the trees. Off by
+    /// default: the stream itself needs no depth, and the second draw costs fill.
+    pub write_depth: bool,
 }
 
 impl Default for RendererOptions {
@@ -78,6 +83,7 @@ impl Default for RendererOptions {
             background: Background::Sky,
             atmosphere: Atmosphere::CLEAR,
             refine: true,
+            write_depth: false,
         }
     }
 }

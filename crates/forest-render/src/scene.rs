@@ -13,6 +13,7 @@ use crate::gpu_types::{GpuFrame, GpuInstance, GpuSpecies};
 pub const PRESORT_TEXTURE_WIDTH: u32 = 4096;
 
 /// One species ready for upload: its atlas and decoded slab images.
+#[derive(Clone)]
 pub struct SpeciesData {
     /// The atlas.
     pub atlas: Atlas,

@@ -121,7 +121,7 @@ impl Target {
         let depth = make(
             "target depth",
             DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );
         Self {
             colour_view: colour.create_view(&Default::default()),
@@ -137,6 +137,36 @@ impl Target {
     /// targets are swizzled); waits for the GPU.
     pub fn read(&self, ctx: &GpuContext) -> image::RgbaImage {
         let (w, h) = self.size;
+        let data = self.copy_out(ctx, &self.colour, wgpu::TextureAspect::All);
+        let mut img = image::RgbaImage::from_raw(w, h, data).expect("one RGBA8 texel per pixel");
+        if matches!(
+            self.format,
+            wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Bgra8Unorm
+        ) {
+            for p in img.pixels_mut() {
+                p.0.swap(0, 2);
+            }
+        }
+        img
+    }
+
+    /// Read the depth back (one value per pixel, rows top to bottom); waits for the GPU.
+    pub fn read_depth(&self, ctx: &GpuContext) -> Vec<f32> {
+        bytemuck::pod_collect_to_vec(&self.copy_out(
+            ctx,
+            &self.depth,
+            wgpu::TextureAspect::DepthOnly,
+        ))
+    }
+
+    /// The texels of `texture` (4 bytes each, the target's size), rows packed; waits.
+    fn copy_out(
+        &self,
+        ctx: &GpuContext,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+    ) -> Vec<u8> {
+        let (w, h) = self.size;
         let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("target readback"),
@@ -147,10 +177,10 @@ impl Target {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
-                texture: &self.colour,
+                texture,
                 mip_level: 0,
                 origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
+                aspect,
             },
             wgpu::TexelCopyBufferInfo {
                 buffer: &buf,
@@ -167,19 +197,10 @@ impl Target {
             },
         );
         let data = ctx.submit_and_read(enc, &buf);
-        let mut img = image::RgbaImage::new(w, h);
+        let mut out = Vec::with_capacity((w * h * 4) as usize);
         for y in 0..h as usize {
-            let src = &data[y * row as usize..y * row as usize + w as usize * 4];
-            img.as_mut()[y * w as usize * 4..(y + 1) * w as usize * 4].copy_from_slice(src);
+            out.extend_from_slice(&data[y * row as usize..y * row as usize + w as usize * 4]);
         }
-        if matches!(
-            self.format,
-            wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Bgra8Unorm
-        ) {
-            for p in img.pixels_mut() {
-                p.0.swap(0, 2);
-            }
-        }
-        img
+        out
     }
 }

@@ -195,6 +195,11 @@ fn constants_shared_with_the_wgsl_agree() {
     for (src, name, rust) in pairs {
         assert_eq!(layout_check::wgsl_const(src, name), rust, "{name}");
     }
+    assert_eq!(
+        layout_check::wgsl_const(&d, "DEPTH_WRITE_ALPHA"),
+        f64::from(forest_render::passes::draw::DEPTH_WRITE_ALPHA),
+        "DEPTH_WRITE_ALPHA"
+    );
     for (name, view) in [
         ("DEBUG_LEVELS", DebugView::Levels),
         ("DEBUG_WEIGHTS", DebugView::Weights),

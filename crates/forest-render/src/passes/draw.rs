@@ -98,7 +98,14 @@ pub struct DrawPass {
     /// Far trees' composited quads (drawn first).
     composite: wgpu::RenderPipeline,
     quads: wgpu::RenderPipeline,
+    /// The depth-writing draws (composited, plain) when the host asks for the trees' depth
+    /// ([`crate::options::RendererOptions::write_depth`]).
+    depth: Option<[wgpu::RenderPipeline; 2]>,
 }
+
+/// Coverage from which [`crate::options::RendererOptions::write_depth`] writes a quad
+/// fragment's depth (`DEPTH_WRITE_ALPHA` in draw.wgsl).
+pub const DEPTH_WRITE_ALPHA: f32 = 0.5;
 
 impl DrawPass {
     /// Create the pipelines for the host's targets: colour and depth formats, sample count
@@ -161,6 +168,31 @@ impl DrawPass {
                 Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
                 false,
             ),
+            depth: opts.write_depth.then(|| {
+                ["fs_composite_depth", "fs_quad_depth"].map(|fs| {
+                    render_pipeline(
+                        device,
+                        &layout,
+                        &module,
+                        wgpu::PrimitiveTopology::TriangleStrip,
+                        [
+                            if fs == "fs_quad_depth" {
+                                "vs_quad"
+                            } else {
+                                "vs_composite"
+                            },
+                            fs,
+                        ],
+                        opts.depth_stencil(true),
+                        opts.multisample(),
+                        &[Some(wgpu::ColorTargetState {
+                            format: opts.format,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::empty(),
+                        })],
+                    )
+                })
+            }),
             bind_layout,
             shadow_layout,
         }
@@ -262,7 +294,17 @@ impl DrawPass {
         if statistics.is_some() {
             pass.end_pipeline_statistics_query();
         }
-        drawn.len() as u32 + environment
+        // The host's depth: the same draws again, depth written where the trees are opaque
+        // (not while counting: the counts are of the colour draws).
+        let mut depth_draws = 0;
+        if let (Some(depth), None) = (&self.depth, counted) {
+            for (pipeline, (_, offset)) in depth.iter().zip(draws).skip(usize::from(!composite)) {
+                pass.set_pipeline(pipeline);
+                pass.draw_indirect(args_buf, offset);
+                depth_draws += 1;
+            }
+        }
+        drawn.len() as u32 + environment + depth_draws
     }
 }
 

@@ -1,0 +1,56 @@
+//! What a Bevy app puts on its entities: a forest placed by its `Transform`, and per camera
+//! how the forest is drawn into that camera's view.
+
+use bevy::prelude::*;
+
+use crate::assets::ForestAsset;
+
+/// A forest in the scene: its asset, placed by the entity's `Transform` (translation,
+/// rotation and uniform scale; the forest's own +Y stays its up for haze and the sun).
+#[derive(Component, Clone, Debug, Default)]
+#[require(Transform, Visibility)]
+pub struct ForestScene(pub Handle<ForestAsset>);
+
+/// How the forests are drawn into a camera's view. A `Camera3d` without it draws no forest.
+/// Each camera gets its own prepared stream, so split screens and minimaps may differ.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct ForestCamera {
+    /// The method.
+    pub method: ForestMethod,
+    /// Refinement threshold ε, pixels (> 0): a quad is refined while its projected edge is
+    /// longer. Smaller is finer and costs more.
+    pub epsilon: f32,
+}
+
+impl Default for ForestCamera {
+    /// The quad stream at ε = 4 pixels.
+    fn default() -> Self {
+        Self {
+            method: ForestMethod::QuadStream,
+            epsilon: 4.0,
+        }
+    }
+}
+
+/// A rendering method available inside Bevy.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ForestMethod {
+    /// The dynamic quad stream: cull, refine by ε, draw (Liu, Hua & Bao 2010).
+    #[default]
+    QuadStream,
+    /// Static impostors: each tree's level-0 slab images, never refined.
+    Impostors,
+}
+
+impl ForestMethod {
+    /// Every method, in the order a switch cycles through them.
+    pub const ALL: [ForestMethod; 2] = [ForestMethod::QuadStream, ForestMethod::Impostors];
+
+    /// Its short name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ForestMethod::QuadStream => "quad stream",
+            ForestMethod::Impostors => "impostors",
+        }
+    }
+}

@@ -1,0 +1,467 @@
+//! The render world's side: the forests and cameras extracted each frame, one GPU scene per
+//! forest asset on Bevy's own device, one prepared [`QuadStream`] per (camera, forest), and
+//! the draw in the `Core3d` schedule after the main opaque pass.
+//!
+//! ```text
+//! ExtractSchedule  extract          forests (asset, world_from_forest), cameras, sun, ambient
+//! Render/Prepare   prepare_forests  GpuScene per asset; per view: stream (re)built for the
+//!                                   view's format, MSAA, depth and size; camera written
+//! Core3d/MainPass  draw_forests     cull + refine, then quads (blended) and their opaque
+//!                                   depth into the view's target, before transparent meshes
+//! ```
+
+use std::sync::Arc;
+
+use bevy::asset::AssetId;
+use bevy::camera::Camera;
+use bevy::light::{AmbientLight, DirectionalLight, GlobalAmbientLight};
+use bevy::pbr::{DistanceFog, FogFalloff};
+use bevy::platform::collections::{HashMap, HashSet};
+use bevy::prelude::*;
+use bevy::render::Extract;
+use bevy::render::camera::ExtractedCamera;
+use bevy::render::renderer::{
+    RenderAdapterInfo, RenderContext, RenderDevice, RenderQueue, ViewQuery,
+};
+use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
+use forest_render::options::Atmosphere;
+use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
+
+use crate::assets::ForestAsset;
+use crate::components::{ForestCamera, ForestMethod, ForestScene};
+use crate::light;
+use crate::stats::{ForestViewStats, SharedStats};
+
+/// A forest as extracted this frame.
+#[derive(Clone)]
+pub struct ExtractedForest {
+    /// Its main-world entity.
+    pub entity: Entity,
+    /// Its asset.
+    pub asset: AssetId<ForestAsset>,
+    /// World ← forest.
+    pub world_from_forest: Mat4,
+}
+
+/// A camera's forest settings as extracted this frame.
+#[derive(Clone, Copy)]
+pub struct ExtractedForestCamera {
+    /// Method and ε.
+    pub settings: ForestCamera,
+    /// Ambient light, linear colour × brightness (cd/m²).
+    pub ambient: Vec3,
+    /// Its fog, if any: linear colour and falloff.
+    pub fog: Option<(Vec3, light::Falloff)>,
+}
+
+/// What the extract system gathers each frame (rebuilt whole, so nothing stale remains).
+#[derive(Resource, Default)]
+pub struct Extracted {
+    /// Forests with a loaded asset.
+    pub forests: Vec<ExtractedForest>,
+    /// Assets first seen (or changed) since the last frame: the render world builds their
+    /// GPU scenes.
+    pub new_assets: Vec<(AssetId<ForestAsset>, ForestAsset)>,
+    /// Assets no longer loaded.
+    pub removed_assets: Vec<AssetId<ForestAsset>>,
+    /// Cameras with a [`ForestCamera`], by main-world entity.
+    pub cameras: HashMap<Entity, ExtractedForestCamera>,
+    /// The first directional light, in world space.
+    pub sun: Option<light::Sun>,
+}
+
+fn linear(c: Color) -> Vec3 {
+    let l = c.to_linear();
+    Vec3::new(l.red, l.green, l.blue)
+}
+
+fn falloff(f: &FogFalloff) -> light::Falloff {
+    match *f {
+        FogFalloff::Linear { start, end } => light::Falloff::Linear { start, end },
+        FogFalloff::Exponential { density } => light::Falloff::Exponential { density },
+        FogFalloff::ExponentialSquared { density } => {
+            light::Falloff::ExponentialSquared { density }
+        }
+        FogFalloff::Atmospheric { extinction, .. } => light::Falloff::Atmospheric {
+            extinction: Vec3::from_array(extinction.to_array()).to_array().into(),
+        },
+    }
+}
+
+/// ExtractSchedule: the forests, the cameras that draw them, the sun and ambient light.
+#[allow(clippy::type_complexity)]
+pub fn extract(
+    mut out: ResMut<Extracted>,
+    forests: Extract<Query<(Entity, &ForestScene, &GlobalTransform, &InheritedVisibility)>>,
+    assets: Extract<Res<Assets<ForestAsset>>>,
+    mut events: Extract<MessageReader<AssetEvent<ForestAsset>>>,
+    cameras: Extract<
+        Query<(
+            Entity,
+            &Camera,
+            &ForestCamera,
+            Option<&AmbientLight>,
+            Option<&DistanceFog>,
+        )>,
+    >,
+    global_ambient: Extract<Option<Res<GlobalAmbientLight>>>,
+    suns: Extract<Query<(&DirectionalLight, &GlobalTransform, &InheritedVisibility)>>,
+) {
+    out.forests.clear();
+    out.cameras.clear();
+    for event in events.read() {
+        match *event {
+            AssetEvent::LoadedWithDependencies { id } | AssetEvent::Modified { id } => {
+                if let Some(a) = assets.get(id) {
+                    out.new_assets.push((id, a.clone()));
+                }
+            }
+            AssetEvent::Removed { id } | AssetEvent::Unused { id } => out.removed_assets.push(id),
+            _ => {}
+        }
+    }
+    for (entity, scene, transform, visible) in &forests {
+        if visible.get() && assets.contains(scene.0.id()) {
+            out.forests.push(ExtractedForest {
+                entity,
+                asset: scene.0.id(),
+                world_from_forest: transform.to_matrix(),
+            });
+        }
+    }
+    let global = global_ambient
+        .as_ref()
+        .map_or(Vec3::splat(80.0), |a| linear(a.color) * a.brightness);
+    for (entity, camera, settings, ambient, fog) in &cameras {
+        if !camera.is_active {
+            continue;
+        }
+        out.cameras.insert(
+            entity,
+            ExtractedForestCamera {
+                settings: *settings,
+                ambient: ambient.map_or(global, |a| linear(a.color) * a.brightness),
+                fog: fog.map(|f| (linear(f.color), falloff(&f.falloff))),
+            },
+        );
+    }
+    out.sun = suns
+        .iter()
+        .find(|(_, _, v)| v.get())
+        .map(|(l, t, _)| light::Sun {
+            to_light: t.back().as_vec3(),
+            colour: linear(l.color),
+            illuminance: l.illuminance,
+        });
+}
+
+/// What a view's stream was built for; a change rebuilds it.
+#[derive(Clone, Copy, PartialEq)]
+struct StreamKey {
+    asset: AssetId<ForestAsset>,
+    format: wgpu::TextureFormat,
+    depth_format: wgpu::TextureFormat,
+    samples: u32,
+    viewport: (u32, u32),
+    epsilon_bits: u32,
+    atmosphere: [u32; 8],
+}
+
+fn atmosphere_bits(a: &Atmosphere) -> [u32; 8] {
+    [
+        a.visibility.to_bits(),
+        a.haze_height.to_bits(),
+        a.horizon[0].to_bits(),
+        a.horizon[1].to_bits(),
+        a.horizon[2].to_bits(),
+        a.zenith[0].to_bits(),
+        u32::from(a.sun_disc),
+        0,
+    ]
+}
+
+/// One forest's stream in one view.
+struct ViewStream {
+    key: StreamKey,
+    stream: QuadStream,
+    /// Written this frame (only those are drawn).
+    prepared: bool,
+}
+
+/// The render world's forests: Bevy's device as a [`GpuContext`], one GPU scene per asset,
+/// one stream per (camera, forest).
+#[derive(Resource, Default)]
+pub struct ForestRenderState {
+    ctx: Option<GpuContext>,
+    scenes: HashMap<AssetId<ForestAsset>, Arc<GpuScene>>,
+    failed: HashMap<AssetId<ForestAsset>, String>,
+    streams: HashMap<(Entity, Entity), ViewStream>,
+}
+
+impl ForestRenderState {
+    /// Streams prepared for the camera `main` this frame.
+    fn prepared(&self, main: Entity) -> impl Iterator<Item = &QuadStream> {
+        self.streams
+            .iter()
+            .filter(move |((c, _), v)| *c == main && v.prepared)
+            .map(|(_, v)| &v.stream)
+    }
+}
+
+/// Render/Prepare: build the GPU scenes of newly loaded forests, then per camera view and
+/// forest (re)build the stream for the view's targets and write its camera.
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn prepare_forests(
+    mut state: ResMut<ForestRenderState>,
+    mut extracted: ResMut<Extracted>,
+    device: Option<Res<RenderDevice>>,
+    queue: Option<Res<RenderQueue>>,
+    adapter: Option<Res<RenderAdapterInfo>>,
+    shared: Res<SharedStats>,
+    views: Query<(
+        &ExtractedView,
+        &ExtractedCamera,
+        &ViewTarget,
+        &ViewDepthStencilTexture,
+        &Msaa,
+    )>,
+) {
+    // The renderer starts a few frames after the app.
+    let (Some(device), Some(queue), Some(adapter)) = (device, queue, adapter) else {
+        return;
+    };
+    let state = &mut *state;
+    let queue: &wgpu::Queue = &queue;
+    let ctx = state.ctx.get_or_insert_with(|| {
+        GpuContext::from_device(
+            (**adapter).clone(),
+            device.wgpu_device().clone(),
+            queue.clone(),
+        )
+    });
+    for id in extracted.removed_assets.drain(..) {
+        state.scenes.remove(&id);
+        state.failed.remove(&id);
+    }
+    for (id, asset) in extracted.new_assets.drain(..) {
+        let species: Vec<_> = asset.species.iter().map(|s| (**s).clone()).collect();
+        match GpuScene::new(ctx, &species, &asset.forest) {
+            Ok(scene) => {
+                state.scenes.insert(id, Arc::new(scene));
+                state.failed.remove(&id);
+            }
+            Err(e) => {
+                error!("forest {id:?} cannot be drawn: {e}");
+                state.failed.insert(id, e.to_string());
+            }
+        }
+        // Streams of the old scene are rebuilt.
+        state.streams.retain(|_, v| v.key.asset != id);
+    }
+    let mut stats = shared.0.lock().unwrap_or_else(|e| e.into_inner());
+    stats.clear();
+    let mut live = HashSet::new();
+    for v in state.streams.values_mut() {
+        v.prepared = false;
+    }
+    for (view, camera, target, depth, msaa) in &views {
+        let r = &view.retained_view_entity;
+        if r.auxiliary_entity.is_some() || r.subview_index != 0 {
+            continue;
+        }
+        let main = r.main_entity.id();
+        let Some(cam) = extracted.cameras.get(&main) else {
+            continue;
+        };
+        let Some(size) = camera.physical_viewport_size else {
+            continue;
+        };
+        let viewport = (size.x.max(1), size.y.max(1));
+        let world_from_view = view.world_from_view.to_matrix();
+        let clip_from_world = view
+            .clip_from_world
+            .unwrap_or(view.clip_from_view * world_from_view.inverse());
+        let atmosphere = light::atmosphere(cam.fog);
+        for forest in &extracted.forests {
+            let key_pair = (main, forest.entity);
+            let mut record = ForestViewStats::default();
+            let Some(scene) = state.scenes.get(&forest.asset) else {
+                if let Some(e) = state.failed.get(&forest.asset) {
+                    record.error = Some(e.clone());
+                    stats.insert(key_pair, record);
+                }
+                continue;
+            };
+            live.insert(key_pair);
+            let key = StreamKey {
+                asset: forest.asset,
+                format: drawn_format(target.main_texture_format()),
+                depth_format: depth.texture().format(),
+                samples: msaa.samples(),
+                viewport,
+                epsilon_bits: cam.settings.epsilon.to_bits(),
+                atmosphere: atmosphere_bits(&atmosphere),
+            };
+            if state.streams.get(&key_pair).is_none_or(|v| v.key != key) {
+                state.streams.remove(&key_pair);
+                let opts = RendererOptions {
+                    format: key.format,
+                    depth_format: key.depth_format,
+                    sample_count: key.samples,
+                    reverse_z: true,
+                    viewport,
+                    min_epsilon: cam.settings.epsilon,
+                    atmosphere,
+                    write_depth: true,
+                    ..Default::default()
+                };
+                match QuadStream::new(&ctx.device, scene.clone(), &opts) {
+                    Ok(stream) => {
+                        state.streams.insert(
+                            key_pair,
+                            ViewStream {
+                                key,
+                                stream,
+                                prepared: false,
+                            },
+                        );
+                    }
+                    Err(e) => {
+                        record.error = Some(e.to_string());
+                        stats.insert(key_pair, record);
+                        continue;
+                    }
+                }
+            }
+            let Some(v) = state.streams.get_mut(&key_pair) else {
+                continue;
+            };
+            // The forest's frame: the camera moved into the forest's space, so that
+            // clip = P·V·M; the sun turned with it.
+            let forest_from_world = forest.world_from_forest.inverse();
+            let sun = extracted.sun.map(|s| light::Sun {
+                to_light: forest_from_world.transform_vector3(s.to_light),
+                ..s
+            });
+            let lighting = light::lighting(sun, cam.ambient, camera.exposure);
+            let view_from_world = world_from_view.inverse();
+            let frame = FrameParams {
+                view: to_forest(view_from_world * forest.world_from_forest),
+                proj: to_forest(clip_from_world * world_from_view),
+                viewport,
+                epsilon: cam.settings.epsilon,
+                light: lighting,
+            };
+            v.stream
+                .set_refine(cam.settings.method == ForestMethod::QuadStream);
+            // Counters of a recent frame; a stream that overflowed grows (the next frames
+            // draw everything).
+            if let Some(s) = v.stream.poll_stats(&ctx.device, &ctx.queue) {
+                if let Err(e) = v.stream.fit(&ctx.device, &s) {
+                    record.error = Some(e.to_string());
+                }
+                record.visible_trees = s.visible_trees;
+                record.quads = s.quads;
+                record.gpu_ms = s.times.map(|t| t.total_ms());
+            }
+            match v.stream.prepare(&ctx.queue, &frame) {
+                Ok(()) => v.prepared = true,
+                Err(e) => record.error = Some(e.to_string()),
+            }
+            stats.insert(key_pair, record);
+        }
+    }
+    state.streams.retain(|k, _| live.contains(k));
+}
+
+/// The format the forest's pipelines draw a view of `format` in: its sRGB twin for the
+/// 8-bit UNORM formats Bevy keeps sRGB-encoded colour in, else `format` itself.
+fn drawn_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+    match format {
+        wgpu::TextureFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8UnormSrgb,
+        wgpu::TextureFormat::Bgra8Unorm => wgpu::TextureFormat::Bgra8UnormSrgb,
+        other => other,
+    }
+}
+
+/// A Bevy matrix as the forest crates' (Bevy and `forest-render` may use different glam
+/// releases).
+fn to_forest(m: Mat4) -> glam::Mat4 {
+    glam::Mat4::from_cols_array(&m.to_cols_array())
+}
+
+/// Core3d, after the main opaque pass: each forest prepared for this view, culled, refined
+/// and drawn into the view's colour (blended) and depth (where opaque), so Bevy's
+/// transparent pass and post-processing see it.
+pub fn draw_forests(
+    view: ViewQuery<(
+        &ExtractedView,
+        &ExtractedCamera,
+        &ViewTarget,
+        &ViewDepthStencilTexture,
+    )>,
+    state: Res<ForestRenderState>,
+    mut ctx: RenderContext,
+) {
+    let (view, camera, target, depth) = view.into_inner();
+    let r = &view.retained_view_entity;
+    if r.auxiliary_entity.is_some() {
+        return;
+    }
+    let main = r.main_entity.id();
+    // A main texture that holds sRGB-encoded bytes in a UNORM format (Bevy's sRGB
+    // compositing space) is drawn through an sRGB view of it (Bevy allows that view format),
+    // so the forest's linear colours are encoded as Bevy's own are.
+    let format = target.main_texture_format();
+    let srgb = drawn_format(format);
+    let views = (srgb != format).then(|| {
+        let view = |t: &wgpu::Texture| -> wgpu::TextureView {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                format: Some(srgb),
+                ..Default::default()
+            })
+        };
+        (
+            view(target.main_texture()),
+            target.sampled_main_texture().map(|t| view(t)),
+        )
+    });
+    for stream in state.prepared(main) {
+        let colour = match &views {
+            Some((single, multi)) => wgpu::RenderPassColorAttachment {
+                view: multi.as_ref().unwrap_or(single),
+                depth_slice: None,
+                resolve_target: multi.as_ref().map(|_| single),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            },
+            None => target.get_color_attachment(),
+        };
+        let encoder = ctx.command_encoder();
+        stream.encode_compute(encoder);
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("forest"),
+                color_attachments: &[Some(colour)],
+                depth_stencil_attachment: Some(depth.get_attachment(wgpu::StoreOp::Store)),
+                timestamp_writes: stream.draw_timestamps(),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if let Some(vp) = &camera.viewport {
+                pass.set_viewport(
+                    vp.physical_position.x as f32,
+                    vp.physical_position.y as f32,
+                    vp.physical_size.x as f32,
+                    vp.physical_size.y as f32,
+                    vp.depth.start,
+                    vp.depth.end,
+                );
+            }
+            stream.render(&mut pass);
+        }
+        stream.resolve_times(encoder);
+    }
+}

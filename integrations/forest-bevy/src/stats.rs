@@ -1,0 +1,58 @@
+//! The last frame's counters per camera and forest, handed from the render world to the
+//! main world (a shared map the render world writes and [`ForestStats`] copies each frame).
+
+use std::sync::{Arc, Mutex};
+
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+
+/// One forest in one camera's view, as the GPU counted it a few frames ago (read back
+/// without waiting).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ForestViewStats {
+    /// Trees that passed the frustum test.
+    pub visible_trees: u32,
+    /// Quads drawn.
+    pub quads: u32,
+    /// Cull + refine + draw on the GPU, milliseconds (where the device has timestamps).
+    pub gpu_ms: Option<f64>,
+    /// Why the forest is not drawn into this view, if it is not (bad camera, a forest that
+    /// did not reach the GPU).
+    pub error: Option<String>,
+}
+
+/// The frame statistics of every (camera, forest) pair drawn, keyed by the main world's
+/// entities.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct ForestStats {
+    /// (camera, forest) → counters.
+    pub views: HashMap<(Entity, Entity), ForestViewStats>,
+}
+
+impl ForestStats {
+    /// The counters of `forest` in `camera`'s view.
+    pub fn get(&self, camera: Entity, forest: Entity) -> Option<&ForestViewStats> {
+        self.views.get(&(camera, forest))
+    }
+
+    /// Quads drawn in `camera`'s view, over all forests.
+    pub fn quads(&self, camera: Entity) -> u64 {
+        self.views
+            .iter()
+            .filter(|((c, _), _)| *c == camera)
+            .map(|(_, s)| u64::from(s.quads))
+            .sum()
+    }
+}
+
+/// The map both worlds hold: the render world writes it, the main world copies it.
+#[derive(Resource, Clone, Default)]
+pub struct SharedStats(pub Arc<Mutex<HashMap<(Entity, Entity), ForestViewStats>>>);
+
+/// Main world, each frame: copy what the render world last wrote.
+pub fn copy_stats(shared: Res<SharedStats>, mut stats: ResMut<ForestStats>) {
+    let views = shared.0.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    if stats.views != views {
+        stats.views = views;
+    }
+}
