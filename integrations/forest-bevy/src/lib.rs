@@ -6,8 +6,8 @@
 //! against Bevy's reverse-Z depth and writing depth where the trees are opaque, so Bevy's
 //! transparent objects and post-processing see them. Bevy's first visible
 //! `DirectionalLight`, its ambient light and the camera's exposure light the trees
-//! ([`light`]); a camera's `DistanceFog` becomes their haze. [`ForestStats`] holds each
-//! view's counters.
+//! ([`light`]); a camera's `DistanceFog` becomes their haze. The trees cast into that light's
+//! shadow cascades and receive them ([`shadows`]). [`ForestStats`] holds each view's counters.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -32,8 +32,7 @@
 //!     .run();
 //! ```
 //!
-//! Not yet: the forest does not cast into Bevy's directional shadow cascades nor receive
-//! them, and only the quad stream and static impostors are offered (the hybrid needs the
+//! Not yet: only the quad stream and static impostors are offered (the hybrid needs the
 //! geometry renderer of `forest-baselines`, which builds level-of-detail meshes at load).
 
 #![deny(missing_docs)]
@@ -42,10 +41,12 @@ pub mod assets;
 pub mod components;
 pub mod light;
 pub mod render;
+pub mod shadows;
 pub mod stats;
 
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::pbr::{LATE_SHADOW_PASS, per_view_shadow_pass, shared_shadow_pass};
 use bevy::prelude::*;
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 
@@ -79,6 +80,13 @@ impl Plugin for ForestPlugin {
             .add_systems(
                 Render,
                 render::prepare_forests.in_set(RenderSystems::PrepareResources),
+            )
+            .add_systems(
+                Core3d,
+                render::cast_forests
+                    .after(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+                    .after(shared_shadow_pass::<LATE_SHADOW_PASS>)
+                    .before(Core3dSystems::MainPass),
             )
             .add_systems(
                 Core3d,

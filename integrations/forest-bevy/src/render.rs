@@ -15,7 +15,10 @@ use std::sync::Arc;
 use bevy::asset::AssetId;
 use bevy::camera::Camera;
 use bevy::light::{AmbientLight, DirectionalLight, GlobalAmbientLight};
-use bevy::pbr::{DistanceFog, FogFalloff};
+use bevy::pbr::{
+    DistanceFog, ExtractedDirectionalLight, FogFalloff, LightEntity, ShadowView, ViewLightEntities,
+    ViewShadowBindings,
+};
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use bevy::render::Extract;
@@ -30,6 +33,7 @@ use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptio
 use crate::assets::ForestAsset;
 use crate::components::{ForestCamera, ForestMethod, ForestScene};
 use crate::light;
+use crate::shadows;
 use crate::stats::{ForestViewStats, SharedStats};
 
 /// A forest as extracted this frame.
@@ -186,6 +190,28 @@ struct ViewStream {
     stream: QuadStream,
     /// Written this frame (only those are drawn).
     prepared: bool,
+    /// Reading Bevy's shadow maps.
+    receiving: bool,
+    /// The last counters read back.
+    last: Option<ForestViewStats>,
+}
+
+/// What a casting stream was built for.
+#[derive(Clone, Copy, PartialEq)]
+struct CasterKey {
+    asset: AssetId<ForestAsset>,
+    resolution: u32,
+}
+
+/// A casting stream's key: (camera, forest, cascade layer).
+type CasterId = (Entity, Entity, u32);
+
+/// One forest's stream casting into one of a view's cascades.
+struct Caster {
+    key: CasterKey,
+    stream: QuadStream,
+    /// Quads it cast in a recent frame.
+    quads: u32,
 }
 
 /// The render world's forests: Bevy's device as a [`GpuContext`], one GPU scene per asset,
@@ -196,6 +222,10 @@ pub struct ForestRenderState {
     scenes: HashMap<AssetId<ForestAsset>, Arc<GpuScene>>,
     failed: HashMap<AssetId<ForestAsset>, String>,
     streams: HashMap<(Entity, Entity), ViewStream>,
+    /// (camera, forest, cascade layer) → the stream casting into that layer.
+    casters: HashMap<CasterId, Caster>,
+    /// Per camera: the light views to cast into this frame, and their casters.
+    casts: HashMap<Entity, Vec<(Entity, CasterId)>>,
 }
 
 impl ForestRenderState {
@@ -224,7 +254,10 @@ pub fn prepare_forests(
         &ViewTarget,
         &ViewDepthStencilTexture,
         &Msaa,
+        Option<(&ViewLightEntities, &ViewShadowBindings)>,
     )>,
+    light_views: Query<(&ShadowView, &ExtractedView, &LightEntity)>,
+    directional: Query<&ExtractedDirectionalLight>,
 ) {
     // The renderer starts a few frames after the app.
     let (Some(device), Some(queue), Some(adapter)) = (device, queue, adapter) else {
@@ -264,7 +297,9 @@ pub fn prepare_forests(
     for v in state.streams.values_mut() {
         v.prepared = false;
     }
-    for (view, camera, target, depth, msaa) in &views {
+    state.casts.clear();
+    let mut live_casters = HashSet::new();
+    for (view, camera, target, depth, msaa, shadow_maps) in &views {
         let r = &view.retained_view_entity;
         if r.auxiliary_entity.is_some() || r.subview_index != 0 {
             continue;
@@ -323,6 +358,8 @@ pub fn prepare_forests(
                                 key,
                                 stream,
                                 prepared: false,
+                                receiving: false,
+                                last: None,
                             },
                         );
                     }
@@ -357,13 +394,114 @@ pub fn prepare_forests(
             // Counters of a recent frame; a stream that overflowed grows (the next frames
             // draw everything).
             if let Some(s) = v.stream.poll_stats(&ctx.device, &ctx.queue) {
+                let mut fresh = ForestViewStats {
+                    visible_trees: s.visible_trees,
+                    quads: s.quads,
+                    cast_quads: 0,
+                    gpu_ms: s.times.map(|t| t.total_ms()),
+                    error: None,
+                };
                 if let Err(e) = v.stream.fit(&ctx.device, &s) {
-                    record.error = Some(e.to_string());
+                    fresh.error = Some(e.to_string());
                 }
-                record.visible_trees = s.visible_trees;
-                record.quads = s.quads;
-                record.gpu_ms = s.times.map(|t| t.total_ms());
+                v.last = Some(fresh);
             }
+            if let Some(last) = &v.last {
+                record = last.clone();
+            }
+            // Bevy's shadow cascades for this view: received, and cast into.
+            let scale = forest
+                .world_from_forest
+                .to_scale_rotation_translation()
+                .0
+                .max_element();
+            let cascades = shadow_maps.map_or_else(Vec::new, |(lights, _)| {
+                shadows::view_cascades(lights, &light_views, &directional, forest_from_world, scale)
+            });
+            match (cascades.is_empty(), shadow_maps) {
+                (false, Some((_, bindings))) => {
+                    let array = bindings.directional_light_depth_texture.create_view(
+                        &wgpu::TextureViewDescriptor {
+                            dimension: Some(wgpu::TextureViewDimension::D2Array),
+                            base_array_layer: 0,
+                            array_layer_count: Some(cascades.len() as u32),
+                            ..Default::default()
+                        },
+                    );
+                    v.stream.receive_host_shadows(
+                        &ctx.device,
+                        Some((&array, cascades[0].resolution, true)),
+                    );
+                    let host: Vec<_> = cascades.iter().map(|c| c.cascade).collect();
+                    if let Err(e) = v.stream.set_host_cascades(&host) {
+                        record.error = Some(e.to_string());
+                    }
+                    v.receiving = true;
+                }
+                _ if v.receiving => {
+                    v.stream.receive_host_shadows(&ctx.device, None);
+                    v.receiving = false;
+                }
+                _ => {}
+            }
+            for c in &cascades {
+                let key = (main, forest.entity, c.layer);
+                let ckey = CasterKey {
+                    asset: forest.asset,
+                    resolution: c.resolution,
+                };
+                if state.casters.get(&key).is_none_or(|k| k.key != ckey) {
+                    let opts = RendererOptions {
+                        depth_format: wgpu::TextureFormat::Depth32Float,
+                        reverse_z: true,
+                        viewport: (c.resolution, c.resolution),
+                        min_epsilon: forest_render::shadow::ShadowOptions::default().epsilon,
+                        overdraw: 0.25,
+                        ..Default::default()
+                    };
+                    match QuadStream::new(&ctx.device, scene.clone(), &opts) {
+                        Ok(stream) => {
+                            state.casters.insert(
+                                key,
+                                Caster {
+                                    key: ckey,
+                                    stream,
+                                    quads: 0,
+                                },
+                            );
+                        }
+                        Err(e) => {
+                            record.error = Some(format!("shadow caster: {e}"));
+                            continue;
+                        }
+                    }
+                }
+                let Some(caster) = state.casters.get_mut(&key) else {
+                    continue;
+                };
+                if let Some(s) = caster.stream.poll_stats(&ctx.device, &ctx.queue) {
+                    if let Err(e) = caster.stream.fit(&ctx.device, &s) {
+                        record.error = Some(format!("shadow caster: {e}"));
+                    }
+                    caster.quads = s.quads;
+                }
+                record.cast_quads += caster.quads;
+                let light = shadows::light_params(c, lighting.sun_dir, frame.eye());
+                match caster.stream.prepare_light(&ctx.device, &ctx.queue, &light) {
+                    Ok(()) => {
+                        live_casters.insert(key);
+                        state
+                            .casts
+                            .entry(main)
+                            .or_default()
+                            .push((c.light_view, key));
+                    }
+                    Err(e) => record.error = Some(format!("shadow caster: {e}")),
+                }
+            }
+            let Some(v) = state.streams.get_mut(&key_pair) else {
+                continue;
+            };
             match v.stream.prepare(&ctx.queue, &frame) {
                 Ok(()) => v.prepared = true,
                 Err(e) => record.error = Some(e.to_string()),
@@ -372,6 +510,44 @@ pub fn prepare_forests(
         }
     }
     state.streams.retain(|k, _| live.contains(k));
+    state.casters.retain(|k, _| live_casters.contains(k));
+}
+
+/// Core3d, after Bevy's shadow passes and before the main pass: each forest's casting stream
+/// of this view culled and refined from the light, and drawn depth-only into its cascade's
+/// layer of Bevy's directional shadow map.
+pub fn cast_forests(
+    view: ViewQuery<&ExtractedView>,
+    light_views: Query<&ShadowView>,
+    state: Res<ForestRenderState>,
+    mut ctx: RenderContext,
+) {
+    let r = &view.into_inner().retained_view_entity;
+    if r.auxiliary_entity.is_some() {
+        return;
+    }
+    let Some(casts) = state.casts.get(&r.main_entity.id()) else {
+        return;
+    };
+    for (light_view, key) in casts {
+        let (Ok(shadow), Some(caster)) = (light_views.get(*light_view), state.casters.get(key))
+        else {
+            continue;
+        };
+        let encoder = ctx.command_encoder();
+        caster.stream.encode_compute(encoder);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("forest shadow cast"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(
+                shadow.depth_attachment.get_attachment(wgpu::StoreOp::Store),
+            ),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        caster.stream.render_depth(&mut pass);
+    }
 }
 
 /// The format the forest's pipelines draw a view of `format` in: its sRGB twin for the

@@ -14,6 +14,8 @@ pub struct ForestViewStats {
     pub visible_trees: u32,
     /// Quads drawn.
     pub quads: u32,
+    /// Quads cast into Bevy's shadow cascades, over all cascades.
+    pub cast_quads: u32,
     /// Cull + refine + draw on the GPU, milliseconds (where the device has timestamps).
     pub gpu_ms: Option<f64>,
     /// Why the forest is not drawn into this view, if it is not (bad camera, a forest that
