@@ -21,11 +21,14 @@ cargo test --locked --workspace
 
 # The Bevy plugin lives in its own workspace with its own lock (integrations/forest-bevy):
 # Bevy 0.20 declares Rust 1.97.1 and builds on this toolchain with --ignore-rust-version.
-# Its first build takes most of this script's time (see integrations/forest-bevy/README.md).
+# Its first build is a large share of this script's time (see docs/bevy.md).
 (
   cd integrations/forest-bevy
+  start=$SECONDS
   cargo fmt -- --check
   cargo clippy --locked --ignore-rust-version --all-targets -- -D warnings
   RUSTDOCFLAGS="-D warnings" cargo doc --locked --ignore-rust-version --no-deps
   cargo test --locked --ignore-rust-version
+  echo "test: forest-bevy checked, built and tested in $((SECONDS - start)) s;" \
+    "its target: $(du -sh target | cut -f1)"
 )

@@ -402,19 +402,25 @@ fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
 }
 
 // The host's depth after the blended quads (`RendererOptions::write_depth`): the same
-// fragments, colour writes off, kept where the quad is at least half opaque.
+// fragments with their coverage alone (no light), colour writes off, kept where the quad is at
+// least half opaque and not masked out.
 @fragment
 fn fs_quad_depth(in: QuadOut) -> @location(0) vec4<f32> {
-    let c = quad_colour(in);
-    if (c.a < DEPTH_WRITE_ALPHA) { discard; }
-    return c;
+    let a = textureSample(colour, colour_sampler, in.uv, in.ids.x).a * in.alpha;
+    if (a < DEPTH_WRITE_ALPHA || masked(in.clip.xy, in.share)) { discard; }
+    return vec4<f32>(0.0);
 }
 
 @fragment
 fn fs_composite_depth(in: CompositeOut) -> @location(0) vec4<f32> {
-    let c = composite_colour(in);
-    if (c.a < DEPTH_WRITE_ALPHA) { discard; }
-    return c;
+    var a = 0.0;
+    for (var k = 0u; k < in.ids.w; k++) {
+        let uv = slab_uv(in, k);
+        let b = textureSampleLevel(colour, colour_sampler, uv, in.ids.x + k, in.depths.w).a;
+        a = a + b * inside_image(uv) * (1.0 - a);
+    }
+    if (a * in.alpha < DEPTH_WRITE_ALPHA || masked(in.clip.xy, in.share)) { discard; }
+    return vec4<f32>(0.0);
 }
 
 // Coverage from which the depth pass writes a fragment's depth (mirrors
@@ -465,6 +471,17 @@ fn composite_colour(in: CompositeOut) -> vec4<f32> {
     return out;
 }
 
+// Whether the pixel `clip` of a quad whose form share and dither interval are `share` belongs
+// to another form (the hybrid's screen door) or another aspect (the dither).
+fn masked(clip: vec2<f32>, share: vec4<u32>) -> bool {
+    if (share.w < WEIGHT_ONE && form_threshold(clip, share.z) >= share.w) { return true; }
+    if ((stream_flags(camera) & FLAG_DITHER) != 0u) {
+        let u = dither_threshold(clip, share.z);
+        if (u < share.x || u >= share.y) { return true; }
+    }
+    return false;
+}
+
 // A quad's fragment of lit colour `c` (premultiplied): the hybrid's and the dither's masks, the
 // debug views, the haze, the aspect's alpha.
 fn shade(in: Fragment, c: vec4<f32>) -> vec4<f32> {
@@ -472,13 +489,7 @@ fn shade(in: Fragment, c: vec4<f32>) -> vec4<f32> {
     let g = in.uv * f32(1u << in.ids.y);
     let px = max(fwidth(g), vec2<f32>(1e-6));
     let mode = u32(camera.viewport.z);
-    if (in.share.w < WEIGHT_ONE && form_threshold(in.clip.xy, in.share.z) >= in.share.w) {
-        discard;
-    }
-    if ((stream_flags(camera) & FLAG_DITHER) != 0u) {
-        let u = dither_threshold(in.clip.xy, in.share.z);
-        if (u < in.share.x || u >= in.share.y) { discard; }
-    }
+    if (masked(in.clip.xy, in.share)) { discard; }
     if (mode == DEBUG_LEVELS) {
         return vec4<f32>(level_colour(in.ids.y) * c.a, c.a) * in.alpha;
     }

@@ -8,7 +8,8 @@
 //! ```
 //! Keys: W A S D fly, Q E down and up, arrows turn, shift faster; J L turn the sun, I K
 //! raise and lower it; M switches method; [ ] halve and double ε. The title bar shows the
-//! method, ε, quads and frame time.
+//! method, ε, quads and frame time. `--screenshot PATH` saves a frame once the forest is
+//! drawn, and exits.
 
 use std::path::PathBuf;
 
@@ -16,6 +17,7 @@ use bevy::asset::RenderAssetUsages;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
+use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use forest_bevy::{
     ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats,
 };
@@ -31,10 +33,21 @@ struct Pending(Handle<ForestAsset>);
 #[derive(Component)]
 struct Sun;
 
+/// Where to save a screenshot before exiting, and the frames drawn so far.
+#[derive(Resource)]
+struct Shot(PathBuf, u32);
+
 fn main() -> AppExit {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let forest = std::env::args()
-        .nth(1)
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let shot = args
+        .iter()
+        .position(|a| a == "--screenshot")
+        .and_then(|i| args.get(i + 1))
+        .map(PathBuf::from);
+    let forest = args
+        .first()
+        .filter(|a| !a.starts_with("--"))
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("out/forest-100k.forest"));
     if !forest.is_file() {
@@ -50,26 +63,51 @@ fn main() -> AppExit {
         .canonicalize()
         .unwrap();
     let name = forest.file_name().unwrap().to_string_lossy().into_owned();
-    App::new()
-        .add_plugins(DefaultPlugins.set(AssetPlugin {
-            file_path: folder.to_string_lossy().into_owned(),
-            ..default()
-        }))
-        .add_plugins(ForestPlugin)
-        .insert_resource(SunAngles(30.0, 35.0))
-        .insert_resource(GlobalAmbientLight {
-            color: Color::srgb(0.75, 0.85, 1.0),
-            brightness: 1500.0,
-            ..default()
-        })
-        .add_systems(
-            Startup,
-            move |mut commands: Commands, assets: Res<AssetServer>| {
-                setup(&mut commands, &assets, &name)
-            },
-        )
-        .add_systems(Update, (terrain, fly, sun, switch, title))
-        .run()
+    let mut app = App::new();
+    if let Some(path) = shot {
+        app.insert_resource(Shot(path, 0))
+            .add_systems(Update, screenshot);
+    }
+    app.add_plugins(DefaultPlugins.set(AssetPlugin {
+        file_path: folder.to_string_lossy().into_owned(),
+        ..default()
+    }))
+    .add_plugins(ForestPlugin)
+    .insert_resource(SunAngles(30.0, 35.0))
+    .insert_resource(ClearColor(Color::srgb(0.62, 0.72, 0.84)))
+    .insert_resource(GlobalAmbientLight {
+        color: Color::srgb(0.75, 0.85, 1.0),
+        brightness: 1500.0,
+        ..default()
+    })
+    .add_systems(
+        Startup,
+        move |mut commands: Commands, assets: Res<AssetServer>| {
+            setup(&mut commands, &assets, &name)
+        },
+    )
+    .add_systems(Update, (terrain, fly, sun, switch, title))
+    .run()
+}
+
+/// Once the forest has drawn for a while: a screenshot, then exit.
+fn screenshot(
+    mut commands: Commands,
+    mut shot: ResMut<Shot>,
+    stats: Res<ForestStats>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    if stats.views.values().any(|s| s.quads > 0) {
+        shot.1 += 1;
+    }
+    if shot.1 == 4 {
+        commands
+            .spawn(Screenshot::primary_window())
+            .observe(save_to_disk(shot.0.clone()));
+    }
+    if shot.1 > 4 && shot.0.exists() || shot.1 == 60 {
+        exit.write(AppExit::Success);
+    }
 }
 
 fn setup(commands: &mut Commands, assets: &AssetServer, name: &str) {
@@ -78,6 +116,8 @@ fn setup(commands: &mut Commands, assets: &AssetServer, name: &str) {
     commands.spawn(ForestScene(forest));
     commands.spawn((
         Camera3d::default(),
+        // HDR: Bevy's tonemapping pass then maps the trees with everything else.
+        bevy::camera::Hdr,
         Tonemapping::AcesFitted,
         ForestCamera::default(),
         DistanceFog {
@@ -93,6 +133,7 @@ fn setup(commands: &mut Commands, assets: &AssetServer, name: &str) {
         Sun,
         DirectionalLight {
             illuminance: 20_000.0,
+            shadow_maps_enabled: true,
             ..default()
         },
         Transform::default(),

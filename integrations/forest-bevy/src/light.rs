@@ -86,12 +86,17 @@ pub enum Falloff {
     },
 }
 
-/// The forest's haze for a Bevy fog of linear `colour` and `falloff`: homogeneous (Bevy's
+/// The forest's haze for a Bevy fog of linear `colour` and `falloff` under the sky
+/// irradiance `sky` (the [`lighting`]'s, from Bevy's ambient light): homogeneous (Bevy's
 /// distance fog does not thin with height), with the visibility at which Bevy's fog leaves
 /// 2 % of a surface's contrast (Koschmieder's 3.912 optical depths). The forest's haze is
-/// exponential in distance, so Bevy's other falloffs match at that distance only. No fog:
+/// exponential in distance, so Bevy's other falloffs match at that distance only.
+///
+/// Bevy mixes its fog colour into the exposed colour as it is; the forest tints its horizon
+/// colour by the frame's sky irradiance over the default light's (so that a sinking sun dims
+/// the haze), so the horizon given here is the fog colour divided by that tint. No fog:
 /// clear air.
-pub fn atmosphere(fog: Option<(Vec3, Falloff)>) -> Atmosphere {
+pub fn atmosphere(fog: Option<(Vec3, Falloff)>, sky: Vec3) -> Atmosphere {
     let Some((colour, falloff)) = fog else {
         return Atmosphere {
             sun_disc: false,
@@ -104,7 +109,13 @@ pub fn atmosphere(fog: Option<(Vec3, Falloff)>) -> Atmosphere {
         Falloff::ExponentialSquared { density } => KOSCHMIEDER.sqrt() / density,
         Falloff::Atmospheric { extinction } => KOSCHMIEDER / extinction.element_sum() * 3.0,
     };
-    let colour = colour.max(Vec3::ZERO).to_array();
+    let reference = Vec3::from_array(Lighting::default().sky.to_array());
+    let tint = if sky.is_finite() {
+        sky.max(Vec3::splat(1e-6))
+    } else {
+        reference
+    };
+    let colour = (colour.max(Vec3::ZERO) * reference / tint).to_array();
     Atmosphere {
         visibility: if visibility.is_finite() && visibility > 0.0 {
             visibility
@@ -164,31 +175,38 @@ mod tests {
         assert!(bad.validate().is_ok());
     }
 
-    /// Each falloff leaves 2 % contrast at the visibility it is given.
+    /// Each falloff leaves 2 % contrast at the visibility it is given, and the haze's colour,
+    /// once the forest tints it by the sky (`sky_tint` in environment.wgsl), is Bevy's fog
+    /// colour whatever Bevy's light units.
     #[test]
     fn fog_visibility_leaves_two_percent() {
-        let colour = Vec3::splat(0.5);
-        let exp = atmosphere(Some((colour, Falloff::Exponential { density: 0.01 })));
+        let colour = Vec3::new(0.5, 0.6, 0.7);
+        let sky = Vec3::new(800.0, 1000.0, 1500.0);
+        let fog = |falloff| atmosphere(Some((colour, falloff)), sky);
+        let exp = fog(Falloff::Exponential { density: 0.01 });
         assert!(((-0.01 * exp.visibility).exp() - 0.02).abs() < 1e-4);
-        let sq = atmosphere(Some((
-            colour,
-            Falloff::ExponentialSquared { density: 0.01 },
-        )));
+        let sq = fog(Falloff::ExponentialSquared { density: 0.01 });
         assert!(((-(0.01 * sq.visibility).powi(2)).exp() - 0.02).abs() < 1e-4);
-        let lin = atmosphere(Some((
-            colour,
-            Falloff::Linear {
-                start: 10.0,
-                end: 110.0,
-            },
-        )));
+        let lin = fog(Falloff::Linear {
+            start: 10.0,
+            end: 110.0,
+        });
         assert!((1.0 - (lin.visibility - 10.0) / 100.0 - 0.02).abs() < 1e-4);
         assert_eq!(exp.haze_height, f32::INFINITY);
-        assert_eq!(exp.horizon, [0.5; 3]);
+        let reference = Vec3::from_array(Lighting::default().sky.to_array());
+        let seen = Vec3::from_array(exp.horizon) * sky / reference;
+        assert!((seen - colour).abs().max_element() < 1e-4, "{seen}");
         // No fog: no haze.
-        assert_eq!(atmosphere(None).visibility, f32::INFINITY);
-        // Degenerate fog: none rather than a NaN.
-        let zero = atmosphere(Some((colour, Falloff::Exponential { density: 0.0 })));
-        assert_eq!(zero.visibility, f32::INFINITY);
+        assert_eq!(atmosphere(None, sky).visibility, f32::INFINITY);
+        // Degenerate fog or light: no NaN.
+        assert_eq!(
+            fog(Falloff::Exponential { density: 0.0 }).visibility,
+            f32::INFINITY
+        );
+        let dark = atmosphere(
+            Some((colour, Falloff::Exponential { density: 0.01 })),
+            Vec3::ZERO,
+        );
+        assert!(dark.horizon.iter().all(|c| c.is_finite()));
     }
 }

@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 use bevy::asset::AssetId;
 use bevy::camera::Camera;
+use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::light::{AmbientLight, DirectionalLight, GlobalAmbientLight};
 use bevy::pbr::{
     DistanceFog, ExtractedDirectionalLight, FogFalloff, LightEntity, ShadowView, ViewLightEntities,
@@ -168,6 +169,7 @@ struct StreamKey {
     samples: u32,
     viewport: (u32, u32),
     epsilon_bits: u32,
+    write_depth: bool,
     atmosphere: [u32; 8],
 }
 
@@ -226,6 +228,8 @@ pub struct ForestRenderState {
     casters: HashMap<CasterId, Caster>,
     /// Per camera: the light views to cast into this frame, and their casters.
     casts: HashMap<Entity, Vec<(Entity, CasterId)>>,
+    /// Cameras warned about (once each).
+    warned: HashSet<Entity>,
 }
 
 impl ForestRenderState {
@@ -255,6 +259,7 @@ pub fn prepare_forests(
         &ViewDepthStencilTexture,
         &Msaa,
         Option<(&ViewLightEntities, &ViewShadowBindings)>,
+        Option<&Tonemapping>,
     )>,
     light_views: Query<(&ShadowView, &ExtractedView, &LightEntity)>,
     directional: Query<&ExtractedDirectionalLight>,
@@ -299,7 +304,7 @@ pub fn prepare_forests(
     }
     state.casts.clear();
     let mut live_casters = HashSet::new();
-    for (view, camera, target, depth, msaa, shadow_maps) in &views {
+    for (view, camera, target, depth, msaa, shadow_maps, tonemapping) in &views {
         let r = &view.retained_view_entity;
         if r.auxiliary_entity.is_some() || r.subview_index != 0 {
             continue;
@@ -311,12 +316,23 @@ pub fn prepare_forests(
         let Some(size) = camera.physical_viewport_size else {
             continue;
         };
+        // Bevy tonemaps LDR views inside each material's shader; the forest's shaders do not,
+        // so an LDR view with a tonemapper shows the trees untonemapped (HDR views are
+        // tonemapped by Bevy's pass, the trees with the rest).
+        let untonemapped = !camera.hdr && tonemapping.is_some_and(|t| *t != Tonemapping::None);
+        if untonemapped && state.warned.insert(main) {
+            warn!(
+                "forest-bevy: camera {main} draws an LDR view with {tonemapping:?}: Bevy \
+                 tonemaps LDR views in each material's shader and the forest's are not; add \
+                 `Hdr` to the camera (or use `Tonemapping::None`)"
+            );
+        }
         let viewport = (size.x.max(1), size.y.max(1));
         let world_from_view = view.world_from_view.to_matrix();
         let clip_from_world = view
             .clip_from_world
             .unwrap_or(view.clip_from_view * world_from_view.inverse());
-        let atmosphere = light::atmosphere(cam.fog);
+        let atmosphere = light::atmosphere(cam.fog, cam.ambient);
         for forest in &extracted.forests {
             let key_pair = (main, forest.entity);
             let mut record = ForestViewStats::default();
@@ -335,6 +351,7 @@ pub fn prepare_forests(
                 samples: msaa.samples(),
                 viewport,
                 epsilon_bits: cam.settings.epsilon.to_bits(),
+                write_depth: cam.settings.write_depth,
                 atmosphere: atmosphere_bits(&atmosphere),
             };
             if state.streams.get(&key_pair).is_none_or(|v| v.key != key) {
@@ -347,7 +364,7 @@ pub fn prepare_forests(
                     viewport,
                     min_epsilon: cam.settings.epsilon,
                     atmosphere,
-                    write_depth: true,
+                    write_depth: cam.settings.write_depth,
                     ..Default::default()
                 };
                 match QuadStream::new(&ctx.device, scene.clone(), &opts) {

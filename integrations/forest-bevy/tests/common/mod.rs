@@ -324,7 +324,7 @@ fn reference_over(
         sample_count: samples,
         viewport: SIZE,
         min_epsilon: epsilon,
-        atmosphere: forest_bevy::light::atmosphere(None),
+        atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO),
         ..Default::default()
     };
     let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();

@@ -1,0 +1,240 @@
+//! The cost of hosting the forest in Bevy: frame times of a forest view drawn by the plugin
+//! inside a headless Bevy app (the whole `App::update` plus waiting for the GPU) against the
+//! same view drawn by `forest-render` alone (write the camera, cull, refine, draw, wait), in
+//! one run, interleaved, medians of the frames.
+//!
+//! ```sh
+//! cargo run --release --ignore-rust-version --example hosting -- FOREST [--size WxH] [--frames N] [--no-depth]
+//! ```
+//! `--no-depth` draws without `ForestCamera::write_depth`. Bevy's camera draws one sample per
+//! pixel, as `forest-render`'s frame does.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::prelude::*;
+use bevy::render::RenderApp;
+use bevy::render::renderer::RenderDevice;
+use bevy::window::{ExitCondition, WindowPlugin};
+use forest_bevy::{ForestCamera, ForestPlugin, ForestScene, ForestStats};
+use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions, Targets};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+    };
+    let forest_path = PathBuf::from(
+        args.first()
+            .ok_or("usage: hosting FOREST [--size WxH] [--frames N]")?,
+    );
+    let (w, h) = match value("--size") {
+        Some(s) => {
+            let (a, b) = s.split_once('x').ok_or("--size WxH")?;
+            (a.parse()?, b.parse()?)
+        }
+        None => (400u32, 300u32),
+    };
+    let frames: usize = value("--frames").map_or(Ok(7), |s| s.parse())?;
+    let epsilon = 4.0;
+    let write_depth = !args.iter().any(|a| a == "--no-depth");
+    let forest = forest_format::forest::Forest::load(&forest_path)?;
+    let folder = forest_path
+        .parent()
+        .unwrap_or(std::path::Path::new("."))
+        .canonicalize()?;
+    // The example's opening view, and one from 60 m above.
+    let ground = forest.ground_height(0.0, 0.0);
+    let views = [
+        (
+            "inside",
+            Vec3::new(0.0, ground + 4.0, 0.0),
+            Vec3::new(30.0, ground + 2.5, 9.0),
+        ),
+        (
+            "above",
+            Vec3::new(-60.0, ground + 60.0, -60.0),
+            Vec3::new(0.0, ground, 0.0),
+        ),
+    ];
+    // forest-render alone.
+    let ctx = GpuContext::headless()?;
+    let species = forest
+        .species
+        .iter()
+        .map(|s| forest_render::SpeciesData::load(&folder.join(s)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let scene = std::sync::Arc::new(GpuScene::new(&ctx, &species, &forest)?);
+    let target = forest_render::target::Target::new(&ctx, w, h);
+    let opts = RendererOptions {
+        reverse_z: true,
+        viewport: (w, h),
+        min_epsilon: epsilon,
+        atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO),
+        ..Default::default()
+    };
+    let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
+    // Bevy, drawing the same view into an image.
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(AssetPlugin {
+                file_path: folder.to_string_lossy().into_owned(),
+                ..default()
+            })
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .disable::<bevy::winit::WinitPlugin>()
+            .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
+    )
+    .add_plugins(ForestPlugin);
+    while app.plugins_state() == bevy::app::PluginsState::Adding {
+        bevy::tasks::tick_global_task_pools_on_main_thread();
+    }
+    app.finish();
+    app.cleanup();
+    let name = forest_path
+        .file_name()
+        .ok_or("no file name")?
+        .to_string_lossy()
+        .into_owned();
+    let handle = app
+        .world()
+        .resource::<AssetServer>()
+        .load::<forest_bevy::ForestAsset>(name);
+    let forest_entity = app.world_mut().spawn(ForestScene(handle)).id();
+    let image = Image::new_target_texture(w, h, wgpu::TextureFormat::Rgba8UnormSrgb, None);
+    let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
+    let camera = app
+        .world_mut()
+        .spawn((
+            Camera3d::default(),
+            RenderTarget::Image(image.into()),
+            Tonemapping::None,
+            // One sample per pixel, as forest-render's own frame draws (Bevy's default is 4).
+            bevy::render::view::Msaa::Off,
+            ForestCamera {
+                epsilon,
+                write_depth,
+                ..default()
+            },
+        ))
+        .id();
+    // One frame of forest-render alone: the camera, then cull, refine and draw, submitted.
+    let draw_alone = |stream: &mut QuadStream, frame: &FrameParams| {
+        stream.prepare(&ctx.queue, frame)?;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let clear = wgpu::Color::BLACK;
+        let targets = Targets::cleared(&target.colour_view, &target.depth_view, clear, 0.0);
+        stream.encode_into(&mut enc, &targets);
+        ctx.queue.submit([enc.finish()]);
+        Ok::<(), forest_render::RenderError>(())
+    };
+    let wait = |app: &App| {
+        let device = app.sub_app(RenderApp).world().resource::<RenderDevice>();
+        let _ = device
+            .wgpu_device()
+            .poll(wgpu::PollType::wait_indefinitely());
+    };
+    println!(
+        "| view | quads (Bevy) | Bevy frame, ms | Bevy frame without the forest, ms | \
+         forest-render frame, ms | ratio | forest GPU passes in Bevy, ms | alone, ms |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for (label, eye, at) in views {
+        *app.world_mut()
+            .get_mut::<Transform>(camera)
+            .ok_or("camera")? = Transform::from_translation(eye).looking_at(at, Vec3::Y);
+        let world_from_view = Transform::from_translation(eye)
+            .looking_at(at, Vec3::Y)
+            .to_matrix();
+        let proj = bevy::camera::CameraProjection::get_clip_from_view(&PerspectiveProjection {
+            aspect_ratio: w as f32 / h as f32,
+            ..default()
+        });
+        let g = |m: Mat4| glam::Mat4::from_cols_array(&m.to_cols_array());
+        let frame = FrameParams {
+            view: g(world_from_view.inverse()),
+            proj: g(proj),
+            viewport: (w, h),
+            epsilon,
+            light: Default::default(),
+        };
+        // Warm both up until the streams hold the view.
+        for _ in 0..200 {
+            app.update();
+            wait(&app);
+            if app
+                .world()
+                .resource::<ForestStats>()
+                .get(camera, forest_entity)
+                .is_some_and(|s| s.quads > 0)
+            {
+                break;
+            }
+        }
+        for _ in 0..4 {
+            app.update();
+            wait(&app);
+            draw_alone(&mut stream, &frame)?;
+            let stats = stream.read_stats(&ctx);
+            stream.fit(&ctx.device, &stats)?;
+        }
+        let (mut bevy, mut alone) = (Vec::new(), Vec::new());
+        for _ in 0..frames {
+            let t = Instant::now();
+            app.update();
+            wait(&app);
+            bevy.push(t.elapsed().as_secs_f64() * 1e3);
+            let t = Instant::now();
+            draw_alone(&mut stream, &frame)?;
+            let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+            alone.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let quads = app.world().resource::<ForestStats>().quads(camera);
+        let hosted_gpu = app
+            .world()
+            .resource::<ForestStats>()
+            .get(camera, forest_entity)
+            .and_then(|s| s.gpu_ms)
+            .unwrap_or(f64::NAN);
+        let alone_gpu = stream
+            .read_stats(&ctx)
+            .times
+            .map_or(f64::NAN, |t| t.total_ms());
+        // Bevy's own frame: the same camera without the forest.
+        app.world_mut().entity_mut(camera).remove::<ForestCamera>();
+        let mut empty = Vec::new();
+        for k in 0..frames + 2 {
+            let t = Instant::now();
+            app.update();
+            wait(&app);
+            if k >= 2 {
+                empty.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        app.world_mut().entity_mut(camera).insert(ForestCamera {
+            epsilon,
+            write_depth,
+            ..default()
+        });
+        let (b, a, e) = (median(bevy), median(alone), median(empty));
+        println!(
+            "| {label} | {quads} | {b:.1} | {e:.1} | {a:.1} | {:.2} | {hosted_gpu:.1} | {alone_gpu:.1} |",
+            b / a
+        );
+    }
+    Ok(())
+}
