@@ -1,164 +1,27 @@
-//! The render world's side: the forests and cameras extracted each frame, one GPU scene per
-//! forest asset on Bevy's own device, one prepared [`QuadStream`] per (camera, forest), and
-//! the draw in the `Core3d` schedule after the main opaque pass.
-//!
-//! ```text
-//! ExtractSchedule  extract          forests (asset, world_from_forest), cameras, sun, ambient
-//! Render/Prepare   prepare_forests  GpuScene per asset; per view: stream (re)built for the
-//!                                   view's format, MSAA, depth and size; camera written
-//! Core3d/MainPass  draw_forests     cull + refine, then quads (blended) and their opaque
-//!                                   depth into the view's target, before transparent meshes
-//! ```
+//! Render/Prepare: one GPU scene per forest asset on Bevy's device, one stream per (camera,
+//! forest) sized for the view, its camera and Bevy's cascades written.
 
 use std::sync::Arc;
 
 use bevy::asset::AssetId;
-use bevy::camera::Camera;
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::light::{AmbientLight, DirectionalLight, GlobalAmbientLight};
 use bevy::pbr::{
-    DistanceFog, ExtractedDirectionalLight, FogFalloff, LightEntity, ShadowView, ViewLightEntities,
-    ViewShadowBindings,
+    ExtractedDirectionalLight, LightEntity, ShadowView, ViewLightEntities, ViewShadowBindings,
 };
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
-use bevy::render::Extract;
 use bevy::render::camera::ExtractedCamera;
-use bevy::render::renderer::{
-    RenderAdapterInfo, RenderContext, RenderDevice, RenderQueue, ViewQuery,
-};
+use bevy::render::renderer::{RenderAdapterInfo, RenderDevice, RenderQueue};
 use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
 use forest_render::options::Atmosphere;
 use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
 
+use super::extract::Extracted;
 use crate::assets::ForestAsset;
-use crate::components::{ForestCamera, ForestMethod, ForestScene};
+use crate::components::ForestMethod;
 use crate::light;
 use crate::shadows;
 use crate::stats::{ForestViewStats, SharedStats};
-
-/// A forest as extracted this frame.
-#[derive(Clone)]
-pub struct ExtractedForest {
-    /// Its main-world entity.
-    pub entity: Entity,
-    /// Its asset.
-    pub asset: AssetId<ForestAsset>,
-    /// World ← forest.
-    pub world_from_forest: Mat4,
-}
-
-/// A camera's forest settings as extracted this frame.
-#[derive(Clone, Copy)]
-pub struct ExtractedForestCamera {
-    /// Method and ε.
-    pub settings: ForestCamera,
-    /// Ambient light, linear colour × brightness (cd/m²).
-    pub ambient: Vec3,
-    /// Its fog, if any: linear colour and falloff.
-    pub fog: Option<(Vec3, light::Falloff)>,
-}
-
-/// What the extract system gathers each frame (rebuilt whole, so nothing stale remains).
-#[derive(Resource, Default)]
-pub struct Extracted {
-    /// Forests with a loaded asset.
-    pub forests: Vec<ExtractedForest>,
-    /// Assets first seen (or changed) since the last frame: the render world builds their
-    /// GPU scenes.
-    pub new_assets: Vec<(AssetId<ForestAsset>, ForestAsset)>,
-    /// Assets no longer loaded.
-    pub removed_assets: Vec<AssetId<ForestAsset>>,
-    /// Cameras with a [`ForestCamera`], by main-world entity.
-    pub cameras: HashMap<Entity, ExtractedForestCamera>,
-    /// The first directional light, in world space.
-    pub sun: Option<light::Sun>,
-}
-
-fn linear(c: Color) -> Vec3 {
-    let l = c.to_linear();
-    Vec3::new(l.red, l.green, l.blue)
-}
-
-fn falloff(f: &FogFalloff) -> light::Falloff {
-    match *f {
-        FogFalloff::Linear { start, end } => light::Falloff::Linear { start, end },
-        FogFalloff::Exponential { density } => light::Falloff::Exponential { density },
-        FogFalloff::ExponentialSquared { density } => {
-            light::Falloff::ExponentialSquared { density }
-        }
-        FogFalloff::Atmospheric { extinction, .. } => light::Falloff::Atmospheric {
-            extinction: Vec3::from_array(extinction.to_array()).to_array().into(),
-        },
-    }
-}
-
-/// ExtractSchedule: the forests, the cameras that draw them, the sun and ambient light.
-#[allow(clippy::type_complexity)]
-pub fn extract(
-    mut out: ResMut<Extracted>,
-    forests: Extract<Query<(Entity, &ForestScene, &GlobalTransform, &InheritedVisibility)>>,
-    assets: Extract<Res<Assets<ForestAsset>>>,
-    mut events: Extract<MessageReader<AssetEvent<ForestAsset>>>,
-    cameras: Extract<
-        Query<(
-            Entity,
-            &Camera,
-            &ForestCamera,
-            Option<&AmbientLight>,
-            Option<&DistanceFog>,
-        )>,
-    >,
-    global_ambient: Extract<Option<Res<GlobalAmbientLight>>>,
-    suns: Extract<Query<(&DirectionalLight, &GlobalTransform, &InheritedVisibility)>>,
-) {
-    out.forests.clear();
-    out.cameras.clear();
-    for event in events.read() {
-        match *event {
-            AssetEvent::LoadedWithDependencies { id } | AssetEvent::Modified { id } => {
-                if let Some(a) = assets.get(id) {
-                    out.new_assets.push((id, a.clone()));
-                }
-            }
-            AssetEvent::Removed { id } | AssetEvent::Unused { id } => out.removed_assets.push(id),
-            _ => {}
-        }
-    }
-    for (entity, scene, transform, visible) in &forests {
-        if visible.get() && assets.contains(scene.0.id()) {
-            out.forests.push(ExtractedForest {
-                entity,
-                asset: scene.0.id(),
-                world_from_forest: transform.to_matrix(),
-            });
-        }
-    }
-    let global = global_ambient
-        .as_ref()
-        .map_or(Vec3::splat(80.0), |a| linear(a.color) * a.brightness);
-    for (entity, camera, settings, ambient, fog) in &cameras {
-        if !camera.is_active {
-            continue;
-        }
-        out.cameras.insert(
-            entity,
-            ExtractedForestCamera {
-                settings: *settings,
-                ambient: ambient.map_or(global, |a| linear(a.color) * a.brightness),
-                fog: fog.map(|f| (linear(f.color), falloff(&f.falloff))),
-            },
-        );
-    }
-    out.sun = suns
-        .iter()
-        .find(|(_, _, v)| v.get())
-        .map(|(l, t, _)| light::Sun {
-            to_light: t.back().as_vec3(),
-            colour: linear(l.color),
-            illuminance: l.illuminance,
-        });
-}
 
 /// What a view's stream was built for; a change rebuilds it.
 #[derive(Clone, Copy, PartialEq)]
@@ -187,7 +50,7 @@ fn atmosphere_bits(a: &Atmosphere) -> [u32; 8] {
 }
 
 /// One forest's stream in one view.
-struct ViewStream {
+pub(super) struct ViewStream {
     key: StreamKey,
     stream: QuadStream,
     /// Written this frame (only those are drawn).
@@ -206,12 +69,12 @@ struct CasterKey {
 }
 
 /// A casting stream's key: (camera, forest, cascade layer).
-type CasterId = (Entity, Entity, u32);
+pub(super) type CasterId = (Entity, Entity, u32);
 
 /// One forest's stream casting into one of a view's cascades.
-struct Caster {
+pub(super) struct Caster {
     key: CasterKey,
-    stream: QuadStream,
+    pub(super) stream: QuadStream,
     /// Quads it cast in a recent frame.
     quads: u32,
 }
@@ -225,16 +88,16 @@ pub struct ForestRenderState {
     failed: HashMap<AssetId<ForestAsset>, String>,
     streams: HashMap<(Entity, Entity), ViewStream>,
     /// (camera, forest, cascade layer) → the stream casting into that layer.
-    casters: HashMap<CasterId, Caster>,
+    pub(super) casters: HashMap<CasterId, Caster>,
     /// Per camera: the light views to cast into this frame, and their casters.
-    casts: HashMap<Entity, Vec<(Entity, CasterId)>>,
+    pub(super) casts: HashMap<Entity, Vec<(Entity, CasterId)>>,
     /// Cameras warned about (once each).
     warned: HashSet<Entity>,
 }
 
 impl ForestRenderState {
     /// Streams prepared for the camera `main` this frame.
-    fn prepared(&self, main: Entity) -> impl Iterator<Item = &QuadStream> {
+    pub(super) fn prepared(&self, main: Entity) -> impl Iterator<Item = &QuadStream> {
         self.streams
             .iter()
             .filter(move |((c, _), v)| *c == main && v.prepared)
@@ -530,46 +393,9 @@ pub fn prepare_forests(
     state.casters.retain(|k, _| live_casters.contains(k));
 }
 
-/// Core3d, after Bevy's shadow passes and before the main pass: each forest's casting stream
-/// of this view culled and refined from the light, and drawn depth-only into its cascade's
-/// layer of Bevy's directional shadow map.
-pub fn cast_forests(
-    view: ViewQuery<&ExtractedView>,
-    light_views: Query<&ShadowView>,
-    state: Res<ForestRenderState>,
-    mut ctx: RenderContext,
-) {
-    let r = &view.into_inner().retained_view_entity;
-    if r.auxiliary_entity.is_some() {
-        return;
-    }
-    let Some(casts) = state.casts.get(&r.main_entity.id()) else {
-        return;
-    };
-    for (light_view, key) in casts {
-        let (Ok(shadow), Some(caster)) = (light_views.get(*light_view), state.casters.get(key))
-        else {
-            continue;
-        };
-        let encoder = ctx.command_encoder();
-        caster.stream.encode_compute(encoder);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("forest shadow cast"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(
-                shadow.depth_attachment.get_attachment(wgpu::StoreOp::Store),
-            ),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        caster.stream.render_depth(&mut pass);
-    }
-}
-
 /// The format the forest's pipelines draw a view of `format` in: its sRGB twin for the
 /// 8-bit UNORM formats Bevy keeps sRGB-encoded colour in, else `format` itself.
-fn drawn_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+pub(super) fn drawn_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
     match format {
         wgpu::TextureFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8UnormSrgb,
         wgpu::TextureFormat::Bgra8Unorm => wgpu::TextureFormat::Bgra8UnormSrgb,
@@ -581,80 +407,4 @@ fn drawn_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
 /// releases).
 fn to_forest(m: Mat4) -> glam::Mat4 {
     glam::Mat4::from_cols_array(&m.to_cols_array())
-}
-
-/// Core3d, after the main opaque pass: each forest prepared for this view, culled, refined
-/// and drawn into the view's colour (blended) and depth (where opaque), so Bevy's
-/// transparent pass and post-processing see it.
-pub fn draw_forests(
-    view: ViewQuery<(
-        &ExtractedView,
-        &ExtractedCamera,
-        &ViewTarget,
-        &ViewDepthStencilTexture,
-    )>,
-    state: Res<ForestRenderState>,
-    mut ctx: RenderContext,
-) {
-    let (view, camera, target, depth) = view.into_inner();
-    let r = &view.retained_view_entity;
-    if r.auxiliary_entity.is_some() {
-        return;
-    }
-    let main = r.main_entity.id();
-    // A main texture that holds sRGB-encoded bytes in a UNORM format (Bevy's sRGB
-    // compositing space) is drawn through an sRGB view of it (Bevy allows that view format),
-    // so the forest's linear colours are encoded as Bevy's own are.
-    let format = target.main_texture_format();
-    let srgb = drawn_format(format);
-    let views = (srgb != format).then(|| {
-        let view = |t: &wgpu::Texture| -> wgpu::TextureView {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                format: Some(srgb),
-                ..Default::default()
-            })
-        };
-        (
-            view(target.main_texture()),
-            target.sampled_main_texture().map(|t| view(t)),
-        )
-    });
-    for stream in state.prepared(main) {
-        let colour = match &views {
-            Some((single, multi)) => wgpu::RenderPassColorAttachment {
-                view: multi.as_ref().unwrap_or(single),
-                depth_slice: None,
-                resolve_target: multi.as_ref().map(|_| single),
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            },
-            None => target.get_color_attachment(),
-        };
-        let encoder = ctx.command_encoder();
-        stream.encode_compute(encoder);
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("forest"),
-                color_attachments: &[Some(colour)],
-                depth_stencil_attachment: Some(depth.get_attachment(wgpu::StoreOp::Store)),
-                timestamp_writes: stream.draw_timestamps(),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if let Some(vp) = &camera.viewport {
-                pass.set_viewport(
-                    vp.physical_position.x as f32,
-                    vp.physical_position.y as f32,
-                    vp.physical_size.x as f32,
-                    vp.physical_size.y as f32,
-                    vp.depth.start,
-                    vp.depth.end,
-                );
-            }
-            stream.render(&mut pass);
-        }
-        stream.resolve_times(encoder);
-    }
 }
