@@ -398,7 +398,43 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 
 @fragment
 fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
-    return quad_colour(in);
+    count_enter(in.clip);
+    let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
+    let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
+    // The crown's own shadow (the march) times the other casters' (the sun's shadow map).
+    let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
+                     in.frame_up, in.sun_vis * tree_shadow(in.world, in.tree));
+    let out = shade(f, lit_texel(f, c, g));
+    count_shown(in.clip, out.a);
+    return out;
+}
+
+@fragment
+fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
+    count_enter(in.clip);
+    // The slabs "over" each other from the front (premultiplied), at the quad's mip level.
+    // Albedo and surface attributes are composited with the same weights, then lit once.
+    var c = vec4<f32>(0.0);
+    var g = vec4<f32>(0.0);
+    var front = 0.0;
+    for (var k = 0u; k < in.ids.w; k++) {
+        let uv = slab_uv(in, k);
+        let w = inside_image(uv) * (1.0 - c.a);
+        let b = textureSampleLevel(colour, colour_sampler, uv, in.ids.x + k, in.depths.w);
+        g = g + textureSampleLevel(surface, colour_sampler, uv, in.ids.x + k, in.depths.w) * w;
+        c = c + b * w;
+        if (k == 0u) { front = c.a; }
+    }
+    // The march starts where the pixel's coverage lies: on the front slab's plane, moved
+    // towards the second's by the share the slabs behind the front one add.
+    let p = mix(in.obj_front, in.obj_back, (c.a - front) / max(c.a, 1e-6));
+    let vis = sun_transmittance_coarse(opacity, colour_sampler, in.species, in.sphere,
+                                       in.sun_obj.w, p, in.sun_obj.xyz);
+    let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
+                     in.frame_up, vis * tree_shadow(in.world, in.tree));
+    let out = shade(f, lit_texel(f, c, g));
+    count_shown(in.clip, out.a);
+    return out;
 }
 
 // The host's depth after the blended quads (`RendererOptions::write_depth`): the same
@@ -426,50 +462,6 @@ fn fs_composite_depth(in: CompositeOut) -> @location(0) vec4<f32> {
 // Coverage from which the depth pass writes a fragment's depth (mirrors
 // passes::draw::DEPTH_WRITE_ALPHA).
 const DEPTH_WRITE_ALPHA: f32 = 0.5;
-
-fn quad_colour(in: QuadOut) -> vec4<f32> {
-    count_enter(in.clip);
-    let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
-    let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
-    // The crown's own shadow (the march) times the other casters' (the sun's shadow map).
-    let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, in.sun_vis * tree_shadow(in.world, in.tree));
-    let out = shade(f, lit_texel(f, c, g));
-    count_shown(in.clip, out.a);
-    return out;
-}
-
-@fragment
-fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
-    return composite_colour(in);
-}
-
-fn composite_colour(in: CompositeOut) -> vec4<f32> {
-    count_enter(in.clip);
-    // The slabs "over" each other from the front (premultiplied), at the quad's mip level.
-    // Albedo and surface attributes are composited with the same weights, then lit once.
-    var c = vec4<f32>(0.0);
-    var g = vec4<f32>(0.0);
-    var front = 0.0;
-    for (var k = 0u; k < in.ids.w; k++) {
-        let uv = slab_uv(in, k);
-        let w = inside_image(uv) * (1.0 - c.a);
-        let b = textureSampleLevel(colour, colour_sampler, uv, in.ids.x + k, in.depths.w);
-        g = g + textureSampleLevel(surface, colour_sampler, uv, in.ids.x + k, in.depths.w) * w;
-        c = c + b * w;
-        if (k == 0u) { front = c.a; }
-    }
-    // The march starts where the pixel's coverage lies: on the front slab's plane, moved
-    // towards the second's by the share the slabs behind the front one add.
-    let p = mix(in.obj_front, in.obj_back, (c.a - front) / max(c.a, 1e-6));
-    let vis = sun_transmittance_coarse(opacity, colour_sampler, in.species, in.sphere,
-                                       in.sun_obj.w, p, in.sun_obj.xyz);
-    let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, vis * tree_shadow(in.world, in.tree));
-    let out = shade(f, lit_texel(f, c, g));
-    count_shown(in.clip, out.a);
-    return out;
-}
 
 // Whether the pixel `clip` of a quad whose form share and dither interval are `share` belongs
 // to another form (the hybrid's screen door) or another aspect (the dither).

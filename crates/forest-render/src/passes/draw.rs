@@ -169,20 +169,17 @@ impl DrawPass {
                 false,
             ),
             depth: opts.write_depth.then(|| {
-                ["fs_composite_depth", "fs_quad_depth"].map(|fs| {
+                [
+                    ["vs_composite", "fs_composite_depth"],
+                    ["vs_quad", "fs_quad_depth"],
+                ]
+                .map(|entries| {
                     render_pipeline(
                         device,
                         &layout,
                         &module,
                         wgpu::PrimitiveTopology::TriangleStrip,
-                        [
-                            if fs == "fs_quad_depth" {
-                                "vs_quad"
-                            } else {
-                                "vs_composite"
-                            },
-                            fs,
-                        ],
+                        entries,
                         opts.depth_stencil(true),
                         opts.multisample(),
                         &[Some(wgpu::ColorTargetState {
