@@ -156,8 +156,9 @@ pub fn prepare_forests(
                 state.failed.insert(id, e.to_string());
             }
         }
-        // Streams of the old scene are rebuilt.
+        // Streams of the old scene are rebuilt, the casting ones too.
         state.streams.retain(|_, v| v.key.asset != id);
+        state.casters.retain(|_, c| c.key.asset != id);
     }
     let mut stats = shared.0.lock().unwrap_or_else(|e| e.into_inner());
     stats.clear();
