@@ -59,7 +59,7 @@ pub struct ForestAsset {
     /// The instances and terrain.
     pub forest: Arc<Forest>,
     /// One atlas per species, in the forest's species order.
-    pub species: Vec<Arc<SpeciesData>>,
+    pub species: Arc<[SpeciesData]>,
 }
 
 /// Loads atlas folders (`*.atlas`).
@@ -87,7 +87,6 @@ impl AssetLoader for AtlasLoader {
                 .with_source(folder.source().clone_owned())
                 .into_owned();
             match load_context.read_asset_bytes(path).await {
-                Ok(bytes) => files.push((name, bytes)),
                 Err(e) if name == MANIFEST_FILE => {
                     return Err(FormatError::invalid(
                         &shown,
@@ -98,15 +97,17 @@ impl AssetLoader for AtlasLoader {
                     )
                     .into());
                 }
-                Err(_) => {}
+                // Kept with its cause: it matters only if the manifest names this file.
+                read => files.push((name, read.map_err(|e| e.to_string()))),
             }
         }
-        let read = |name: &str| {
-            files
-                .iter()
-                .find(|(n, _)| *n == name)
-                .map(|(_, b)| b.clone())
-                .ok_or_else(|| FormatError::invalid(shown.join(name), "missing from the atlas"))
+        let read = |name: &str| match files.iter().find(|(n, _)| *n == name) {
+            Some((_, Ok(bytes))) => Ok(bytes.clone()),
+            Some((_, Err(cause))) => Err(FormatError::invalid(shown.join(name), cause.clone())),
+            None => Err(FormatError::invalid(
+                shown.join(name),
+                "missing from the atlas",
+            )),
         };
         let atlas = Atlas::from_files(&shown, &read)?;
         let data =
@@ -162,11 +163,13 @@ impl AssetLoader for ForestLoader {
                 .load_value::<ForestAtlas>(atlas_path)
                 .await
                 .map_err(|e| fail(cause_of(&e)))?;
-            species.push(loaded.get().data.clone());
+            // The nested load's asset is this forest's alone: taken, not copied.
+            let data = loaded.take().data;
+            species.push(Arc::try_unwrap(data).unwrap_or_else(|shared| (*shared).clone()));
         }
         Ok(ForestAsset {
             forest: Arc::new(forest),
-            species,
+            species: species.into(),
         })
     }
 

@@ -18,6 +18,11 @@ pub fn to_forest(v: Vec3) -> glam::Vec3 {
     glam::Vec3::from_array(v.to_array())
 }
 
+/// A Bevy matrix as the forest crates' (see [`to_forest`]).
+pub fn mat_to_forest(m: bevy::math::Mat4) -> glam::Mat4 {
+    glam::Mat4::from_cols_array(&m.to_cols_array())
+}
+
 /// A directional light as Bevy describes it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sun {

@@ -31,13 +31,13 @@ pub struct HostCascade {
 }
 
 /// The shadow-casting directional light's cascades of a camera view, in the forest's frame
-/// (`forest_from_world`, whose uniform scale is `scale`); empty when no directional light
+/// (`world_from_forest`, whose uniform scale is `scale`); empty when no directional light
 /// casts shadows there.
 pub fn view_cascades(
     lights: &ViewLightEntities,
     light_views: &Query<(&ShadowView, &ExtractedView, &LightEntity)>,
     directional: &Query<&ExtractedDirectionalLight>,
-    forest_from_world: Mat4,
+    world_from_forest: Mat4,
     scale: f32,
 ) -> Vec<HostCascade> {
     let mut out = Vec::new();
@@ -86,7 +86,7 @@ pub fn view_cascades(
                 split: (near / scale, far / scale),
                 centre: glam::Vec3::ZERO,
                 radius: 0.5 * texel * resolution as f32 / scale,
-                view_proj: to_forest(clip_from_world * forest_from_world.inverse()),
+                view_proj: crate::light::mat_to_forest(clip_from_world * world_from_forest),
                 texel: texel / scale,
                 depth_range: r.recip() / scale,
             },
@@ -109,8 +109,4 @@ pub fn light_params(c: &HostCascade, to_light: glam::Vec3, view_eye: glam::Vec3)
         epsilon: ShadowOptions::default().epsilon,
         view_eye,
     }
-}
-
-fn to_forest(m: Mat4) -> glam::Mat4 {
-    glam::Mat4::from_cols_array(&m.to_cols_array())
 }

@@ -13,7 +13,6 @@ use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderAdapterInfo, RenderDevice, RenderQueue};
 use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
-use forest_render::options::Atmosphere;
 use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
 
 use super::extract::Extracted;
@@ -23,49 +22,17 @@ use crate::light;
 use crate::shadows;
 use crate::stats::{ForestViewStats, SharedStats};
 
-/// What a view's stream was built for; a change rebuilds it.
-#[derive(Clone, Copy, PartialEq)]
-struct StreamKey {
-    asset: AssetId<ForestAsset>,
-    format: wgpu::TextureFormat,
-    depth_format: wgpu::TextureFormat,
-    samples: u32,
-    viewport: (u32, u32),
-    epsilon_bits: u32,
-    write_depth: bool,
-    atmosphere: [u32; 8],
-}
-
-fn atmosphere_bits(a: &Atmosphere) -> [u32; 8] {
-    [
-        a.visibility.to_bits(),
-        a.haze_height.to_bits(),
-        a.horizon[0].to_bits(),
-        a.horizon[1].to_bits(),
-        a.horizon[2].to_bits(),
-        a.zenith[0].to_bits(),
-        u32::from(a.sun_disc),
-        0,
-    ]
-}
-
 /// One forest's stream in one view.
 pub(super) struct ViewStream {
-    key: StreamKey,
+    /// The asset its scene is of (it is rebuilt when that or its options change).
+    asset: AssetId<ForestAsset>,
     stream: QuadStream,
     /// Written this frame (only those are drawn).
     prepared: bool,
-    /// Reading Bevy's shadow maps.
-    receiving: bool,
+    /// The Bevy shadow map (and its cascade count) it reads, if any.
+    receiving: Option<(wgpu::Texture, usize)>,
     /// The last counters read back.
     last: Option<ForestViewStats>,
-}
-
-/// What a casting stream was built for.
-#[derive(Clone, Copy, PartialEq)]
-struct CasterKey {
-    asset: AssetId<ForestAsset>,
-    resolution: u32,
 }
 
 /// A casting stream's key: (camera, forest, cascade layer).
@@ -73,7 +40,8 @@ pub(super) type CasterId = (Entity, Entity, u32);
 
 /// One forest's stream casting into one of a view's cascades.
 pub(super) struct Caster {
-    key: CasterKey,
+    /// The asset its scene is of (it is rebuilt when that or its options change).
+    asset: AssetId<ForestAsset>,
     pub(super) stream: QuadStream,
     /// Quads it cast in a recent frame.
     quads: u32,
@@ -145,8 +113,7 @@ pub fn prepare_forests(
         state.failed.remove(&id);
     }
     for (id, asset) in extracted.new_assets.drain(..) {
-        let species: Vec<_> = asset.species.iter().map(|s| (**s).clone()).collect();
-        match GpuScene::new(ctx, &species, &asset.forest) {
+        match GpuScene::new(ctx, &asset.species, &asset.forest) {
             Ok(scene) => {
                 state.scenes.insert(id, Arc::new(scene));
                 state.failed.remove(&id);
@@ -157,8 +124,8 @@ pub fn prepare_forests(
             }
         }
         // Streams of the old scene are rebuilt, the casting ones too.
-        state.streams.retain(|_, v| v.key.asset != id);
-        state.casters.retain(|_, c| c.key.asset != id);
+        state.streams.retain(|_, v| v.asset != id);
+        state.casters.retain(|_, c| c.asset != id);
     }
     let mut stats = shared.0.lock().unwrap_or_else(|e| e.into_inner());
     stats.clear();
@@ -208,43 +175,34 @@ pub fn prepare_forests(
                 continue;
             };
             live.insert(key_pair);
-            let key = StreamKey {
-                asset: forest.asset,
+            let opts = RendererOptions {
                 format: drawn_format(target.main_texture_format()),
                 depth_format: depth.texture().format(),
-                samples: msaa.samples(),
+                sample_count: msaa.samples(),
+                reverse_z: true,
                 viewport,
-                epsilon_bits: cam.settings.epsilon.to_bits(),
+                min_epsilon: cam.settings.epsilon,
+                atmosphere,
                 write_depth: cam.settings.write_depth,
-                atmosphere: atmosphere_bits(&atmosphere),
+                ..Default::default()
             };
-            if state.streams.get(&key_pair).is_none_or(|v| v.key != key) {
-                state.streams.remove(&key_pair);
-                let opts = RendererOptions {
-                    format: key.format,
-                    depth_format: key.depth_format,
-                    sample_count: key.samples,
-                    reverse_z: true,
-                    viewport,
-                    min_epsilon: cam.settings.epsilon,
-                    atmosphere,
-                    write_depth: cam.settings.write_depth,
-                    ..Default::default()
-                };
+            let built = state.streams.get(&key_pair);
+            if built.is_none_or(|v| v.asset != forest.asset || *v.stream.options_built() != opts) {
                 match QuadStream::new(&ctx.device, scene.clone(), &opts) {
                     Ok(stream) => {
                         state.streams.insert(
                             key_pair,
                             ViewStream {
-                                key,
+                                asset: forest.asset,
                                 stream,
                                 prepared: false,
-                                receiving: false,
+                                receiving: None,
                                 last: None,
                             },
                         );
                     }
                     Err(e) => {
+                        state.streams.remove(&key_pair);
                         record.error = Some(e.to_string());
                         stats.insert(key_pair, record);
                         continue;
@@ -264,8 +222,8 @@ pub fn prepare_forests(
             let lighting = light::lighting(sun, cam.ambient, camera.exposure);
             let view_from_world = world_from_view.inverse();
             let frame = FrameParams {
-                view: to_forest(view_from_world * forest.world_from_forest),
-                proj: to_forest(clip_from_world * world_from_view),
+                view: light::mat_to_forest(view_from_world * forest.world_from_forest),
+                proj: light::mat_to_forest(clip_from_world * world_from_view),
                 viewport,
                 epsilon: cam.settings.epsilon,
                 light: lighting,
@@ -297,61 +255,69 @@ pub fn prepare_forests(
                 .0
                 .max_element();
             let cascades = shadow_maps.map_or_else(Vec::new, |(lights, _)| {
-                shadows::view_cascades(lights, &light_views, &directional, forest_from_world, scale)
+                shadows::view_cascades(
+                    lights,
+                    &light_views,
+                    &directional,
+                    forest.world_from_forest,
+                    scale,
+                )
             });
-            match (cascades.is_empty(), shadow_maps) {
-                (false, Some((_, bindings))) => {
-                    let array = bindings.directional_light_depth_texture.create_view(
-                        &wgpu::TextureViewDescriptor {
+            // Bevy's map, bound again only when it is another texture or another cascade
+            // count; the cascades' matrices are written every frame.
+            let maps = shadow_maps
+                .filter(|_| !cascades.is_empty())
+                .map(|(_, b)| (&*b.directional_light_depth_texture, cascades.len()));
+            if maps != v.receiving.as_ref().map(|(t, n)| (t, *n)) {
+                match maps {
+                    Some((texture, n)) => {
+                        let array = texture.create_view(&wgpu::TextureViewDescriptor {
                             dimension: Some(wgpu::TextureViewDimension::D2Array),
                             base_array_layer: 0,
-                            array_layer_count: Some(cascades.len() as u32),
+                            array_layer_count: Some(n as u32),
                             ..Default::default()
-                        },
-                    );
-                    v.stream.receive_host_shadows(
-                        &ctx.device,
-                        Some((&array, cascades[0].resolution, true)),
-                    );
-                    let host: Vec<_> = cascades.iter().map(|c| c.cascade).collect();
-                    if let Err(e) = v.stream.set_host_cascades(&host) {
-                        record.error = Some(e.to_string());
+                        });
+                        let resolution = cascades[0].resolution;
+                        v.stream
+                            .receive_host_shadows(&ctx.device, Some((&array, resolution, true)));
                     }
-                    v.receiving = true;
+                    None => v.stream.receive_host_shadows(&ctx.device, None),
                 }
-                _ if v.receiving => {
-                    v.stream.receive_host_shadows(&ctx.device, None);
-                    v.receiving = false;
+                v.receiving = maps.map(|(t, n)| (t.clone(), n));
+            }
+            if v.receiving.is_some() {
+                let host: Vec<_> = cascades.iter().map(|c| c.cascade).collect();
+                if let Err(e) = v.stream.set_host_cascades(&host) {
+                    record.error = Some(e.to_string());
                 }
-                _ => {}
             }
             for c in &cascades {
                 let key = (main, forest.entity, c.layer);
-                let ckey = CasterKey {
-                    asset: forest.asset,
-                    resolution: c.resolution,
+                let opts = RendererOptions {
+                    depth_format: wgpu::TextureFormat::Depth32Float,
+                    reverse_z: true,
+                    viewport: (c.resolution, c.resolution),
+                    min_epsilon: forest_render::shadow::ShadowOptions::default().epsilon,
+                    overdraw: 0.25,
+                    ..Default::default()
                 };
-                if state.casters.get(&key).is_none_or(|k| k.key != ckey) {
-                    let opts = RendererOptions {
-                        depth_format: wgpu::TextureFormat::Depth32Float,
-                        reverse_z: true,
-                        viewport: (c.resolution, c.resolution),
-                        min_epsilon: forest_render::shadow::ShadowOptions::default().epsilon,
-                        overdraw: 0.25,
-                        ..Default::default()
-                    };
+                let built = state.casters.get(&key);
+                if built
+                    .is_none_or(|k| k.asset != forest.asset || *k.stream.options_built() != opts)
+                {
                     match QuadStream::new(&ctx.device, scene.clone(), &opts) {
                         Ok(stream) => {
                             state.casters.insert(
                                 key,
                                 Caster {
-                                    key: ckey,
+                                    asset: forest.asset,
                                     stream,
                                     quads: 0,
                                 },
                             );
                         }
                         Err(e) => {
+                            state.casters.remove(&key);
                             record.error = Some(format!("shadow caster: {e}"));
                             continue;
                         }
@@ -402,10 +368,4 @@ pub(super) fn drawn_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
         wgpu::TextureFormat::Bgra8Unorm => wgpu::TextureFormat::Bgra8UnormSrgb,
         other => other,
     }
-}
-
-/// A Bevy matrix as the forest crates' (Bevy and `forest-render` may use different glam
-/// releases).
-fn to_forest(m: Mat4) -> glam::Mat4 {
-    glam::Mat4::from_cols_array(&m.to_cols_array())
 }
