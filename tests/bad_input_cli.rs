@@ -115,8 +115,9 @@ fn species_are_checked_alike_by_scene_info_and_render() {
     let (good, forest_file) = bush_forest(d, false);
     // A hybrid-switch record out of range in each field it has, and a bounding sphere beyond
     // any model's coordinates.
-    let cases: [(&str, serde_json::Value, &str); 6] = [
+    let cases: [(&str, serde_json::Value, &str); 7] = [
         ("crown_radii", serde_json::json!(-2.0), "crown_radii = -2"),
+        ("tolerance", serde_json::json!(11.0), "tolerance = 11"),
         ("viewport", serde_json::json!([0, 0]), "viewport = [0, 0]"),
         ("fov_y_deg", serde_json::json!(7200.0), "fov_y_deg = 7200"),
         ("epsilon", serde_json::json!(0.0), "epsilon = 0"),
@@ -284,6 +285,13 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         d,
         &["'-64'", "--resolution"],
     );
+    for t in ["-0.5", "11", "nan"] {
+        refused(
+            &["bake", &bush, "-o", &p("n.atlas"), "--switch-tolerance", t],
+            d,
+            &[&format!("'{t}'"), "--switch-tolerance", "0 to 10"],
+        );
+    }
     refused(
         &[
             "scene",

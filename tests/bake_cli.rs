@@ -121,9 +121,14 @@ fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
         ladder
             .iter()
             .all(|r| r["flip_geometry"].as_f64().unwrap() > 0.0
-                && r["flip_quads"].as_f64().unwrap() > 0.0),
+                && r["flip_quads"].as_f64().unwrap() > 0.0
+                && r["flip_lods"]
+                    .as_array()
+                    .is_some_and(|l| l.len() == 2 && l.iter().all(|x| x.as_f64().unwrap() > 0.0))),
         "{v}"
     );
+    // Measured at the default tolerance, which the record keeps.
+    assert_eq!(switch["tolerance"].as_f64(), Some(0.0), "{switch}");
     let recorded = forest_format::Atlas::load(&atlas)
         .unwrap()
         .manifest

@@ -20,7 +20,8 @@ use forest_render::context::RenderError;
 /// Where the near trees end.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Near {
-    /// Per species, where its quad stream becomes as accurate as its own triangles: the
+    /// Per species, where its quad stream becomes as accurate as its own triangles (within
+    /// the tolerance the bake measured it at, [`forest_format::atlas::HybridSwitch::tolerance`]): the
     /// distance at which the species' finest quads project to the size its atlas records
     /// ([`forest_format::atlas::HybridSwitch`], measured by `forest bake` against a 4×4
     /// supersampled reference), else to [`forest_render::forms::DEFAULT_SWITCH_PIXELS`]. It follows the tree's size,
@@ -28,7 +29,8 @@ pub enum Near {
     /// move it: a coarser ε makes the near trees' quads coarser still, not better (an
     /// ε-scaled switch left the hybrid at ε 8–32 less accurate than the discrete LODs at the
     /// same time). Measured on the five bundled species (400×300, 60°, ε 2) the crossover lies
-    /// between 1.8 (pine) and 3.0 (oak, ash) crown radii: a single switch for every species
+    /// between 2.1 (pine) and 6 (oak, ash: the ladder's end) crown radii, 1.3 to 3.5 with a
+    /// 25 % tolerance: a single switch for every species
     /// draws some trees in their less accurate form.
     Auto,
     /// A fixed distance in metres from the eye to a tree's bounding-sphere centre: 0 draws
@@ -145,6 +147,7 @@ mod tests {
             fov_y_deg: 60.0,
             epsilon: 2.0,
             cameras: 1,
+            tolerance: 0.0,
         });
         m
     }

@@ -66,12 +66,17 @@ pub struct BakeArgs {
     #[arg(long, value_name = "GIB", allow_negative_numbers = true)]
     pub memory_limit: Option<f64>,
     /// Do not measure the hybrid method's switch distance. By default the bake renders the
-    /// new atlas against its model on the GPU (54 views of one tree, 400×300) to find where
-    /// the quad stream becomes as accurate as the triangles, and records it in the manifest;
-    /// without it (or without a GPU) the hybrid switches where the finest quads project to
-    /// 1.5 pixels.
+    /// new atlas against its model on the GPU (views of one tree at 400×300) to find where
+    /// the quad stream becomes as accurate as the triangles (within --switch-tolerance), and
+    /// records it in the manifest; without it (or without a GPU) the hybrid switches where
+    /// the finest quads project to 1.5 pixels.
     #[arg(long)]
     pub no_hybrid_switch: bool,
+    /// The hybrid switch's tolerance: the quad stream may be up to this fraction less
+    /// accurate (mean FLIP) than the model's triangles where the hybrid switches a tree to
+    /// it (0: as accurate; 0 to 10).
+    #[arg(long, default_value_t = crate::switch::DEFAULT_TOLERANCE, value_parser = parse_tolerance, allow_negative_numbers = true)]
+    pub switch_tolerance: f32,
 }
 
 /// Arguments of `forest info`.
@@ -256,6 +261,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                     &ctx,
                     species,
                     &args.model,
+                    args.switch_tolerance,
                     Some(std::mem::take(&mut out.sky)),
                     &progress,
                 )
@@ -316,6 +322,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 "crown_radii": r.radii,
                 "flip_geometry": r.geometry,
                 "flip_quads": r.quads,
+                "flip_lods": r.lods,
             }))
             .collect::<Vec<_>>(),
     });
@@ -362,11 +369,12 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         if let Some(h) = &m.hybrid_switch {
             let d = &crate::switch::DISTANCES;
             let (first, last) = (d[0], d[d.len() - 1]);
-            let (_, inside) = crate::switch::crossover(&ladder);
+            let (_, inside) = crate::switch::crossover(&ladder, h.tolerance);
             println!(
-                "  hybrid switch: the quad stream (ε {}) is as accurate as the triangles from {:.2} \
-                 crown radii{} (finest quads {:.2} px at {}x{}, {}°)",
+                "  hybrid switch: the quad stream (ε {}) is within {:.0} % of the triangles' error \
+                 from {:.2} crown radii{} (finest quads {:.2} px at {}x{}, {}°)",
                 h.epsilon,
+                h.tolerance * 100.0,
                 h.crown_radii,
                 if inside {
                     String::new()
@@ -379,11 +387,23 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 h.fov_y_deg
             );
         }
+        if !ladder.is_empty() {
+            let radii = m.hybrid_switch.map_or(f32::INFINITY, |h| h.crown_radii);
+            println!("  {}", crate::switch::describe_lods(&ladder, radii));
+        }
         if let Some(p) = &args.contact_sheet {
             println!("  contact sheet {}", p.display());
         }
     }
     Ok(())
+}
+
+fn parse_tolerance(s: &str) -> Result<f32, String> {
+    let max = forest_format::atlas::HybridSwitch::MAX_TOLERANCE;
+    match s.parse::<f32>() {
+        Ok(t) if (0.0..=max).contains(&t) => Ok(t),
+        _ => Err(format!("{s:?}: expected a fraction from 0 to {max}")),
+    }
 }
 
 /// Each file's megabytes, e.g. `colour.jpg 0.88, alpha.png 0.44, …`, from

@@ -1,15 +1,18 @@
 //! The hybrid's switch of one model, measured at bake: where its quad stream becomes as
-//! accurate as its own triangles.
+//! accurate as its own triangles, within a tolerance.
 //!
 //! One tree (scale 1, unrotated) is seen from seeded random cameras at a ladder of distances
 //! from its crown's centre (in crown radii; azimuth uniform, elevation −20° to 40°, eyes kept
 //! 0.3 m above the ground, looking at the centre; 400×300, 60°, transparent background).
-//! Each view is drawn as full geometry at 1× and as the quad stream at ε 2, and both are
-//! compared (mean FLIP) with the 4×4 supersampled reference ([`MeshMethod::Reference`]). The crossover is where the
-//! stream's mean error, minus the geometry's, first reaches zero (linear between the two
+//! Each view is drawn as full geometry at 1×, as the quad stream at ε 2 and as the
+//! discrete-LOD baseline's mesh LODs 1 and 2, and each is compared (mean FLIP) with the 4×4
+//! supersampled reference ([`MeshMethod::Reference`]). The crossover is where the stream's
+//! mean error first reaches `1 + tolerance` times the geometry's (linear between the two
 //! distances around it), found by bisection over the ladder (4 or 5 of its 9 rungs: the
-//! difference falls with distance); it is recorded as the width the finest quads project to there
-//! ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree size.
+//! excess falls with distance); it is recorded as the width the finest quads project to
+//! there ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree
+//! size. The LODs' errors say whether they could draw the hybrid's near trees instead of the
+//! full model ([`describe_lods`]; on the bundled species they never come within 1.8× of it).
 
 use std::path::Path;
 
@@ -41,6 +44,17 @@ const REFERENCE_SS: u32 = 4;
 /// Seed of the camera directions.
 const SEED: u64 = 0x5717_c400;
 
+/// Distances of the discrete-LOD baseline that draw every tree nearer than 10⁶ m in mesh
+/// LOD `lod` (1 or 2).
+fn whole_lod(lod: usize) -> forest_baselines::geometry::Lods {
+    let mut distances = [1e-6, 2e-6, 1e6];
+    if lod == 1 {
+        distances[1] = 1e6;
+        distances[2] = 2e6;
+    }
+    forest_baselines::geometry::Lods { distances }
+}
+
 /// The mean FLIP of both forms at one distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rung {
@@ -50,7 +64,30 @@ pub struct Rung {
     pub geometry: f32,
     /// The quad stream at [`EPSILON`].
     pub quads: f32,
+    /// The discrete-LOD baseline's mesh LODs 1 and 2 at 1× (the whole tree in that LOD).
+    pub lods: [f32; 2],
 }
+
+impl Rung {
+    /// The stream's error beyond what `tolerance` allows it over the triangles':
+    /// `quads − (1 + tolerance) · geometry`; the switch lies where it reaches 0.
+    pub fn excess(&self, tolerance: f32) -> f32 {
+        self.quads - (1.0 + tolerance) * self.geometry
+    }
+
+    /// Mesh LOD `k`'s (1 or 2) error as a multiple of the full model's.
+    pub fn lod_ratio(&self, k: usize) -> f32 {
+        self.lods[k - 1] / self.geometry.max(f32::MIN_POSITIVE)
+    }
+}
+
+/// The default [`HybridSwitch::tolerance`]: none, the stream must be as accurate as the
+/// triangles. Measured in the real-size walkthrough (3 000 trees, 6 seeded eye-height
+/// cameras, 400×300): a 25 % tolerance moves the bundled species' switches from 2.1–6 to
+/// 1.3–3.5 crown radii and the hybrid to the cheap end of the front (ε 16: 0.30× the time,
+/// 0.18× the vertices, 1.6× the fragments, FLIP 0.0577 → 0.0664), but at the accurate end
+/// it loses (ε 1–4: FLIP +10 %, no faster), so it is a choice, not the default.
+pub const DEFAULT_TOLERANCE: f32 = 0.0;
 
 /// Rungs a bisection of [`DISTANCES`] measures at most: ⌈log₂ 9⌉ + 1 for the rung before the
 /// crossing (what the progress bar counts).
@@ -75,15 +112,15 @@ pub fn first_crossing(
     Ok((lo < n).then_some(lo))
 }
 
-/// The crossover of a ladder (crown radii): where `quads − geometry` first reaches zero,
-/// linear between the rungs around it; the first rung when the stream is already the more
-/// accurate there, the last when it never is. The flag tells whether it lies inside the
-/// ladder.
-pub fn crossover(ladder: &[Rung]) -> (f32, bool) {
+/// The crossover of a ladder (crown radii): where `quads − (1 + tolerance) · geometry` first
+/// reaches zero, linear between the rungs around it; the first rung when the stream is
+/// already within the tolerance there, the last when it never is. The flag tells whether it
+/// lies inside the ladder.
+pub fn crossover(ladder: &[Rung], tolerance: f32) -> (f32, bool) {
     let Some(first) = ladder.first() else {
         return (0.0, false);
     };
-    let diff = |r: &Rung| r.quads - r.geometry;
+    let diff = |r: &Rung| r.excess(tolerance);
     if diff(first) <= 0.0 {
         return (first.radii, false);
     }
@@ -118,14 +155,46 @@ pub fn finest_quad_pixels(levels: u32, radii: f32) -> f32 {
 pub fn describe(m: &forest_format::AtlasManifest) -> String {
     match &m.hybrid_switch {
         Some(h) => format!(
-            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°)",
-            h.finest_quad_pixels, h.crown_radii, h.viewport[0], h.viewport[1], h.fov_y_deg
+            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, stream within {:.0} % of \
+             the triangles' error)",
+            h.finest_quad_pixels,
+            h.crown_radii,
+            h.viewport[0],
+            h.viewport[1],
+            h.fov_y_deg,
+            h.tolerance * 100.0
         ),
         None => format!(
             "finest quads {} px (not measured: the default)",
             forest_render::forms::DEFAULT_SWITCH_PIXELS
         ),
     }
+}
+
+/// The mesh LODs' accuracy on a measured ladder, in words: per LOD, its smallest error as a
+/// multiple of the full model's over the rungs nearer than the switch (all rungs when none
+/// is), which says whether the LOD could draw the hybrid's near trees.
+pub fn describe_lods(ladder: &[Rung], switch_radii: f32) -> String {
+    let near: Vec<&Rung> = ladder.iter().filter(|r| r.radii < switch_radii).collect();
+    let rungs: Vec<&Rung> = if near.is_empty() {
+        ladder.iter().collect()
+    } else {
+        near
+    };
+    let best = |k: usize| {
+        rungs
+            .iter()
+            .map(|r| r.lod_ratio(k))
+            .fold(f32::INFINITY, f32::min)
+    };
+    format!(
+        "mesh LODs 1 / 2: at best {:.2}x / {:.2}x the full model's error on {} measured \
+         rung{} nearer than the switch",
+        best(1),
+        best(2),
+        rungs.len(),
+        if rungs.len() == 1 { "" } else { "s" }
+    )
 }
 
 /// An upper estimate of the memory (bytes) [`measure`] adds to a bake's peak for a model of
@@ -137,13 +206,17 @@ pub fn peak_bytes_estimate(model_bytes: u64) -> u64 {
     (160 << 20) + 9 * model_bytes
 }
 
-/// Measure the switch of the model `model` baked into `species`, reusing `sky`, the bake's
-/// traced sky visibility of its triangles, when the model is the one the atlas was baked
-/// from; `progress(done, total)` counts the views. Returns the record and the ladder it came from.
+/// Measure the switch of the model `model` baked into `species` at `tolerance` (see
+/// [`HybridSwitch::tolerance`]), reusing `sky`, the bake's traced sky visibility of its
+/// triangles, when the model is the one the atlas was baked from; `progress(done, total)`
+/// counts the views. Each rung also measures the discrete-LOD baseline's mesh LODs 1 and 2
+/// ([`Rung::lods`]), which says whether they could draw the hybrid's near trees. Returns the
+/// record and the ladder it came from.
 pub fn measure(
     ctx: &GpuContext,
     species: SpeciesData,
     model: &Path,
+    tolerance: f32,
     sky: Option<Vec<forest_bake::sky::TriangleSky>>,
     progress: &dyn Fn(u64, u64),
 ) -> Result<(HybridSwitch, Vec<Rung>)> {
@@ -205,6 +278,7 @@ pub fn measure(
         }
         let radii = DISTANCES[i];
         let (mut g_sum, mut q_sum) = (0.0f32, 0.0f32);
+        let mut lod_sums = [0.0f32; 2];
         for &(azimuth, elevation) in &directions {
             let d = radii * sphere.radius;
             let offset = Vec3::new(
@@ -234,6 +308,11 @@ pub fn measure(
             r.set_method(ctx, Method::Quads)?;
             r.render_fitted(ctx, &cam, &small)?;
             let quads = small.read(ctx);
+            for (k, sum) in lod_sums.iter_mut().enumerate() {
+                r.set_method(ctx, Method::Mesh(MeshMethod::Lods(whole_lod(k + 1))))?;
+                r.render_fitted(ctx, &cam, &small)?;
+                *sum += forest_metrics::flip(&reference, &small.read(ctx))?.0;
+            }
             ctx.check_errors()?;
             g_sum += forest_metrics::flip(&reference, &geometry)?.0;
             q_sum += forest_metrics::flip(&reference, &quads)?.0;
@@ -245,19 +324,20 @@ pub fn measure(
             radii,
             geometry: g_sum / n,
             quads: q_sum / n,
+            lods: lod_sums.map(|s| s / n),
         };
         measured[i] = Some(out);
         Ok(out)
     };
     let first = first_crossing(DISTANCES.len(), |i| {
-        rung(i, &mut measured).map(|r| r.quads - r.geometry <= 0.0)
+        rung(i, &mut measured).map(|r| r.excess(tolerance) <= 0.0)
     })?;
     if let Some(i) = first.filter(|&i| i > 0) {
         rung(i - 1, &mut measured)?;
     }
     progress(total, total);
     let ladder: Vec<Rung> = measured.into_iter().flatten().collect();
-    let (radii, _) = crossover(&ladder);
+    let (radii, _) = crossover(&ladder, tolerance);
     let pixels = finest_quad_pixels(manifest.levels, radii)
         .clamp(HybridSwitch::MIN_PIXELS, HybridSwitch::MAX_PIXELS);
     Ok((
@@ -268,6 +348,7 @@ pub fn measure(
             fov_y_deg: FOV_Y_DEG,
             epsilon: EPSILON,
             cameras: CAMERAS,
+            tolerance,
         },
         ladder,
     ))
@@ -302,6 +383,7 @@ mod tests {
             radii,
             geometry,
             quads,
+            lods: [0.0; 2],
         }
     }
 
@@ -314,19 +396,44 @@ mod tests {
             rung(3.0, 0.03, 0.02),
             rung(4.0, 0.01, 0.02),
         ];
-        let (k, inside) = crossover(&ladder);
+        let (k, inside) = crossover(&ladder, 0.0);
         assert!((k - (2.0 + 2.0 / 3.0)).abs() < 1e-5, "{k}");
+        assert!(inside);
+        // Allowed 50 % more error than the triangles: the excess falls from 0.20 − 0.15 = 0.05
+        // at 1 to 0.07 − 0.075 = −0.005 at 2.
+        let (k, inside) = crossover(&ladder, 0.5);
+        assert!((k - (1.0 + 0.05 / 0.055)).abs() < 1e-5, "{k}");
         assert!(inside);
         // Better from the first rung, or never: the ladder's ends, flagged.
         assert_eq!(
-            crossover(&[rung(1.0, 0.2, 0.1), rung(2.0, 0.1, 0.2)]),
+            crossover(&[rung(1.0, 0.2, 0.1), rung(2.0, 0.1, 0.2)], 0.0),
             (1.0, false)
         );
         assert_eq!(
-            crossover(&[rung(1.0, 0.1, 0.2), rung(2.0, 0.1, 0.2)]),
+            crossover(&[rung(1.0, 0.1, 0.2), rung(2.0, 0.1, 0.2)], 0.0),
             (2.0, false)
         );
-        assert_eq!(crossover(&[]), (0.0, false));
+        // Twice the triangles' error is within a tolerance of 1 from the first rung.
+        assert_eq!(
+            crossover(&[rung(1.0, 0.1, 0.2), rung(2.0, 0.1, 0.2)], 1.0),
+            (1.0, false)
+        );
+        assert_eq!(crossover(&[], 0.0), (0.0, false));
+    }
+
+    #[test]
+    fn lods_are_described_by_their_best_ratio_nearer_than_the_switch() {
+        let mut a = rung(1.0, 0.10, 0.20);
+        a.lods = [0.30, 0.40];
+        let mut b = rung(2.0, 0.05, 0.07);
+        b.lods = [0.10, 0.20];
+        let mut far = rung(4.0, 0.01, 0.01);
+        far.lods = [0.01, 0.01];
+        let text = describe_lods(&[a, b, far], 3.0);
+        assert!(text.contains("2.00x / 4.00x"), "{text}");
+        assert!(text.contains("on 2 measured rungs"), "{text}");
+        // No rung nearer than the switch: every rung counts.
+        assert!(describe_lods(&[far], 1.0).contains("1.00x / 1.00x"));
     }
 
     #[test]

@@ -305,6 +305,7 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
         fov_y_deg: 60.0,
         epsilon: 2.0,
         cameras: 1,
+        tolerance: 0.0,
     });
     let atlases: Vec<_> = species.iter().map(|s| s.atlas.clone()).collect();
     let measured = common::prepared_for(&atlases);

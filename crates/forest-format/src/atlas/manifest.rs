@@ -82,7 +82,8 @@ pub struct OpacityInfo {
 /// Where the quad stream becomes as accurate as the model's own triangles (full geometry at
 /// 1×), both compared with 4×4 supersampled full geometry (mean FLIP over seeded cameras
 /// around one tree). The distance is stored as the size the finest quads project to there,
-/// `finest_quad_pixels`, which carries over to any viewport, field of view and tree size:
+/// `finest_quad_pixels`, which carries over to any viewport, field of view and tree size
+/// ("as accurate" within [`HybridSwitch::tolerance`]):
 /// at focal length `f` pixels a tree of crown radius `R` switches at
 /// `d = f · (2R / 2^(levels−1)) / finest_quad_pixels`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -102,6 +103,11 @@ pub struct HybridSwitch {
     pub epsilon: f32,
     /// Cameras per distance.
     pub cameras: u32,
+    /// The error the switch allows the quad stream above the triangles', as a fraction of
+    /// theirs: the crossover is where the stream's mean FLIP first reaches `(1 + tolerance)`
+    /// times the triangles'. 0 (atlases measured before it was recorded): as accurate.
+    #[serde(default)]
+    pub tolerance: f32,
 }
 
 impl HybridSwitch {
@@ -116,6 +122,8 @@ impl HybridSwitch {
     pub const MAX_VIEWPORT: u32 = 16384;
     /// Largest ε it may have been measured at (pixels).
     pub const MAX_EPSILON: f32 = 1e4;
+    /// Largest accepted [`HybridSwitch::tolerance`].
+    pub const MAX_TOLERANCE: f32 = 10.0;
 
     /// Every field in its range: the switch size in [`Self::MIN_PIXELS`,
     /// `Self::MAX_PIXELS`], crown radii in (0, [`Self::MAX_CROWN_RADII`]], a viewport of 1 to
@@ -158,6 +166,13 @@ impl HybridSwitch {
         }
         if self.cameras == 0 {
             return Err("cameras = 0, expected at least 1".into());
+        }
+        let t = self.tolerance;
+        if !(0.0..=Self::MAX_TOLERANCE).contains(&t) {
+            return Err(format!(
+                "tolerance = {t}, outside [0, {}]",
+                Self::MAX_TOLERANCE
+            ));
         }
         Ok(())
     }

@@ -199,6 +199,7 @@ fn the_loader_names_what_is_wrong() {
         fov_y_deg: 60.0,
         epsilon: 2.0,
         cameras: 6,
+        tolerance: 0.25,
     });
     measured.save(&path).unwrap();
     assert_eq!(Atlas::load(&path).unwrap(), measured);
@@ -216,6 +217,16 @@ fn the_loader_names_what_is_wrong() {
         "{}",
         err(&path)
     );
+    // A tolerance out of its range is named; a record without one (older atlases) reads as 0.
+    std::fs::write(
+        &manifest,
+        text.replace("\"tolerance\": 0.25", "\"tolerance\": -0.5"),
+    )
+    .unwrap();
+    assert!(err(&path).contains("tolerance = -0.5"), "{}", err(&path));
+    std::fs::write(&manifest, text.replace(",\n    \"tolerance\": 0.25", "")).unwrap();
+    let older = Atlas::load(&path).unwrap();
+    assert_eq!(older.manifest.hybrid_switch.map(|h| h.tolerance), Some(0.0));
     assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
 }
 
