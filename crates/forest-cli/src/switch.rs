@@ -12,7 +12,7 @@
 //! excess falls with distance); it is recorded as the width the finest quads project to
 //! there ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree
 //! size. The LODs' errors say whether they could draw the hybrid's near trees instead of the
-//! full model ([`describe_lods`]; on the bundled species they never come within 1.8× of it).
+//! full model ([`describe_lods`]; on the bundled species they never come within 1.7× of it).
 
 use std::path::Path;
 
