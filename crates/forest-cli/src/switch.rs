@@ -47,11 +47,11 @@ const SEED: u64 = 0x5717_c400;
 /// Distances of the discrete-LOD baseline that draw every tree nearer than 10⁶ m in mesh
 /// LOD `lod` (1 or 2).
 fn whole_lod(lod: usize) -> forest_baselines::geometry::Lods {
-    let mut distances = [1e-6, 2e-6, 1e6];
-    if lod == 1 {
-        distances[1] = 1e6;
-        distances[2] = 2e6;
-    }
+    let distances = if lod == 1 {
+        [1e-6, 1e6, 2e6]
+    } else {
+        [1e-6, 2e-6, 1e6]
+    };
     forest_baselines::geometry::Lods { distances }
 }
 
