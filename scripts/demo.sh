@@ -11,30 +11,29 @@ cargo build --release --locked -p forest-cli
 forest=./target/release/forest
 mkdir -p out/atlases out/contact out/render
 species=()
-models=()
 for s in oak ash aspen pine bush; do
   atlas="out/atlases/$s.atlas"
   # Cached: re-bake only when the model, its materials or textures are newer than the atlas,
-  # or the atlas predates the measured hybrid switch.
+  # or the atlas predates the measured hybrid switch or the stored model (model.bin).
   if [ -f "$atlas/manifest.json" ] && [ -z "$(find "assets/trees/$s" -newer "$atlas/manifest.json" -type f)" ] \
-     && grep -q '"hybrid_switch"' "$atlas/manifest.json" && $forest info "$atlas" >/dev/null 2>&1; then
+     && grep -q '"hybrid_switch"' "$atlas/manifest.json" && [ -f "$atlas/model.bin" ] \
+     && $forest info "$atlas" >/dev/null 2>&1; then
     echo "cached: $atlas"
   else
     $forest bake "assets/trees/$s/$s.obj" -o "$atlas" --contact-sheet "out/contact/$s.png"
   fi
   species+=("$atlas")
-  models+=("assets/trees/$s/$s.obj")
 done
 $forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${species[*]}")" --seed 1 \
   --terrain hills -o out/forest-100k.forest
-# The hybrid: the trees within a few crown radii as full geometry, the rest as the quad stream,
-# both casting the sun's shadows.
+# The hybrid: the trees within a few crown radii as full geometry (the models the bake stored
+# in the atlases), the rest as the quad stream, both casting the sun's shadows.
 $forest render out/forest-100k.forest -o out/render/forest.png --view inside --view hill --view birds-eye \
-  --size 800x600 --method hybrid --shadows on --models "$(IFS=,; echo "${models[*]}")"
+  --size 800x600 --method hybrid --shadows on
 # The same forest at two times of day: a low morning sun and noon.
 for t in 7.5 12; do
   $forest render out/forest-100k.forest -o "out/render/forest-$t.png" --view hill --time "$t" \
-    --size 800x600 --method hybrid --shadows on --models "$(IFS=,; echo "${models[*]}")"
+    --size 800x600 --method hybrid --shadows on
 done
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png,"

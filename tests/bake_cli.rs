@@ -150,12 +150,15 @@ fn bake_writes_an_atlas_a_contact_sheet_and_json_figures() {
     let manifest = std::fs::metadata(atlas.join("manifest.json"))
         .unwrap()
         .len();
-    assert_eq!(files.len(), 5, "{files:?}");
+    // The prepared model (model.bin) among them, with its triangles.
+    assert_eq!(files.len(), 6, "{files:?}");
+    let lods = v2["model_lod_triangles"].as_array().unwrap();
+    assert_eq!(lods[0].as_u64(), v["triangles"].as_u64(), "{v2}");
     assert_eq!(
         files.values().map(|b| b.as_u64().unwrap()).sum::<u64>() + manifest,
         on_disk
     );
-    for name in ["surface.png", "opacity.png"] {
+    for name in ["surface.png", "opacity.png", "model.bin"] {
         let bytes = std::fs::metadata(atlas.join(name)).unwrap().len();
         assert_eq!(files[name].as_u64(), Some(bytes), "{name}");
     }

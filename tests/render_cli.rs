@@ -77,31 +77,77 @@ fn bake_scene_render_end_to_end() {
         "64x48",
     ]));
     assert!(d.join("small.png").is_file());
-    // The hybrid: near trees as geometry (a fixed switch distance), the rest as quads.
-    let text = ok(&forest(&[
-        "render",
-        &p("small.json"),
-        "-o",
-        &p("hybrid.png"),
-        "--eye",
-        "0,2,30",
-        "--target",
-        "0,2,0",
-        "--size",
-        "64x48",
-        "--method",
-        "hybrid",
-        "--near",
-        "1000",
-        "--json",
-        "--models",
-        &format!("{},{}", model("bush"), model("aspen")),
-    ]));
+    // The hybrid: near trees as geometry (a fixed switch distance), the rest as quads; drawn
+    // from the models the bake stored in the atlases, and from the OBJ files, alike.
+    let hybrid = |out: &str, models: &[&str]| {
+        let mut a = vec![
+            "render",
+            &p("small.json"),
+            "-o",
+            out,
+            "--eye",
+            "0,2,30",
+            "--target",
+            "0,2,0",
+            "--size",
+            "64x48",
+            "--method",
+            "hybrid",
+            "--near",
+            "1000",
+            "--json",
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+        a.extend(models.iter().map(|s| s.to_string()));
+        forest(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let objs = format!("{},{}", model("bush"), model("aspen"));
+    let text = ok(&hybrid(&p("hybrid.png"), &[]));
+    ok(&hybrid(&p("hybrid-obj.png"), &["--models", &objs]));
     let v: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
     assert_eq!(v["method"], "hybrid");
     assert!(v["geometry_trees"].as_u64().unwrap() > 0, "{v}");
     assert_eq!(v["quads"], 0, "every tree nearer than 1 km: {v}");
     assert!(v.get("fragments").is_none(), "counted only when asked: {v}");
+    let stored = image::open(d.join("hybrid.png")).unwrap().to_rgba8();
+    let from_obj = image::open(d.join("hybrid-obj.png")).unwrap().to_rgba8();
+    assert_eq!(stored, from_obj, "the stored models are the OBJs prepared");
+    // Without model.bin (an atlas baked with --no-model), the message says what to do.
+    let bare = d.join("bare");
+    std::fs::create_dir_all(bare.join("bush.atlas")).unwrap();
+    for e in std::fs::read_dir(d.join("bush.atlas")).unwrap() {
+        let e = e.unwrap();
+        if e.file_name() != "model.bin" {
+            std::fs::copy(e.path(), bare.join("bush.atlas").join(e.file_name())).unwrap();
+        }
+    }
+    ok(&forest(&[
+        "scene",
+        "--model-sizes",
+        "--trees",
+        "5",
+        "--species",
+        &bare.join("bush.atlas").display().to_string(),
+        "-o",
+        &bare.join("bare.json").display().to_string(),
+    ]));
+    let e = err(&forest(&[
+        "render",
+        &bare.join("bare.json").display().to_string(),
+        "-o",
+        &bare.join("x.png").display().to_string(),
+        "--view",
+        "birds-eye",
+        "--method",
+        "lods",
+    ]));
+    assert!(
+        e.contains("bush.atlas") && e.contains("model.bin") && e.contains("--models"),
+        "{e}"
+    );
+    assert!(!bare.join("x.png").exists());
     // Exact fragment counts and the overdraw view, for a quad method and a geometry one.
     for method in ["quads", "lods"] {
         let out = p(&format!("overdraw-{method}.png"));

@@ -35,6 +35,7 @@ pub mod gltf_mesh;
 pub mod ldi;
 pub mod lod;
 pub mod mesh;
+pub mod model;
 pub mod opacity;
 pub mod quadtree;
 pub mod shadowing;
@@ -289,27 +290,8 @@ pub fn write_depth_exr(path: &Path, out: &BakeOutput) -> Result<(), BakeError> {
     Ok(forest_format::atomic::write_with(path, write)?)
 }
 
-/// One vertex of the full-geometry reference (48 bytes, as `GeoVertex` in
-/// `shaders/geometry_types.wgsl`): object-space position, sky visibility of both sides,
-/// normal (towards the front side), material, uv.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct RefVertex {
-    /// Object-space position (metres).
-    pub pos: [f32; 3],
-    /// Sky visibility of the front side (the side `normal` faces) at this corner, `[0, 1]`.
-    pub sky_front: f32,
-    /// Unit normal.
-    pub normal: [f32; 3],
-    /// Material index.
-    pub material: u32,
-    /// Texture coordinates (OBJ convention).
-    pub uv: [f32; 2],
-    /// Leaf rank for stochastic simplification ([`lod::NONE`] when not a leaf, or unused).
-    pub element: u32,
-    /// Sky visibility of the back side at this corner, `[0, 1]`.
-    pub sky_back: f32,
-}
+/// One vertex of the full-geometry reference (the prepared model's vertex).
+pub use forest_format::model::RefVertex;
 
 /// The full-geometry reference's vertices: the model's triangles, non-indexed (three vertices
 /// per triangle, in the mesh's order), each corner with the sky visibility of both sides from

@@ -20,19 +20,7 @@ use crate::RefVertex;
 /// "No element" (a triangle that is not a leaf, or a branch triangle in leaf numbering).
 pub const NONE: u32 = u32::MAX;
 
-/// Distance bands of the runtime's draw segments (depth sorting and per-band vertex counts).
-pub const BANDS: u32 = 16;
-
-/// Level of detail `λ ∈ (0, 1]` of an object at distance `d` (metres, already divided by the
-/// instance scale): `b = min(1, d0²/d²)`, `λ = b^(ln ½ / ln h)`. `h ∈ (0, 1)` is the value of
-/// `b` at which half the elements are drawn (`h = ½` gives `λ = b`). `λ = 1` for `d ≤ d0`.
-pub fn lambda(d: f32, d0: f32, h: f32) -> f32 {
-    if d <= d0 {
-        return 1.0;
-    }
-    let b = (d0 / d) * (d0 / d);
-    b.powf(0.5f32.ln() / h.ln()).clamp(1e-9, 1.0)
-}
+pub use forest_format::model::{BANDS, dilate_colour_from, lambda, lambda_band};
 
 /// Area-preservation factor `s = (1 − (1 − r)^(1/λ)) / r` (Cook et al.): how much to enlarge
 /// each kept element's area so the object's *visible* area stays the same, where `r` is one
@@ -60,13 +48,6 @@ pub fn fade(u: f32, lambda: f32, width: f32) -> f32 {
         return if u < lambda { 1.0 } else { 0.0 };
     }
     ((lambda + r - u) / (2.0 * r)).clamp(0.0, 1.0)
-}
-
-/// Draw band of level `λ`: `min(BANDS − 1, ⌊−2·log2 λ⌋)`; every `λ` of band `k` is at most
-/// [`band_lambda`]`(k)`.
-pub fn lambda_band(lambda: f32) -> u32 {
-    let b = (-2.0 * lambda.max(1e-9).log2()).floor();
-    (b.max(0.0) as u32).min(BANDS - 1)
 }
 
 /// The largest `λ` of band `k`: `2^(−k/2)`.
@@ -475,7 +456,8 @@ pub fn mean_leaf_colour(mesh: &crate::Mesh, lod0: &[RefVertex]) -> Vec3 {
 }
 
 /// Elevations (degrees above the horizon) of the billboard images, seed 004's four.
-pub const BILLBOARD_ELEVATIONS: [f32; 4] = [0.0, 30.0, 60.0, 90.0];
+pub const BILLBOARD_ELEVATIONS: [f32; forest_format::model::BILLBOARDS as usize] =
+    [0.0, 30.0, 60.0, 90.0];
 
 /// A billboard's two images: albedo with coverage, and its surface attributes.
 pub struct BillboardImage {
@@ -572,54 +554,6 @@ pub fn billboard_images(
 /// bilinear filtering and mip-mapping at silhouettes average only real colours.
 pub fn dilate_colour(img: &mut image::RgbaImage) {
     dilate_colour_from(img, 1);
-}
-
-/// [`dilate_colour`] from the texels whose alpha is at least `min_alpha` (1..=255): every
-/// other texel takes the colour of the nearest such texel, ring by ring. With 128 only the
-/// texels that pass a 0.5 alpha test keep their colour (an alpha-tested texture's fringe of
-/// faint texels, often matted against another colour, never shows).
-pub fn dilate_colour_from(img: &mut image::RgbaImage, min_alpha: u8) {
-    let (w, h) = img.dimensions();
-    let min_alpha = min_alpha.max(1);
-    let mut known: Vec<bool> = img.pixels().map(|p| p[3] >= min_alpha).collect();
-    if !known.iter().any(|k| *k) {
-        return;
-    }
-    loop {
-        let mut next = known.clone();
-        let mut changed = false;
-        for y in 0..h {
-            for x in 0..w {
-                let i = (y * w + x) as usize;
-                if known[i] {
-                    continue;
-                }
-                let mut acc = [0u32; 3];
-                let mut c = 0;
-                for (dx, dy) in [(-1i32, 0i32), (1, 0), (0, -1), (0, 1)] {
-                    let (nx, ny) = (x as i32 + dx, y as i32 + dy);
-                    if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
-                        continue;
-                    }
-                    if known[(ny as u32 * w + nx as u32) as usize] {
-                        let p = img.get_pixel(nx as u32, ny as u32);
-                        (0..3).for_each(|k| acc[k] += u32::from(p[k]));
-                        c += 1;
-                    }
-                }
-                if c > 0 {
-                    let p = img.get_pixel_mut(x, y);
-                    (0..3).for_each(|k| p[k] = (acc[k] / c) as u8);
-                    next[i] = true;
-                    changed = true;
-                }
-            }
-        }
-        known = next;
-        if !changed {
-            break;
-        }
-    }
 }
 
 #[cfg(test)]

@@ -87,8 +87,14 @@ impl Hybrid {
     /// The camera's `forms` for a frame of `camera`: in [`Near::Auto`] its focal length in
     /// pixels, which each tree's switch unit turns into its switch distance.
     pub fn forms(&self, camera: &Camera) -> [f32; 4] {
+        self.forms_for_focal(camera.focal_pixels())
+    }
+
+    /// [`Self::forms`] for a camera of focal length `focal_pixels` (a host's projection:
+    /// [`forest_render::FrameParams::focal_pixels`]).
+    pub fn forms_for_focal(&self, focal_pixels: f32) -> [f32; 4] {
         match self.near {
-            Near::Auto => [0.0, camera.focal_pixels(), self.band, self.jitter],
+            Near::Auto => [0.0, focal_pixels, self.band, self.jitter],
             Near::Metres(m) if m >= GEOMETRY_ALWAYS => FORMS_GEOMETRY,
             Near::Metres(m) => [m, 0.0, self.band, self.jitter],
         }

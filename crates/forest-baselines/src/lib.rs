@@ -3,7 +3,8 @@
 //!
 //! - [`geometry`]: full geometry (the ground-truth reference when supersampled, the
 //!   brute-force baseline at 1×), stochastic simplification (Cook et al. 2007) and discrete
-//!   LODs + billboards, with their CPU preparation (the bake's tracer and simplifier);
+//!   LODs + billboards, drawn from the species' prepared models (which the bake writes into
+//!   each atlas, [`forest_format::model`]: this crate needs neither the models nor the bake);
 //! - [`hybrid`]: the nearest trees as geometry, the rest as the quad stream;
 //! - [`methods`]: every method behind one run-time switch.
 //!
@@ -20,8 +21,11 @@
 //! let ctx = GpuContext::headless()?;
 //! let forest = Forest::load("f.forest".as_ref())?;
 //! let oak = SpeciesData::load("oak.atlas".as_ref())?;
-//! let mesh = forest_bake::Mesh::load("oak.obj".as_ref())?;
-//! let prepared = PreparedGeometry::new(&[GeometrySpecies::new(mesh, &oak.atlas.manifest)]);
+//! // The prepared model `forest bake` wrote into the atlas folder.
+//! let model = forest_format::model::PreparedModel::load("oak.atlas".as_ref())?
+//!     .ok_or("oak.atlas has no prepared model")?;
+//! let species = GeometrySpecies::new(model.into(), &oak.atlas.manifest);
+//! let prepared = PreparedGeometry::new(&[species]);
 //! let (w, h) = (4 * 400, 4 * 300);
 //! let opts = RendererOptions { viewport: (w, h), ..Default::default() };
 //! let mut geometry = GeometryRenderer::with_targets(&ctx, &prepared, &forest, &opts)?;

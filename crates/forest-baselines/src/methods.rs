@@ -310,6 +310,100 @@ impl ForestRenderer {
         }
     }
 
+    /// A host's frame (the middleware's `prepare`): write the current method's cameras from
+    /// the host's matrices; the hybrid's per-tree forms follow the projection's focal length.
+    /// Then [`Self::encode_compute`] and [`Self::render`] into the host's pass.
+    pub fn prepare(
+        &mut self,
+        queue: &wgpu::Queue,
+        frame: &forest_render::FrameParams,
+    ) -> Result<(), RenderError> {
+        match (self.method, &mut self.geometry) {
+            (Method::Mesh(_), Some(g)) => g.prepare(queue, frame),
+            (Method::Hybrid(h), Some(g)) => {
+                let forms = h.forms_for_focal(frame.focal_pixels());
+                self.stream.set_forms(forms);
+                g.set_forms(forms);
+                self.stream.prepare(queue, frame)?;
+                g.prepare(queue, frame)
+            }
+            _ => self.stream.prepare(queue, frame),
+        }
+    }
+
+    /// The compute passes of a host's frame, after [`Self::prepare`]: the current method's
+    /// culls (and the quad stream's refinement).
+    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        match (self.method, &self.geometry) {
+            (Method::Mesh(_), Some(g)) => g.encode_compute(encoder),
+            (Method::Hybrid(_), Some(g)) => {
+                self.stream.encode_compute(encoder);
+                g.encode_compute(encoder);
+            }
+            _ => self.stream.encode_compute(encoder),
+        }
+    }
+
+    /// Draw into the host's render pass, after [`Self::encode_compute`]: the geometry first
+    /// (opaque and alpha-tested, depth written), then the quads back to front, depth-tested.
+    pub fn render(&self, pass: &mut wgpu::RenderPass) {
+        match (self.method, &self.geometry) {
+            (Method::Mesh(_), Some(g)) => g.record_draw(pass, false),
+            (Method::Hybrid(_), Some(g)) => {
+                g.record_draw(pass, false);
+                self.stream.render(pass);
+            }
+            _ => self.stream.render(pass),
+        }
+    }
+
+    /// Timestamp writes for the host's render pass that draws the forest: the quad stream's
+    /// draw time (`None` for the geometry methods, whose draw is not timed in a host's pass).
+    pub fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        match (self.method, &self.geometry) {
+            (Method::Mesh(_), Some(_)) => None,
+            _ => self.stream.draw_timestamps(),
+        }
+    }
+
+    /// Resolve a host's frame's pass times and counters (after the pass [`Self::render`]
+    /// recorded into).
+    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder) {
+        match (self.method, &self.geometry) {
+            (Method::Mesh(_), Some(g)) => g.resolve_times(encoder, false),
+            (Method::Hybrid(_), Some(g)) => {
+                self.stream.resolve_times(encoder);
+                g.resolve_times(encoder, false);
+            }
+            _ => self.stream.resolve_times(encoder),
+        }
+    }
+
+    /// Receive a host's sun shadows in both forms (see `QuadStream::receive_host_shadows`);
+    /// `None` stops.
+    pub fn receive_host_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        maps: Option<(&wgpu::TextureView, u32, bool)>,
+    ) {
+        self.stream.receive_host_shadows(device, maps);
+        if let Some(g) = &mut self.geometry {
+            g.receive_host_shadows(device, maps);
+        }
+    }
+
+    /// The host's cascades for both forms' receivers (see `QuadStream::set_host_cascades`).
+    pub fn set_host_cascades(
+        &mut self,
+        cascades: &[forest_render::shadow::Cascade],
+    ) -> Result<(), RenderError> {
+        self.stream.set_host_cascades(cascades)?;
+        if let Some(g) = &mut self.geometry {
+            g.set_host_cascades(cascades)?;
+        }
+        Ok(())
+    }
+
     /// Camera writes of both forms since they were created: (count, bytes). A hybrid frame
     /// writes the camera once for each form and nothing else.
     pub fn uploads(&self) -> (u64, u64) {

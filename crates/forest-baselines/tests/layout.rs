@@ -13,7 +13,7 @@ use layout_check::{Expect, check, shared};
 
 #[test]
 fn geometry_structs_match_the_host() {
-    use forest_bake::RefVertex;
+    use forest_format::model::RefVertex;
     let expected: Vec<Expect> = vec![
         (
             "GeoVertex",
@@ -140,7 +140,7 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
     );
     assert_eq!(
         layout_check::wgsl_const(&cull, "BANDS"),
-        f64::from(forest_bake::lod::BANDS)
+        f64::from(forest_format::model::BANDS)
     );
     for (entry, size) in layout_check::workgroup_sizes(&cull) {
         let want = match entry.as_str() {

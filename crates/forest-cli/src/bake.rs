@@ -77,6 +77,12 @@ pub struct BakeArgs {
     /// it (0: as accurate; 0 to 10).
     #[arg(long, default_value_t = crate::switch::DEFAULT_TOLERANCE, value_parser = parse_tolerance, allow_negative_numbers = true)]
     pub switch_tolerance: f32,
+    /// Do not store the prepared model (model.bin: the model's triangles with their traced
+    /// sky visibility, its mesh LODs and billboards) in the atlas. The geometry methods and
+    /// the hybrid then need the model itself (`forest render --models`), and the Bevy plugin
+    /// offers the quad stream and impostors only.
+    #[arg(long)]
+    pub no_model: bool,
 }
 
 /// Arguments of `forest info`.
@@ -242,6 +248,18 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let mut out = forest_bake::bake_file(&args.model, &params, &progress)?;
     bar.finish_and_clear();
 
+    // The model prepared for the geometry methods (stored, and drawn by the switch
+    // measurement), reusing the bake's traced sky visibility.
+    let model = if args.no_model && args.no_hybrid_switch {
+        None
+    } else {
+        let mesh = forest_bake::Mesh::load(&args.model)?;
+        let sky = std::mem::take(&mut out.sky);
+        let same = out.atlas.manifest.source.hash == format!("{:016x}", mesh.hash);
+        let sky = same.then_some(&sky[..]);
+        Some(std::sync::Arc::new(forest_bake::model::prepare(&mesh, sky)))
+    };
+
     // Where the hybrid should switch this model to the quad stream, measured before the atlas
     // is written so that it is written once, whole.
     let mut ladder = Vec::new();
@@ -257,15 +275,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 };
                 let species =
                     forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
-                let (switch, rungs) = crate::switch::measure(
-                    &ctx,
-                    species,
-                    &args.model,
-                    args.switch_tolerance,
-                    Some(std::mem::take(&mut out.sky)),
-                    &progress,
-                )
-                .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
+                let model = model.clone().expect("prepared when the switch is measured");
+                let (switch, rungs) =
+                    crate::switch::measure(&ctx, species, model, args.switch_tolerance, &progress)
+                        .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
                 bar.finish_and_clear();
                 out.atlas.manifest.hybrid_switch = Some(switch);
                 ladder = rungs;
@@ -280,7 +293,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         }
     }
 
-    let disk = out.atlas.save(&args.output)?;
+    let model_file = model.filter(|_| !args.no_model).map(|m| m.encode());
+    let disk = out
+        .atlas
+        .save_with_model(&args.output, model_file.as_deref())?;
     if let Some(p) = &args.contact_sheet {
         // The sheet shows what was stored (after the lossy colour codec), not the raw trace.
         let layers = out
@@ -295,7 +311,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
 
     let m = &out.atlas.manifest;
     // Each file's bytes, for the report and the summary (the nodes are encoded to count them).
-    let files = out.atlas.file_bytes();
+    let mut files = out.atlas.file_bytes();
+    if let Some(bytes) = &model_file {
+        files.push((forest_format::model::MODEL_FILE, bytes.len() as u64));
+    }
     let report = serde_json::json!({
         "model": args.model.display().to_string(),
         "output": args.output.display().to_string(),
@@ -433,6 +452,20 @@ fn channels(m: &forest_format::AtlasManifest) -> String {
 pub fn info(args: &InfoArgs) -> Result<()> {
     let atlas = Atlas::load(&args.atlas)?;
     let m = &atlas.manifest;
+    // The prepared model, checked as a renderer checks it.
+    let model = forest_format::model::PreparedModel::load(&args.atlas)?;
+    if let Some(model) = &model {
+        model.check_source(&args.atlas, &m.source.hash)?;
+    }
+    let mut files = atlas.file_bytes();
+    let model_path = args.atlas.join(forest_format::model::MODEL_FILE);
+    if model.is_some() {
+        let bytes = std::fs::metadata(&model_path)
+            .with_context(|| model_path.display().to_string())?
+            .len();
+        files.push((forest_format::model::MODEL_FILE, bytes));
+    }
+    let lod_triangles = model.as_ref().map(|m| m.lod_vertices.map(|v| v / 3));
     if args.json {
         println!(
             "{}",
@@ -443,10 +476,11 @@ pub fn info(args: &InfoArgs) -> Result<()> {
                 "nodes_per_level": m.nodes_per_level,
                 "node_count": m.node_count,
                 "gpu_bytes": m.gpu_bytes(),
-                "files": atlas
-                    .file_bytes()
-                    .into_iter()
+                "files": files
+                    .iter()
+                    .copied()
                     .collect::<std::collections::BTreeMap<_, _>>(),
+                "model_lod_triangles": lod_triangles,
                 "channels": channels(m),
                 "opacity": m.opacity,
                 "bounding_sphere": m.bounding_sphere,
@@ -467,8 +501,19 @@ pub fn info(args: &InfoArgs) -> Result<()> {
             m.node_count,
             m.gpu_bytes() as f64 / 1e6
         );
-        println!("  files: {}", file_summary(&atlas.file_bytes()));
+        println!("  files: {}", file_summary(&files));
         println!("  channels: {}", channels(m));
+        match lod_triangles {
+            Some([l0, l1, l2]) => println!(
+                "  model (the geometry methods and the hybrid): {l0} triangles, mesh LODs \
+                 {l1} and {l2}, {} billboards",
+                forest_format::model::BILLBOARDS
+            ),
+            None => println!(
+                "  model: none stored (baked with --no-model); the geometry methods and the \
+                 hybrid need --models"
+            ),
+        }
         println!("  hybrid switch: {}", crate::switch::describe(m));
     }
     Ok(())

@@ -211,10 +211,11 @@ pub struct MethodArgs {
     /// full geometry (the brute-force baseline); the reference (full geometry with every
     /// texture read at its finest level, for --supersample 4); stochastic simplification;
     /// discrete LODs + billboards; hybrid (trees nearer than --near as full geometry, the
-    /// rest as the quad stream). The last five need --models.
+    /// rest as the quad stream). The last five draw the models the bake stored in the atlases
+    /// (model.bin), or --models.
     #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
-    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods). Each must be the file its atlas was baked from (the same bytes, or else the same bounding sphere within 1 %)
+    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods), instead of those stored in the atlases. Each must be the file its atlas was baked from (the same bytes, or else the same bounding sphere within 1 %)
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<PathBuf>,
     /// Draw --models that are not the files their atlases were baked from (each is named on stderr)
@@ -372,11 +373,11 @@ impl MethodArgs {
         })
     }
 
-    /// The geometry method chosen (None for the quad-stream methods), requiring one OBJ model
-    /// per species for it.
+    /// The geometry method chosen (None for the quad-stream methods), requiring one model per
+    /// species for it when --models is given (else the atlases' stored models are drawn).
     pub fn checked_method(&self, species: usize) -> Result<Option<MeshMethod>> {
         let m = self.method(&self.method)?;
-        if m.is_some() && self.models.len() != species {
+        if m.is_some() && !self.models.is_empty() && self.models.len() != species {
             bail!(
                 "--method {} needs --models with one model per species ({} given, the forest has {species})",
                 self.method,
@@ -871,7 +872,7 @@ fn render_hybrid(
     species: &[SpeciesData],
     cameras: &[(String, Camera)],
 ) -> Result<()> {
-    let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
+    let prepared = args_models(args, forest, species)?;
     let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
     r.set_method(ctx, Method::Hybrid(hybrid))?;
@@ -979,6 +980,55 @@ pub fn write_png(img: &image::RgbaImage, out: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The species' models for the geometry-based methods: `models` prepared here when given,
+/// else those the bake stored in each atlas of the forest `forest_file` (model.bin).
+pub fn models_for(
+    models: &[PathBuf],
+    forest_file: &Path,
+    forest: &Forest,
+    species: &[SpeciesData],
+    allow_other: bool,
+) -> Result<PreparedGeometry> {
+    if !models.is_empty() {
+        return prepare_models(models, species, allow_other);
+    }
+    let dir = forest_file.parent().unwrap_or(Path::new("."));
+    let geo_species = forest
+        .species
+        .iter()
+        .zip(species)
+        .map(|(name, s)| {
+            let atlas = dir.join(name);
+            let model = forest_format::model::PreparedModel::load(&atlas)?.ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{} holds no prepared model ({}): bake it again without --no-model, or \
+                     pass the species' models with --models",
+                    atlas.display(),
+                    forest_format::model::MODEL_FILE
+                )
+            })?;
+            model.check_source(&atlas, &s.atlas.manifest.source.hash)?;
+            Ok(GeometrySpecies::new(model.into(), &s.atlas.manifest))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(PreparedGeometry::new(&geo_species))
+}
+
+/// [`models_for`] the forest and the options of `render`.
+fn args_models(
+    args: &RenderArgs,
+    forest: &Forest,
+    species: &[SpeciesData],
+) -> Result<PreparedGeometry> {
+    models_for(
+        &args.m.models,
+        &args.forest,
+        forest,
+        species,
+        args.m.allow_other_models,
+    )
+}
+
 /// Load the species' OBJ models and prepare them for the geometry-based methods, lit as their
 /// atlases were baked.
 pub fn prepare_models(
@@ -992,7 +1042,8 @@ pub fn prepare_models(
         .map(|(m, s)| {
             let mesh = forest_bake::Mesh::load(m)?;
             check_model(m, &mesh, &s.atlas.manifest, allow_other)?;
-            Ok(GeometrySpecies::new(mesh, &s.atlas.manifest))
+            let model = forest_bake::model::prepare(&mesh, None);
+            Ok(GeometrySpecies::new(model.into(), &s.atlas.manifest))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(PreparedGeometry::new(&geo_species))
@@ -1049,7 +1100,7 @@ fn render_geometry(
     species: &[SpeciesData],
     cameras: &[(String, Camera)],
 ) -> Result<()> {
-    let prepared = prepare_models(&args.m.models, species, args.m.allow_other_models)?;
+    let prepared = args_models(args, forest, species)?;
     let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
     geo.set_method(ctx, method)?;
     // The reference's maps are finer, as in every suite (ForestRenderer::set_shadows).

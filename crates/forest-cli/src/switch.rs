@@ -14,15 +14,14 @@
 //! size. The LODs' errors say whether they could draw the hybrid's near trees instead of the
 //! full model ([`describe_lods`]; on the bundled species they never come within 1.7× of it).
 
-use std::path::Path;
-
-use anyhow::{Context, Result};
+use anyhow::Result;
 use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
 use forest_baselines::hybrid::auto_radii;
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::atlas::HybridSwitch;
 use forest_format::forest::{Forest, Instance};
 use forest_format::generate::SplitMix64;
+use forest_format::model::PreparedModel;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
@@ -206,18 +205,15 @@ pub fn peak_bytes_estimate(model_bytes: u64) -> u64 {
     (160 << 20) + 9 * model_bytes
 }
 
-/// Measure the switch of the model `model` baked into `species` at `tolerance` (see
-/// [`HybridSwitch::tolerance`]), reusing `sky`, the bake's traced sky visibility of its
-/// triangles, when the model is the one the atlas was baked from; `progress(done, total)`
-/// counts the views. Each rung also measures the discrete-LOD baseline's mesh LODs 1 and 2
+/// Measure the switch of the prepared model `model` of the species baked into `species` at
+/// `tolerance` (see [`HybridSwitch::tolerance`]); `progress(done, total)` counts the views. Each rung also measures the discrete-LOD baseline's mesh LODs 1 and 2
 /// ([`Rung::lods`]), which says whether they could draw the hybrid's near trees. Returns the
 /// record and the ladder it came from.
 pub fn measure(
     ctx: &GpuContext,
     species: SpeciesData,
-    model: &Path,
+    model: std::sync::Arc<PreparedModel>,
     tolerance: f32,
-    sky: Option<Vec<forest_bake::sky::TriangleSky>>,
     progress: &dyn Fn(u64, u64),
 ) -> Result<(HybridSwitch, Vec<Rung>)> {
     let manifest = species.atlas.manifest.clone();
@@ -232,15 +228,7 @@ pub fn measure(
         }],
         1,
     );
-    let mesh = forest_bake::Mesh::load(model)
-        .with_context(|| format!("loading {} for the geometry", model.display()))?;
-    // The bake's traced sky visibility, when it traced this very model.
-    let same_model = manifest.source.hash == format!("{:016x}", mesh.hash);
-    let mut geometry_species = GeometrySpecies::new(mesh, &manifest);
-    if let Some(sky) = sky.filter(|_| same_model) {
-        geometry_species = geometry_species.with_sky(sky);
-    }
-    let prepared = PreparedGeometry::new(&[geometry_species]);
+    let prepared = PreparedGeometry::new(&[GeometrySpecies::new(model, &manifest)]);
     let opts = RendererOptions {
         format: TARGET_FORMAT,
         viewport: VIEWPORT,

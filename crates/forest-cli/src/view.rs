@@ -18,7 +18,7 @@ use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
-use crate::render::{MethodArgs, load_scene, parse_size, prepare_models, write_png};
+use crate::render::{MethodArgs, load_scene, models_for, parse_size, prepare_models, write_png};
 
 /// Arguments of `forest view`.
 #[derive(Args, Debug)]
@@ -183,8 +183,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let geometry = match mesh_method {
         Some(_) => Some(geometry(
             &ctx,
-            &prepare_models(
+            &models_for(
                 &args_models.models,
+                &forest_file,
+                &forest,
                 &species,
                 args_models.allow_other_models,
             )?,
@@ -246,8 +248,14 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Lighting) -> Result<()> {
     let (forest, species) = load_scene(forest_file)?;
     let mesh_method = m.checked_method(forest.species.len())?;
+    // The models: --models, else those stored in the atlases (the geometry methods are
+    // offered when every atlas holds one).
     let prepared = if m.models.is_empty() {
-        None
+        match models_for(&[], forest_file, &forest, &species, false) {
+            Ok(p) => Some(p),
+            Err(e) if mesh_method.is_some() => return Err(e),
+            Err(_) => None,
+        }
     } else {
         Some(prepare_models(&m.models, &species, m.allow_other_models)?)
     };

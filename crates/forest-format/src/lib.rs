@@ -10,7 +10,8 @@
 //! - [`atlas`]: the baked atlas (manifest, colour, nodes), its atomic writer and checked loader;
 //! - [`forest`], [`generate`], [`terrain`]: forest files, the clumped-forest generator and the
 //!   height field the trees stand on;
-//! - [`camera_path`]: recorded camera paths for the viewer.
+//! - [`camera_path`]: recorded camera paths for the viewer;
+//! - [`model`]: a species' prepared model for the geometry-based methods and the hybrid.
 //!
 //! A forest made and checked without a GPU or any file (the species are atlas names; `forest
 //! scene` writes the same with `Forest::save`), lit at eight in the morning:
@@ -46,6 +47,7 @@ pub mod directions;
 pub mod error;
 pub mod forest;
 pub mod generate;
+pub mod model;
 pub mod node;
 pub mod nodes_codec;
 pub mod opacity;

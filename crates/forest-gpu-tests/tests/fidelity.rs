@@ -51,8 +51,9 @@ fn atlases() -> &'static (Atlas, Atlas) {
 fn prepared() -> &'static PreparedGeometry {
     static P: OnceLock<PreparedGeometry> = OnceLock::new();
     P.get_or_init(|| {
+        let mesh = forest_bake::Mesh::load(&model()).unwrap();
         PreparedGeometry::new(&[GeometrySpecies::new(
-            forest_bake::Mesh::load(&model()).unwrap(),
+            forest_bake::model::prepare(&mesh, None).into(),
             &atlases().0.manifest,
         )])
     })

@@ -85,6 +85,81 @@ fn receiver_group(
     receivers_of(device, layout, &view, false)
 }
 
+/// A host engine's shadow maps as a forest's receivers read them: the group over its depth
+/// array and the cascades of the next frames (shared by the quad stream and the geometry
+/// renderer, so that the hybrid's two forms receive the same shadows).
+pub struct HostShadows {
+    group: wgpu::BindGroup,
+    resolution: u32,
+    reverse_z: bool,
+    offset_texels: f32,
+    cascades: Vec<crate::shadow::Cascade>,
+}
+
+impl HostShadows {
+    /// The receivers of `view`, a depth array (a layer per cascade, `resolution`² texels,
+    /// standard depth or `reverse_z`), bound with `layout` (the draw's group 2); no cascade
+    /// until [`Self::set_cascades`].
+    pub fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        view: &wgpu::TextureView,
+        resolution: u32,
+        reverse_z: bool,
+    ) -> Self {
+        Self {
+            group: receivers_of(device, layout, view, reverse_z),
+            resolution,
+            reverse_z,
+            offset_texels: ShadowOptions::default().offset_texels,
+            cascades: Vec::new(),
+        }
+    }
+
+    /// The host's cascades: each one's world → shadow clip matrix, the view depth where it
+    /// ends (`split.1`), its texel and its depth range (metres); at most
+    /// [`crate::shadow::MAX_CASCADES`], finite. Refused, with nothing changed, otherwise.
+    pub fn set_cascades(&mut self, cascades: &[crate::shadow::Cascade]) -> Result<(), RenderError> {
+        if cascades.len() > crate::shadow::MAX_CASCADES as usize {
+            return Err(RenderError::Parameter(format!(
+                "{} shadow cascades: at most {}",
+                cascades.len(),
+                crate::shadow::MAX_CASCADES
+            )));
+        }
+        if cascades.iter().any(|c| {
+            !(c.view_proj.is_finite()
+                && c.split.1.is_finite()
+                && c.texel > 0.0
+                && c.depth_range > 0.0)
+        }) {
+            return Err(RenderError::Parameter(
+                "a shadow cascade's matrix, split, texel or depth range is not finite and \
+                 positive"
+                    .into(),
+            ));
+        }
+        self.cascades = cascades.to_vec();
+        Ok(())
+    }
+
+    /// Write the cascades into a camera uniform's receiver fields.
+    pub fn write(&self, g: &mut GpuCamera) {
+        crate::shadow::write_receivers_of(
+            g,
+            &self.cascades,
+            self.resolution,
+            self.offset_texels,
+            self.reverse_z,
+        );
+    }
+
+    /// The receivers' group (the draw's group 2).
+    pub fn group(&self) -> &wgpu::BindGroup {
+        &self.group
+    }
+}
+
 /// The receivers' group over a depth array `view` (a host's maps too), compared as
 /// standard depth or reverse-Z.
 pub fn receivers_of(

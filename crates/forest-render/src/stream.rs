@@ -27,6 +27,7 @@ use crate::passes::cull::CullPass;
 use crate::passes::draw::DrawPass;
 use crate::passes::refine::RefinePass;
 use crate::scene::GpuScene;
+use crate::shadow_maps::HostShadows;
 use crate::stats::{FrameStats, PassTimes, StatsRing};
 use crate::work::{CountingPass, FrameWork, StatisticsQueries};
 
@@ -114,15 +115,6 @@ pub struct QuadStream {
     host_shadows: Option<HostShadows>,
     /// The casting pipeline into a host's map ([`Self::prepare_light`]).
     host_cast: Option<crate::passes::cast::CastPass>,
-}
-
-/// A host's shadow maps as the forest's receivers read them.
-struct HostShadows {
-    group: wgpu::BindGroup,
-    resolution: u32,
-    reverse_z: bool,
-    offset_texels: f32,
-    cascades: Vec<crate::shadow::Cascade>,
 }
 
 /// Bytes of the camera buffer: the view's camera, then a light-view camera per cascade
@@ -282,18 +274,13 @@ impl QuadStream {
     ) {
         self.host_shadows = maps.map(|(view, resolution, reverse_z)| {
             self.shadows = None;
-            HostShadows {
-                group: crate::shadow_maps::receivers_of(
-                    device,
-                    &self.passes.draw.shadow_layout,
-                    view,
-                    reverse_z,
-                ),
+            HostShadows::new(
+                device,
+                &self.passes.draw.shadow_layout,
+                view,
                 resolution,
                 reverse_z,
-                offset_texels: crate::shadow::ShadowOptions::default().offset_texels,
-                cascades: Vec::new(),
-            }
+            )
         });
     }
 
@@ -305,35 +292,12 @@ impl QuadStream {
         &mut self,
         cascades: &[crate::shadow::Cascade],
     ) -> Result<(), RenderError> {
-        if cascades.len() > crate::shadow::MAX_CASCADES as usize {
-            return Err(RenderError::Parameter(format!(
-                "{} shadow cascades: at most {}",
-                cascades.len(),
-                crate::shadow::MAX_CASCADES
-            )));
-        }
-        if cascades.iter().any(|c| {
-            !(c.view_proj.is_finite()
-                && c.split.1.is_finite()
-                && c.texel > 0.0
-                && c.depth_range > 0.0)
-        }) {
-            return Err(RenderError::Parameter(
-                "a shadow cascade's matrix, split, texel or depth range is not finite and \
-                 positive"
-                    .into(),
-            ));
-        }
         match &mut self.host_shadows {
-            Some(h) => h.cascades = cascades.to_vec(),
-            None => {
-                return Err(RenderError::Parameter(
-                    "host cascades without host shadow maps: call receive_host_shadows first"
-                        .into(),
-                ));
-            }
+            Some(h) => h.set_cascades(cascades),
+            None => Err(RenderError::Parameter(
+                "host cascades without host shadow maps: call receive_host_shadows first".into(),
+            )),
         }
-        Ok(())
     }
 
     /// Write a host's light view (the frame's upload for this stream): from here on the stream
@@ -885,13 +849,7 @@ impl QuadStream {
         g.forms = self.forms;
         g.set_light(&self.light);
         if let Some(h) = &self.host_shadows {
-            crate::shadow::write_receivers_of(
-                &mut g,
-                &h.cascades,
-                h.resolution,
-                h.offset_texels,
-                h.reverse_z,
-            );
+            h.write(&mut g);
         }
         let cameras = match &self.shadows {
             Some(sh) => crate::shadow::cameras(
@@ -1093,7 +1051,7 @@ impl QuadStream {
             &self.sized.bg_draw[(self.iterations % 2) as usize],
             match (&self.shadows, &self.host_shadows) {
                 (Some(s), _) => s.receivers(),
-                (None, Some(h)) => &h.group,
+                (None, Some(h)) => h.group(),
                 (None, None) => &self.no_shadows,
             },
             &self.sized.args,

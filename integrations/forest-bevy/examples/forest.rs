@@ -243,14 +243,20 @@ fn sun(
     }
 }
 
+/// The methods M cycles through (full geometry left out: every tree of a large forest as its
+/// model takes seconds a frame on a CPU).
+const METHODS: [ForestMethod; 4] = [
+    ForestMethod::QuadStream,
+    ForestMethod::Hybrid,
+    ForestMethod::DiscreteLods,
+    ForestMethod::Impostors,
+];
+
 fn switch(keys: Res<ButtonInput<KeyCode>>, mut cams: Query<&mut ForestCamera>) {
     for mut c in &mut cams {
         if keys.just_pressed(KeyCode::KeyM) {
-            let i = ForestMethod::ALL
-                .iter()
-                .position(|m| *m == c.method)
-                .unwrap_or(0);
-            c.method = ForestMethod::ALL[(i + 1) % ForestMethod::ALL.len()];
+            let i = METHODS.iter().position(|m| *m == c.method).unwrap_or(0);
+            c.method = METHODS[(i + 1) % METHODS.len()];
         }
         if keys.just_pressed(KeyCode::BracketLeft) {
             c.epsilon = (c.epsilon * 0.5).max(1.0);
@@ -270,11 +276,17 @@ fn title(
     let (Ok((camera, c)), Ok(mut window)) = (cams.single(), windows.single_mut()) else {
         return;
     };
+    // A method the forest cannot draw (atlases baked without models) says why.
+    let error = stats
+        .views
+        .iter()
+        .find_map(|((cam, _), s)| (*cam == camera).then_some(s.error.as_deref()).flatten());
     window.title = format!(
-        "forest in Bevy: {} ε {} px, {} quads, {:.1} ms (M method, [ ] ε, IJKL sun)",
+        "forest in Bevy: {} ε {} px, {} quads, {:.1} ms (M method, [ ] ε, IJKL sun){}",
         c.method.name(),
         c.epsilon,
         stats.quads(camera),
-        time.delta_secs() * 1000.0
+        time.delta_secs() * 1000.0,
+        error.map(|e| format!(": {e}")).unwrap_or_default()
     );
 }

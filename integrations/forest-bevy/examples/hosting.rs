@@ -4,10 +4,11 @@
 //! one run, interleaved, medians of the frames.
 //!
 //! ```sh
-//! cargo run --release --ignore-rust-version --example hosting -- FOREST [--size WxH] [--frames N] [--no-depth]
+//! cargo run --release --ignore-rust-version --example hosting -- FOREST [--size WxH] [--frames N] [--no-depth] [--method quads|hybrid|lods]
 //! ```
-//! `--no-depth` draws without `ForestCamera::write_depth`. Bevy's camera draws one sample per
-//! pixel, as `forest-render`'s frame does.
+//! `--no-depth` draws without `ForestCamera::write_depth`. `--method` draws the quad stream
+//! (default), the hybrid or the discrete LODs (these two from the models the atlases hold).
+//! Bevy's camera draws one sample per pixel, as `forest-render`'s frame does.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -18,7 +19,8 @@ use bevy::prelude::*;
 use bevy::render::RenderApp;
 use bevy::render::renderer::RenderDevice;
 use bevy::window::{ExitCondition, WindowPlugin};
-use forest_bevy::{ForestCamera, ForestPlugin, ForestScene, ForestStats};
+use forest_baselines::{ForestRenderer, GeometryRenderer, GeometrySpecies, PreparedGeometry};
+use forest_bevy::{ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats};
 use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions, Targets};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -47,6 +49,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames: usize = value("--frames").map_or(Ok(7), |s| s.parse())?;
     let epsilon = 4.0;
     let write_depth = !args.iter().any(|a| a == "--no-depth");
+    let method = match value("--method").map(String::as_str) {
+        None | Some("quads") => ForestMethod::QuadStream,
+        Some("hybrid") => ForestMethod::Hybrid,
+        Some("lods") => ForestMethod::DiscreteLods,
+        Some(m) => return Err(format!("--method {m}: quads, hybrid or lods").into()),
+    };
+    let settings = ForestCamera {
+        method,
+        epsilon,
+        write_depth,
+    };
     let forest = forest_format::forest::Forest::load(&forest_path)?;
     let folder = forest_path
         .parent()
@@ -82,7 +95,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO),
         ..Default::default()
     };
-    let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
+    let stream = QuadStream::new(&ctx.device, scene, &opts)?;
+    // The models the atlases hold, for the model methods.
+    let geometry = if method.needs_models() {
+        let models = forest
+            .species
+            .iter()
+            .zip(&species)
+            .map(|(name, s)| {
+                let model = forest_format::model::PreparedModel::load(&folder.join(name))?
+                    .ok_or_else(|| format!("{name} holds no model.bin: bake it again"))?;
+                Ok(GeometrySpecies::new(model.into(), &s.atlas.manifest))
+            })
+            .collect::<Result<Vec<_>, Box<dyn std::error::Error>>>()?;
+        let prepared = PreparedGeometry::new(&models);
+        Some(GeometryRenderer::with_targets(
+            &ctx, &prepared, &forest, &opts,
+        )?)
+    } else {
+        None
+    };
+    let mut stream = ForestRenderer::new(stream, geometry);
+    stream.set_method(&ctx, method.method())?;
     // Bevy, drawing the same view into an image.
     let mut app = App::new();
     app.add_plugins(
@@ -125,20 +159,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Tonemapping::None,
             // One sample per pixel, as forest-render's own frame draws (Bevy's default is 4).
             bevy::render::view::Msaa::Off,
-            ForestCamera {
-                epsilon,
-                write_depth,
-                ..default()
-            },
+            settings,
         ))
         .id();
     // One frame of forest-render alone: the camera, then cull, refine and draw, submitted.
-    let draw_alone = |stream: &mut QuadStream, frame: &FrameParams| {
+    let draw_alone = |stream: &mut ForestRenderer, frame: &FrameParams| {
         stream.prepare(&ctx.queue, frame)?;
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         let clear = wgpu::Color::BLACK;
         let targets = Targets::cleared(&target.colour_view, &target.depth_view, clear, 0.0);
-        stream.encode_into(&mut enc, &targets);
+        stream.encode_compute(&mut enc);
+        {
+            let mut pass = targets.begin(&mut enc, "forest", stream.draw_timestamps());
+            stream.render(&mut pass);
+        }
+        stream.resolve_times(&mut enc);
         ctx.queue.submit([enc.finish()]);
         Ok::<(), forest_render::RenderError>(())
     };
@@ -149,10 +184,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .poll(wgpu::PollType::wait_indefinitely());
     };
     println!(
-        "| view | quads (Bevy) | Bevy frame, ms | Bevy frame without the forest, ms | \
+        "| view | quads (Bevy) | triangles (Bevy) | Bevy frame, ms | Bevy frame without the forest, ms | \
          forest-render frame, ms | ratio | forest GPU passes in Bevy, ms | alone, ms |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for (label, eye, at) in views {
         *app.world_mut()
             .get_mut::<Transform>(camera)
@@ -180,7 +215,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .world()
                 .resource::<ForestStats>()
                 .get(camera, forest_entity)
-                .is_some_and(|s| s.quads > 0)
+                .is_some_and(|s| s.quads > 0 || s.triangles > 0)
             {
                 break;
             }
@@ -204,6 +239,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             alone.push(t.elapsed().as_secs_f64() * 1e3);
         }
         let quads = app.world().resource::<ForestStats>().quads(camera);
+        let triangles = app
+            .world()
+            .resource::<ForestStats>()
+            .get(camera, forest_entity)
+            .map_or(0, |s| s.triangles);
         let hosted_gpu = app
             .world()
             .resource::<ForestStats>()
@@ -225,14 +265,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 empty.push(t.elapsed().as_secs_f64() * 1e3);
             }
         }
-        app.world_mut().entity_mut(camera).insert(ForestCamera {
-            epsilon,
-            write_depth,
-            ..default()
-        });
+        app.world_mut().entity_mut(camera).insert(settings);
         let (b, a, e) = (median(bevy), median(alone), median(empty));
         println!(
-            "| {label} | {quads} | {b:.1} | {e:.1} | {a:.1} | {:.2} | {hosted_gpu:.1} | {alone_gpu:.1} |",
+            "| {label} | {quads} | {triangles} | {b:.1} | {e:.1} | {a:.1} | {:.2} | {hosted_gpu:.1} | {alone_gpu:.1} |",
             b / a
         );
     }

@@ -2,7 +2,8 @@
 //!
 //! - [`ForestAtlas`], loaded from an atlas folder (`NAME.atlas`, as `forest bake` writes it)
 //!   by [`AtlasLoader`]: each of its files is read through Bevy's asset reader and checked by
-//!   `forest-format` as `forest render` checks it.
+//!   `forest-format` as `forest render` checks it, with the species' prepared model
+//!   (`model.bin`, which the geometry methods and the hybrid draw) when the bake stored one.
 //! - [`ForestAsset`], loaded from a `.forest` file by [`ForestLoader`], with the atlases it
 //!   names (relative to its folder) loaded as its dependencies.
 //!
@@ -16,9 +17,11 @@ use std::sync::Arc;
 use bevy::asset::io::Reader;
 use bevy::asset::{Asset, AssetLoader, AssetPath, LoadContext};
 use bevy::reflect::TypePath;
+use forest_baselines::{GeometrySpecies, PreparedGeometry};
 use forest_format::FormatError;
 use forest_format::atlas::{ATLAS_FILES, Atlas, MANIFEST_FILE};
 use forest_format::forest::Forest;
+use forest_format::model::{MODEL_FILE, PreparedModel};
 use forest_render::SpeciesData;
 
 /// Why a forest or an atlas did not load. Its message names the file and the cause.
@@ -50,6 +53,8 @@ pub enum LoadError {
 pub struct ForestAtlas {
     /// The decoded atlas.
     pub data: Arc<SpeciesData>,
+    /// The species' prepared model (`model.bin`), when the bake stored one.
+    pub model: Option<Arc<PreparedModel>>,
 }
 
 /// A forest: its trees (instances, presorted per direction), its terrain, and its species'
@@ -60,6 +65,9 @@ pub struct ForestAsset {
     pub forest: Arc<Forest>,
     /// One atlas per species, in the forest's species order.
     pub species: Arc<[SpeciesData]>,
+    /// Every species' prepared model gathered for the geometry methods and the hybrid, or
+    /// why there is none (the atlases without a `model.bin`).
+    pub geometry: Result<Arc<PreparedGeometry>, String>,
 }
 
 /// Loads atlas folders (`*.atlas`).
@@ -110,10 +118,20 @@ impl AssetLoader for AtlasLoader {
             )),
         };
         let atlas = Atlas::from_files(&shown, &read)?;
+        // The prepared model, when the bake stored one; one that is there must be sound.
+        let model = match files.iter().find(|(n, _)| *n == MODEL_FILE) {
+            Some((_, Ok(bytes))) => {
+                let model = PreparedModel::decode(bytes, &shown.join(MODEL_FILE))?;
+                model.check_source(&shown, &atlas.manifest.source.hash)?;
+                Some(Arc::new(model))
+            }
+            _ => None,
+        };
         let data =
             SpeciesData::decode(atlas, &shown).map_err(|e| LoadError::Decode(e.to_string()))?;
         Ok(ForestAtlas {
             data: Arc::new(data),
+            model,
         })
     }
 
@@ -145,6 +163,8 @@ impl AssetLoader for ForestLoader {
             .map_err(|e| FormatError::invalid(&path, e.to_string()))?;
         let forest = Forest::parse(&path, &bytes)?;
         let mut species = Vec::with_capacity(forest.species.len());
+        let mut models = Vec::with_capacity(forest.species.len());
+        let mut without = Vec::new();
         for (index, name) in forest.species.iter().enumerate() {
             let fail = |cause: String| LoadError::Atlas {
                 forest: path.clone(),
@@ -164,12 +184,28 @@ impl AssetLoader for ForestLoader {
                 .await
                 .map_err(|e| fail(cause_of(&e)))?;
             // The nested load's asset is this forest's alone: taken, not copied.
-            let data = loaded.take().data;
+            let ForestAtlas { data, model } = loaded.take();
+            match model {
+                Some(m) => models.push(GeometrySpecies::new(m, &data.atlas.manifest)),
+                None => without.push(name.clone()),
+            }
             species.push(Arc::try_unwrap(data).unwrap_or_else(|shared| (*shared).clone()));
         }
+        let geometry = if without.is_empty() {
+            Ok(Arc::new(PreparedGeometry::new(&models)))
+        } else {
+            Err(format!(
+                "{} of {} hold no prepared model ({MODEL_FILE}): bake {} again without \
+                 --no-model to draw the geometry methods and the hybrid",
+                without.join(", "),
+                path.display(),
+                if without.len() == 1 { "it" } else { "them" }
+            ))
+        };
         Ok(ForestAsset {
             forest: Arc::new(forest),
             species: species.into(),
+            geometry,
         })
     }
 

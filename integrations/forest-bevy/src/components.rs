@@ -46,17 +46,52 @@ pub enum ForestMethod {
     QuadStream,
     /// Static impostors: each tree's level-0 slab images, never refined.
     Impostors,
+    /// The trees next to the camera as their full models, the rest as the quad stream, each
+    /// species switching where its bake measured the quads as accurate as its triangles.
+    /// Needs every species' prepared model (`model.bin`, which `forest bake` stores).
+    Hybrid,
+    /// Discrete LODs (the full model, two simplified meshes, billboards) by distance. Needs
+    /// the prepared models.
+    DiscreteLods,
+    /// Every tree as its full model. Needs the prepared models.
+    FullGeometry,
 }
 
 impl ForestMethod {
     /// Every method, in the order a switch cycles through them.
-    pub const ALL: [ForestMethod; 2] = [ForestMethod::QuadStream, ForestMethod::Impostors];
+    pub const ALL: [ForestMethod; 5] = [
+        ForestMethod::QuadStream,
+        ForestMethod::Hybrid,
+        ForestMethod::Impostors,
+        ForestMethod::DiscreteLods,
+        ForestMethod::FullGeometry,
+    ];
 
     /// Its short name.
     pub fn name(self) -> &'static str {
         match self {
             ForestMethod::QuadStream => "quad stream",
             ForestMethod::Impostors => "impostors",
+            ForestMethod::Hybrid => "hybrid",
+            ForestMethod::DiscreteLods => "discrete LODs",
+            ForestMethod::FullGeometry => "full geometry",
+        }
+    }
+
+    /// Whether it draws the species' models (and so needs their prepared models).
+    pub fn needs_models(self) -> bool {
+        !matches!(self, ForestMethod::QuadStream | ForestMethod::Impostors)
+    }
+
+    /// The renderer's method with its default parameters.
+    pub fn method(self) -> forest_baselines::Method {
+        use forest_baselines::{Hybrid, MeshMethod, Method};
+        match self {
+            ForestMethod::QuadStream => Method::Quads,
+            ForestMethod::Impostors => Method::Impostor,
+            ForestMethod::Hybrid => Method::Hybrid(Hybrid::default()),
+            ForestMethod::DiscreteLods => Method::Mesh(MeshMethod::Lods(Default::default())),
+            ForestMethod::FullGeometry => Method::Mesh(MeshMethod::Full { depth_sort: true }),
         }
     }
 }

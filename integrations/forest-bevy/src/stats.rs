@@ -14,6 +14,10 @@ pub struct ForestViewStats {
     pub visible_trees: u32,
     /// Quads drawn.
     pub quads: u32,
+    /// Triangles drawn (the geometry methods, and the hybrid's near trees).
+    pub triangles: u64,
+    /// Trees the hybrid drew as their models.
+    pub geometry_trees: u32,
     /// Quads cast into Bevy's shadow cascades, over all cascades.
     pub cast_quads: u32,
     /// Cull + refine + draw on the GPU, milliseconds (where the device has timestamps).

@@ -8,7 +8,7 @@ use bevy::asset::AssetLoadFailedEvent;
 use bevy::prelude::*;
 use bevy::render::view::Msaa;
 use common::*;
-use forest_bevy::{ForestAsset, ForestStats};
+use forest_bevy::{ForestAsset, ForestMethod, ForestStats};
 
 /// Pixels that differ from the clear colour by more than 8 levels in a channel.
 fn covered(img: &image::RgbaImage) -> Vec<bool> {
@@ -83,12 +83,65 @@ fn every_kind_of_view_matches_forest_render() {
             expected_light(sun_dir()),
             *samples,
         );
-        bevy.save(out_dir().join(format!("view-{name}.png")))
-            .unwrap();
-        reference
-            .save(out_dir().join(format!("view-{name}-reference.png")))
-            .unwrap();
-        let flip = assert_flip(name, &reference, &bevy, 0.02);
+        let flip = compare_view(name, &reference, &bevy, 0.02);
+        println!("{name}: FLIP {flip:.4}, coverage {coverage:.2}, {stats:?}");
+    }
+}
+
+/// The methods that draw the species' models, from the prepared model the bake stored in
+/// the atlas: the hybrid (its near trees as models, its transition band in both forms) and
+/// the discrete LODs, two cameras of one app, each within FLIP 0.02 of `forest-render`
+/// drawing the same method alone.
+#[test]
+fn the_model_methods_match_forest_render() {
+    let mut app = app(assets());
+    let forest = spawn_forest(&mut app, Transform::IDENTITY);
+    let methods = [ForestMethod::Hybrid, ForestMethod::DiscreteLods];
+    let views: Vec<_> = methods
+        .iter()
+        .map(|&method| {
+            let view = View {
+                method,
+                ..View::at(EYE, AT)
+            };
+            (method, view, spawn_camera(&mut app, view))
+        })
+        .collect();
+    for (method, _, (camera, _)) in &views {
+        settle_on(&mut app, *camera, forest, |s| match method {
+            ForestMethod::Hybrid => s.quads > 0 && s.geometry_trees > 0 && s.triangles > 0,
+            _ => s.triangles > 0,
+        });
+    }
+    let images: Vec<_> = views
+        .iter()
+        .map(|(_, _, (_, image))| read(&mut app, image))
+        .collect();
+    for ((method, view, (camera, _)), bevy) in views.iter().zip(images) {
+        let stats = app
+            .world()
+            .resource::<ForestStats>()
+            .get(*camera, forest)
+            .cloned();
+        let stats = stats.expect("statistics");
+        assert!(
+            stats.error.is_none(),
+            "{}: {:?}",
+            method.name(),
+            stats.error
+        );
+        let name = method.name().replace(' ', "-");
+        let reference = reference_with(
+            view.eye,
+            view.target,
+            view.epsilon,
+            expected_light(sun_dir()),
+            1,
+            *method,
+        );
+        let coverage = share(&covered(&bevy));
+        assert!(coverage > 0.1, "{name}: trees cover only {coverage}");
+        let flip = compare_view(&name, &reference, &bevy, 0.02);
         println!("{name}: FLIP {flip:.4}, coverage {coverage:.2}, {stats:?}");
     }
 }
@@ -259,14 +312,27 @@ fn collect(
     }
 }
 
-/// A forest naming a missing atlas, and one naming a corrupt atlas, each fail to load with
-/// an asset event that names the atlas and the cause; nothing panics and nothing is drawn.
+/// A forest naming a missing atlas, one naming a corrupt atlas and one whose atlas holds a
+/// corrupt prepared model each fail to load with an asset event that names the file and the
+/// cause; nothing panics and nothing is drawn.
 #[test]
 fn missing_and_corrupt_atlases_are_reported() {
     let dir = out_dir().join("bad-assets");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(dir.join("corrupt.atlas")).unwrap();
     std::fs::write(dir.join("corrupt.atlas/manifest.json"), b"{ not json").unwrap();
+    // A sound atlas with a truncated model.bin.
+    std::fs::create_dir_all(dir.join("badmodel.atlas")).unwrap();
+    for e in std::fs::read_dir(assets().join("bush.atlas")).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), dir.join("badmodel.atlas").join(e.file_name())).unwrap();
+    }
+    let model = std::fs::read(dir.join("badmodel.atlas/model.bin")).unwrap();
+    std::fs::write(
+        dir.join("badmodel.atlas/model.bin"),
+        &model[..model.len() / 2],
+    )
+    .unwrap();
     let instance = forest_format::forest::Instance {
         position: [0.0; 3],
         rotation: 0.0,
@@ -276,6 +342,7 @@ fn missing_and_corrupt_atlases_are_reported() {
     for (file, atlas) in [
         ("missing.forest", "nowhere.atlas"),
         ("corrupt.forest", "corrupt.atlas"),
+        ("badmodel.forest", "badmodel.atlas"),
     ] {
         forest_format::forest::Forest::new(vec![atlas.into()], vec![instance], 4)
             .save(&dir.join(file))
@@ -285,17 +352,21 @@ fn missing_and_corrupt_atlases_are_reported() {
     let mut app = app(&dir);
     app.init_resource::<Failures>().add_systems(Update, collect);
     let server = app.world().resource::<AssetServer>().clone();
-    let handles: Vec<Handle<ForestAsset>> =
-        ["missing.forest", "corrupt.forest", "truncated.forest"]
-            .iter()
-            .map(|f| server.load(*f))
-            .collect();
+    let handles: Vec<Handle<ForestAsset>> = [
+        "missing.forest",
+        "corrupt.forest",
+        "truncated.forest",
+        "badmodel.forest",
+    ]
+    .iter()
+    .map(|f| server.load(*f))
+    .collect();
     for h in &handles {
         app.world_mut().spawn(forest_bevy::ForestScene(h.clone()));
     }
     let (_camera, _image) = spawn_camera(&mut app, View::at(EYE, AT));
-    update_until(&mut app, 600, "three load failures", |app| {
-        app.world().resource::<Failures>().0.len() >= 3
+    update_until(&mut app, 600, "four load failures", |app| {
+        app.world().resource::<Failures>().0.len() >= 4
     });
     let failures = &app.world().resource::<Failures>().0;
     println!("{failures:#?}");
@@ -308,6 +379,8 @@ fn missing_and_corrupt_atlases_are_reported() {
         "{corrupt}"
     );
     assert!(find("truncated.forest").is_some());
+    let model = find("badmodel.forest").expect("the corrupt model reported");
+    assert!(model.contains("model.bin"), "{model}");
     assert_eq!(app.world().resource::<ForestStats>().views.len(), 0);
 }
 

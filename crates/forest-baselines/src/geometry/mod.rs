@@ -3,8 +3,9 @@
 //! 003), stochastic simplification (seeds 000/001) and discrete LODs + billboards (seed 004).
 //!
 //! ```text
-//! per species, once: reference_vertices (per-vertex sun visibility, the bake's tracer)
+//! per species, at bake: reference_vertices (per-vertex sky visibility, the bake's tracer)
 //!   ─► lod::build_lods (LOD 0 = every triangle, leaves shuffled; LODs 1, 2) + billboards
+//!   ─► the atlas's model.bin (forest_format::model), gathered by PreparedGeometry
 //! per frame: geo_reset ─► geo_classify (frustum, distance band) ─► geo_args (offsets,
 //!   indirect arguments per band × species) ─► geo_scatter ─► draw bands nearest first
 //! ```
@@ -19,9 +20,10 @@ mod prepare;
 mod renderer;
 mod textures;
 
+pub use forest_format::model::BILLBOARD_RESOLUTION;
 pub use layout::{COMPUTE_SLOTS, compute_entries, draw_entries};
 pub use params::{GeometrySpecies, GeometryStats, Lods, MeshMethod, SpeciesFigures, Stochastic};
-pub use prepare::{BILLBOARD_RESOLUTION, PreparedGeometry};
+pub use prepare::PreparedGeometry;
 pub use renderer::{GeometryRenderer, RESET_WG};
 pub use textures::MATERIAL_TEXTURE_SIZE;
 

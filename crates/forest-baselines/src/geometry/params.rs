@@ -1,43 +1,33 @@
 //! What the geometry-based methods are asked to draw: the species' models, the method and its
 //! parameters, and the counters a frame reports.
 
-use forest_bake::Mesh;
-use forest_bake::lod::BANDS;
+use forest_format::model::{BANDS, PreparedModel};
 use forest_render::context::RenderError;
 use forest_render::stats::PassTimes;
 
 use crate::gpu_types::GpuMethod;
 
 /// A species for the geometry-based methods.
+#[derive(Clone)]
 pub struct GeometrySpecies {
-    /// The model.
-    pub mesh: Mesh,
+    /// Its prepared model (the bake's, [`forest_format::model::PreparedModel`]).
+    pub model: std::sync::Arc<PreparedModel>,
     /// The hybrid's switch unit of its atlas ([`forest_render::forms::switch_unit`]), so that
     /// both forms agree where each tree switches (any value when the hybrid is not used).
     pub switch_unit: f32,
-    /// The sky visibility of the mesh's triangles when it is already traced (the bake's, one
-    /// entry per triangle: [`forest_bake::sky::triangle_sky`]); traced at preparation when
-    /// `None`.
-    pub sky: Option<Vec<forest_bake::sky::TriangleSky>>,
 }
 
 impl GeometrySpecies {
-    /// The model `mesh` of the species baked into the atlas of `manifest`: its hybrid switch
-    /// comes from the atlas, so the geometry switches as its quads do.
-    pub fn new(mesh: Mesh, manifest: &forest_format::AtlasManifest) -> Self {
+    /// The prepared `model` of the species baked into the atlas of `manifest`: its hybrid
+    /// switch comes from the atlas, so the geometry switches as its quads do.
+    pub fn new(
+        model: std::sync::Arc<PreparedModel>,
+        manifest: &forest_format::AtlasManifest,
+    ) -> Self {
         Self {
-            mesh,
+            model,
             switch_unit: forest_render::forms::switch_unit(manifest),
-            sky: None,
         }
-    }
-
-    /// The same with the mesh's sky visibility already traced (one entry per triangle, in the
-    /// mesh's order), which preparation then reuses; a `sky` of another length is ignored and
-    /// traced again.
-    pub fn with_sky(mut self, sky: Vec<forest_bake::sky::TriangleSky>) -> Self {
-        self.sky = (sky.len() == self.mesh.tris.len()).then_some(sky);
-        self
     }
 }
 
@@ -200,7 +190,7 @@ impl MeshMethod {
                 }
             }
             MeshMethod::Stochastic(s) => {
-                forest_bake::lod::lambda_band(forest_bake::lod::lambda(d, s.d0, s.h))
+                forest_format::model::lambda_band(forest_format::model::lambda(d, s.d0, s.h))
             }
             MeshMethod::Lods(l) => {
                 let (mut lod, mut start) = (0, 1.0);

@@ -2,8 +2,8 @@
 //! band on the GPU, write indirect arguments per band × species, scatter, and draw the bands
 //! nearest first.
 
-use forest_bake::lod::BANDS;
 use forest_format::forest::Forest;
+use forest_format::model::BANDS;
 use forest_render::Targets;
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
@@ -20,8 +20,9 @@ use wgpu::util::DeviceExt;
 
 use super::layout::{compute_entries, draw_entries};
 use super::params::{GeometryStats, MeshMethod, SpeciesFigures};
-use super::prepare::{BILLBOARD_RESOLUTION, PreparedGeometry};
+use super::prepare::PreparedGeometry;
 use super::textures::{MATERIAL_TEXTURE_SIZE, layered_texture};
+use forest_format::model::BILLBOARD_RESOLUTION;
 
 /// Workgroup size of `geo_reset` (one invocation per segment); the other per-tree entry
 /// points use the runtime's `WG` (a test checks both against the WGSL).
@@ -82,6 +83,8 @@ pub struct GeometryRenderer {
     shadows: Option<super::light::LightViews>,
     /// The last light views switched off, kept for switching them on again.
     parked: Option<super::light::LightViews>,
+    /// A host's shadow maps the trees receive instead ([`Self::receive_host_shadows`]).
+    host_shadows: Option<forest_render::shadow_maps::HostShadows>,
     /// What every view of the renderer binds (its own lists aside).
     shared: Shared,
 }
@@ -538,6 +541,7 @@ impl GeometryRenderer {
             no_shadows,
             shadows: None,
             parked: None,
+            host_shadows: None,
             shared,
             queries,
             statistics,
@@ -654,6 +658,9 @@ impl GeometryRenderer {
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
         g.forms = self.forms;
         g.set_light(&self.light);
+        if let Some(h) = &self.host_shadows {
+            h.write(&mut g);
+        }
         let cameras = match &self.shadows {
             Some(lv) => forest_render::shadow::cameras(
                 &g,
@@ -704,6 +711,9 @@ impl GeometryRenderer {
             s.as_ref()
                 .is_some_and(|s| std::sync::Arc::ptr_eq(&s.targets, t))
         };
+        if targets.is_some() {
+            self.host_shadows = None;
+        }
         match targets {
             None => {
                 if let Some(s) = self.shadows.take() {
@@ -718,6 +728,41 @@ impl GeometryRenderer {
                 self.parked = self.shadows.take();
                 self.shadows = Some(super::light::LightViews::new(device, &self.shared, t));
             }
+        }
+    }
+
+    /// Receive a host's sun shadows (as `QuadStream::receive_host_shadows`): `maps` is the
+    /// host's depth array (a layer per cascade, `resolution`² texels, standard depth or
+    /// reverse-Z); `None` stops. Each frame's cascades come from [`Self::set_host_cascades`].
+    /// The renderer's own (or shared) shadows are switched off.
+    pub fn receive_host_shadows(
+        &mut self,
+        device: &wgpu::Device,
+        maps: Option<(&wgpu::TextureView, u32, bool)>,
+    ) {
+        self.host_shadows = maps.map(|(view, resolution, reverse_z)| {
+            self.share_shadows(device, None);
+            forest_render::shadow_maps::HostShadows::new(
+                device,
+                &self.shadow_layout,
+                view,
+                resolution,
+                reverse_z,
+            )
+        });
+    }
+
+    /// The host's cascades for the next frames' receivers (see
+    /// [`Self::receive_host_shadows`]; checked as `QuadStream::set_host_cascades`).
+    pub fn set_host_cascades(
+        &mut self,
+        cascades: &[forest_render::shadow::Cascade],
+    ) -> Result<(), RenderError> {
+        match &mut self.host_shadows {
+            Some(h) => h.set_cascades(cascades),
+            None => Err(RenderError::Parameter(
+                "host cascades without host shadow maps: call receive_host_shadows first".into(),
+            )),
         }
     }
 
@@ -853,13 +898,12 @@ impl GeometryRenderer {
     pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
         let ground = ground && self.background == Background::Sky;
         pass.set_bind_group(0, &self.draw_bg, &[]);
-        pass.set_bind_group(
-            2,
-            self.shadows
-                .as_ref()
-                .map_or(&self.no_shadows, |s| s.targets.receivers()),
-            &[],
-        );
+        let receivers = match (&self.shadows, &self.host_shadows) {
+            (Some(s), _) => s.targets.receivers(),
+            (None, Some(h)) => h.group(),
+            (None, None) => &self.no_shadows,
+        };
+        pass.set_bind_group(2, receivers, &[]);
         let environment = if ground {
             self.terrain
                 .record_ground(pass, &self.environment, &self.terrain_pipeline)

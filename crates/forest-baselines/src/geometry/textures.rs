@@ -1,46 +1,14 @@
 //! The geometry renderer's textures: material and billboard layers in one sRGB array each,
 //! with coverage-preserving mip chains filtered in linear light (as the atlas's are).
 
-use forest_bake::Mesh;
 use forest_render::context::GpuContext;
 use wgpu::util::DeviceExt;
 
-/// Side of every material texture layer on the GPU.
-pub const MATERIAL_TEXTURE_SIZE: u32 = 512;
+pub use forest_format::model::MATERIAL_TEXTURE_SIZE;
 
 /// Bytes of RGBA8 layers with their mip chains (a third more than level 0).
 pub(super) fn layer_bytes(layers: &[image::RgbaImage]) -> u64 {
     layers.iter().map(|l| l.as_raw().len() as u64 * 4 / 3).sum()
-}
-
-/// Combine a material's colour and alpha sources into one RGBA image of the layer size.
-pub(super) fn material_layer(
-    mesh: &Mesh,
-    colour: Option<usize>,
-    alpha: Option<(usize, bool)>,
-) -> image::RgbaImage {
-    let s = MATERIAL_TEXTURE_SIZE;
-    let resize = |t: usize| {
-        let tex = &mesh.textures[t];
-        let img = image::RgbaImage::from_raw(tex.width, tex.height, tex.rgba.clone())
-            .expect("texture size");
-        image::imageops::resize(&img, s, s, image::imageops::FilterType::Triangle)
-    };
-    let mut out = match colour {
-        Some(c) => resize(c),
-        None => image::RgbaImage::from_pixel(s, s, image::Rgba([255, 255, 255, 255])),
-    };
-    if let Some((a, channel)) = alpha {
-        let src = if Some(a) == colour && channel {
-            out.clone()
-        } else {
-            resize(a)
-        };
-        for (o, p) in out.pixels_mut().zip(src.pixels()) {
-            o[3] = forest_bake::mesh::texel_alpha(p.0, channel);
-        }
-    }
-    out
 }
 
 /// Every mip level of linear data down to 1×1, each the box filter of the one above (bytes and
@@ -90,7 +58,7 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     let mut data = Vec::new();
     let mut dilated = img.clone();
     // Level 0's bilinear filter must not mix in the colour of failing texels either.
-    forest_bake::lod::dilate_colour_from(&mut dilated, ALPHA_TEST_BYTE);
+    forest_format::model::dilate_colour_from(&mut dilated, ALPHA_TEST_BYTE);
     let table = srgb_decode_table();
     let linear = |x: u32, y: u32| {
         let p = dilated.get_pixel(x, y).0;

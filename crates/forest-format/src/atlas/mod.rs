@@ -333,6 +333,12 @@ impl Atlas {
     /// `path`. An existing atlas at `path` is replaced; any other existing file or folder there
     /// is left alone and reported as an error.
     pub fn save(&self, path: &Path) -> Result<u64, FormatError> {
+        self.save_with_model(path, None)
+    }
+
+    /// [`Self::save`] with the species' prepared model ([`crate::model`], its encoded bytes)
+    /// written into the same folder, in the same atomic rename.
+    pub fn save_with_model(&self, path: &Path, model: Option<&[u8]>) -> Result<u64, FormatError> {
         if path.exists() && !path.join(MANIFEST_FILE).is_file() {
             return Err(FormatError::invalid(
                 path,
@@ -370,6 +376,11 @@ impl Atlas {
             let mut total = 0u64;
             for (file, bytes) in files {
                 let f = tmp.join(file);
+                std::fs::write(&f, bytes).map_err(|e| FormatError::io(&f, e))?;
+                total += bytes.len() as u64;
+            }
+            if let Some(bytes) = model {
+                let f = tmp.join(crate::model::MODEL_FILE);
                 std::fs::write(&f, bytes).map_err(|e| FormatError::io(&f, e))?;
                 total += bytes.len() as u64;
             }
@@ -534,7 +545,7 @@ fn check_folder(path: &Path) -> Result<(), FormatError> {
 
 /// Parse and check the manifest read from `mpath` (which errors name).
 /// Every file a bake may write into an atlas folder (both colour encodings').
-pub const ATLAS_FILES: [&str; 7] = [
+pub const ATLAS_FILES: [&str; 8] = [
     MANIFEST_FILE,
     "colour.jpg",
     "colour.png",
@@ -542,6 +553,7 @@ pub const ATLAS_FILES: [&str; 7] = [
     SURFACE_FILE,
     OPACITY_FILE,
     NODES_FILE,
+    crate::model::MODEL_FILE,
 ];
 
 /// The entries of atlas folder `path` that no bake writes (the user's own files, or

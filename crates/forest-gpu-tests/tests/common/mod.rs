@@ -208,8 +208,10 @@ pub fn prepared_for(atlases: &[Atlas]) -> forest_baselines::geometry::PreparedGe
         .iter()
         .zip(atlases)
         .map(|(s, a)| {
+            let mesh =
+                forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj"))).unwrap();
             forest_baselines::geometry::GeometrySpecies::new(
-                forest_bake::Mesh::load(&root().join(format!("assets/trees/{s}/{s}.obj"))).unwrap(),
+                forest_bake::model::prepare(&mesh, None).into(),
                 &a.manifest,
             )
         })

@@ -46,7 +46,8 @@ pub fn cast_forests(
 
 /// Core3d, after the main opaque pass: each forest prepared for this view, culled, refined
 /// and drawn into the view's colour (blended) and depth (where opaque), so Bevy's
-/// transparent pass and post-processing see it.
+/// transparent pass and post-processing see it: the models first (the geometry methods, the
+/// hybrid's near trees), depth written, then the quads.
 pub fn draw_forests(
     view: ViewQuery<(
         &ExtractedView,
@@ -80,7 +81,7 @@ pub fn draw_forests(
             target.sampled_main_texture().map(|t| view(t)),
         )
     });
-    for stream in state.prepared(main) {
+    for renderer in state.prepared(main) {
         let colour = match &views {
             Some((single, multi)) => wgpu::RenderPassColorAttachment {
                 view: multi.as_ref().unwrap_or(single),
@@ -94,13 +95,13 @@ pub fn draw_forests(
             None => target.get_color_attachment(),
         };
         let encoder = ctx.command_encoder();
-        stream.encode_compute(encoder);
+        renderer.encode_compute(encoder);
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("forest"),
                 color_attachments: &[Some(colour)],
                 depth_stencil_attachment: Some(depth.get_attachment(wgpu::StoreOp::Store)),
-                timestamp_writes: stream.draw_timestamps(),
+                timestamp_writes: renderer.draw_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -114,8 +115,8 @@ pub fn draw_forests(
                     vp.depth.end,
                 );
             }
-            stream.render(&mut pass);
+            renderer.render(&mut pass);
         }
-        stream.resolve_times(encoder);
+        renderer.resolve_times(encoder);
     }
 }

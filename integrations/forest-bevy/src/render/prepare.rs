@@ -13,20 +13,22 @@ use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderAdapterInfo, RenderDevice, RenderQueue};
 use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
+use forest_baselines::{ForestRenderer, GeometryRenderer, PreparedGeometry};
+use forest_format::forest::Forest;
 use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
 
 use super::extract::Extracted;
 use crate::assets::ForestAsset;
-use crate::components::ForestMethod;
 use crate::light;
 use crate::shadows;
 use crate::stats::{ForestViewStats, SharedStats};
 
-/// One forest's stream in one view.
+/// One forest's renderer in one view: its quad stream, and the geometry renderer while the
+/// view's method draws models.
 pub(super) struct ViewStream {
     /// The asset its scene is of (it is rebuilt when that or its options change).
     asset: AssetId<ForestAsset>,
-    stream: QuadStream,
+    renderer: ForestRenderer,
     /// Written this frame (only those are drawn).
     prepared: bool,
     /// The Bevy shadow map (and its cascade count) it reads, if any.
@@ -47,12 +49,18 @@ pub(super) struct Caster {
     quads: u32,
 }
 
+/// A forest asset's trees and its species' prepared models, or why it has none.
+type Models = (Arc<Forest>, Result<Arc<PreparedGeometry>, String>);
+
 /// The render world's forests: Bevy's device as a [`GpuContext`], one GPU scene per asset,
 /// one stream per (camera, forest).
 #[derive(Resource, Default)]
 pub struct ForestRenderState {
     ctx: Option<GpuContext>,
     scenes: HashMap<AssetId<ForestAsset>, Arc<GpuScene>>,
+    /// Per asset, its trees and its prepared models for the geometry methods (or why it has
+    /// none).
+    models: HashMap<AssetId<ForestAsset>, Models>,
     failed: HashMap<AssetId<ForestAsset>, String>,
     streams: HashMap<(Entity, Entity), ViewStream>,
     /// (camera, forest, cascade layer) → the stream casting into that layer.
@@ -64,12 +72,12 @@ pub struct ForestRenderState {
 }
 
 impl ForestRenderState {
-    /// Streams prepared for the camera `main` this frame.
-    pub(super) fn prepared(&self, main: Entity) -> impl Iterator<Item = &QuadStream> {
+    /// Renderers prepared for the camera `main` this frame.
+    pub(super) fn prepared(&self, main: Entity) -> impl Iterator<Item = &ForestRenderer> {
         self.streams
             .iter()
             .filter(move |((c, _), v)| *c == main && v.prepared)
-            .map(|(_, v)| &v.stream)
+            .map(|(_, v)| &v.renderer)
     }
 }
 
@@ -110,9 +118,13 @@ pub fn prepare_forests(
     });
     for id in extracted.removed_assets.drain(..) {
         state.scenes.remove(&id);
+        state.models.remove(&id);
         state.failed.remove(&id);
     }
     for (id, asset) in extracted.new_assets.drain(..) {
+        state
+            .models
+            .insert(id, (asset.forest.clone(), asset.geometry.clone()));
         match GpuScene::new(ctx, &asset.species, &asset.forest) {
             Ok(scene) => {
                 state.scenes.insert(id, Arc::new(scene));
@@ -186,15 +198,43 @@ pub fn prepare_forests(
                 write_depth: cam.settings.write_depth,
                 ..Default::default()
             };
+            let method = cam.settings.method;
+            let models = if method.needs_models() {
+                match state.models.get(&forest.asset) {
+                    Some((trees, Ok(m))) => Some((trees.clone(), m.clone())),
+                    Some((_, Err(e))) => {
+                        state.streams.remove(&key_pair);
+                        record.error = Some(format!("{}: {e}", method.name()));
+                        stats.insert(key_pair, record);
+                        continue;
+                    }
+                    None => continue,
+                }
+            } else {
+                None
+            };
+            // Rebuilt for another asset or other targets, and when the method needs models
+            // the renderer has not uploaded (a quad-stream view uploads none).
             let built = state.streams.get(&key_pair);
-            if built.is_none_or(|v| v.asset != forest.asset || *v.stream.options_built() != opts) {
-                match QuadStream::new(&ctx.device, scene.clone(), &opts) {
-                    Ok(stream) => {
+            if built.is_none_or(|v| {
+                v.asset != forest.asset
+                    || *v.renderer.stream.options_built() != opts
+                    || (models.is_some() && v.renderer.geometry.is_none())
+            }) {
+                let built = QuadStream::new(&ctx.device, scene.clone(), &opts).and_then(|stream| {
+                    let geometry = models
+                        .as_ref()
+                        .map(|(trees, m)| GeometryRenderer::with_targets(ctx, m, trees, &opts))
+                        .transpose()?;
+                    Ok(ForestRenderer::new(stream, geometry))
+                });
+                match built {
+                    Ok(renderer) => {
                         state.streams.insert(
                             key_pair,
                             ViewStream {
                                 asset: forest.asset,
-                                stream,
+                                renderer,
                                 prepared: false,
                                 receiving: None,
                                 last: None,
@@ -212,6 +252,16 @@ pub fn prepare_forests(
             let Some(v) = state.streams.get_mut(&key_pair) else {
                 continue;
             };
+            let wanted = method.method();
+            if v.renderer.method() != wanted {
+                if let Err(e) = v.renderer.set_method(ctx, wanted) {
+                    record.error = Some(e.to_string());
+                    stats.insert(key_pair, record);
+                    continue;
+                }
+                // The counters read back were of the other method.
+                v.last = None;
+            }
             // The forest's frame: the camera moved into the forest's space, so that
             // clip = P·V·M; the sun turned with it.
             let forest_from_world = forest.world_from_forest.inverse();
@@ -228,19 +278,20 @@ pub fn prepare_forests(
                 epsilon: cam.settings.epsilon,
                 light: lighting,
             };
-            v.stream
-                .set_refine(cam.settings.method == ForestMethod::QuadStream);
             // Counters of a recent frame; a stream that overflowed grows (the next frames
             // draw everything).
-            if let Some(s) = v.stream.poll_stats(&ctx.device, &ctx.queue) {
+            if let Some(s) = v.renderer.poll_stats(&ctx.device, &ctx.queue) {
+                let quads = s.stream.quads;
                 let mut fresh = ForestViewStats {
                     visible_trees: s.visible_trees,
-                    quads: s.quads,
+                    quads,
+                    triangles: s.primitives.saturating_sub(u64::from(quads)),
+                    geometry_trees: s.geometry_trees,
                     cast_quads: 0,
                     gpu_ms: s.times.map(|t| t.total_ms()),
                     error: None,
                 };
-                if let Err(e) = v.stream.fit(&ctx.device, &s) {
+                if let Err(e) = v.renderer.fit(&ctx.device, &s) {
                     fresh.error = Some(e.to_string());
                 }
                 v.last = Some(fresh);
@@ -278,16 +329,16 @@ pub fn prepare_forests(
                             ..Default::default()
                         });
                         let resolution = cascades[0].resolution;
-                        v.stream
+                        v.renderer
                             .receive_host_shadows(&ctx.device, Some((&array, resolution, true)));
                     }
-                    None => v.stream.receive_host_shadows(&ctx.device, None),
+                    None => v.renderer.receive_host_shadows(&ctx.device, None),
                 }
                 v.receiving = maps.map(|(t, n)| (t.clone(), n));
             }
             if v.receiving.is_some() {
                 let host: Vec<_> = cascades.iter().map(|c| c.cascade).collect();
-                if let Err(e) = v.stream.set_host_cascades(&host) {
+                if let Err(e) = v.renderer.set_host_cascades(&host) {
                     record.error = Some(e.to_string());
                 }
             }
@@ -349,7 +400,7 @@ pub fn prepare_forests(
             let Some(v) = state.streams.get_mut(&key_pair) else {
                 continue;
             };
-            match v.stream.prepare(&ctx.queue, &frame) {
+            match v.renderer.prepare(&ctx.queue, &frame) {
                 Ok(()) => v.prepared = true,
                 Err(e) => record.error = Some(e.to_string()),
             }

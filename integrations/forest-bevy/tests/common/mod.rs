@@ -18,7 +18,8 @@ use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::texture::GpuImage;
 use bevy::render::view::Msaa;
 use bevy::window::{ExitCondition, WindowPlugin};
-use forest_bevy::{ForestCamera, ForestPlugin, ForestScene};
+use forest_baselines::{ForestRenderer, GeometryRenderer, GeometrySpecies, PreparedGeometry};
+use forest_bevy::{ForestCamera, ForestMethod, ForestPlugin, ForestScene};
 use forest_format::shading::Lighting;
 use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions, Targets};
 
@@ -61,10 +62,13 @@ pub fn assets() -> &'static Path {
             spp: 2,
             ..Default::default()
         };
-        let atlas = forest_bake::bake_file(&obj, &params, &|_, _| {})
-            .unwrap()
-            .atlas;
-        atlas.save(&dir.join("bush.atlas")).unwrap();
+        let out = forest_bake::bake_file(&obj, &params, &|_, _| {}).unwrap();
+        // With its prepared model, as `forest bake` stores it.
+        let mesh = forest_bake::Mesh::load(&obj).unwrap();
+        let model = forest_bake::model::prepare(&mesh, Some(&out.sky));
+        out.atlas
+            .save_with_model(&dir.join("bush.atlas"), Some(&model.encode()))
+            .unwrap();
         let forest = forest_format::generate::generate(&forest_format::generate::GenerateParams {
             trees: 60,
             species: vec!["bush.atlas".into()],
@@ -133,6 +137,7 @@ pub struct View {
     pub hdr: bool,
     pub msaa: Msaa,
     pub epsilon: f32,
+    pub method: ForestMethod,
 }
 
 impl View {
@@ -143,6 +148,7 @@ impl View {
             hdr: false,
             msaa: Msaa::Off,
             epsilon: 4.0,
+            method: ForestMethod::QuadStream,
         }
     }
 }
@@ -166,6 +172,7 @@ pub fn spawn_camera(app: &mut App, v: View) -> (Entity, Handle<Image>) {
         v.msaa,
         ForestCamera {
             epsilon: v.epsilon,
+            method: v.method,
             ..default()
         },
         Transform::from_translation(v.eye).looking_at(v.target, Vec3::Y),
@@ -209,6 +216,32 @@ pub fn settle(app: &mut App, camera: Entity, forest: Entity) {
     for _ in 0..6 {
         app.update();
     }
+}
+
+/// Frames until `ready` holds for the camera's statistics of the forest, and a few more.
+pub fn settle_on(
+    app: &mut App,
+    camera: Entity,
+    forest: Entity,
+    ready: impl Fn(&forest_bevy::ForestViewStats) -> bool,
+) {
+    let stats = |app: &App| {
+        app.world()
+            .resource::<forest_bevy::ForestStats>()
+            .get(camera, forest)
+            .cloned()
+    };
+    for _ in 0..600 {
+        app.update();
+        if stats(app).is_some_and(|s| ready(&s)) {
+            for _ in 0..6 {
+                app.update();
+            }
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    panic!("the forest's statistics never got ready: {:?}", stats(app));
 }
 
 /// Read a render-target image back from the render world.
@@ -281,6 +314,25 @@ pub fn reference(
     light: Lighting,
     samples: u32,
 ) -> image::RgbaImage {
+    reference_with(
+        eye,
+        target,
+        epsilon,
+        light,
+        samples,
+        ForestMethod::QuadStream,
+    )
+}
+
+/// [`reference`] drawn with `method`.
+pub fn reference_with(
+    eye: Vec3,
+    target: Vec3,
+    epsilon: f32,
+    light: Lighting,
+    samples: u32,
+    method: ForestMethod,
+) -> image::RgbaImage {
     let clear = Color::srgb(CLEAR[0], CLEAR[1], CLEAR[2]).to_linear();
     let colour = wgpu::Color {
         r: f64::from(clear.red),
@@ -288,7 +340,23 @@ pub fn reference(
         b: f64::from(clear.blue),
         a: 1.0,
     };
-    reference_over(eye, target, epsilon, light, samples, colour)
+    reference_over(eye, target, epsilon, light, samples, colour, method)
+}
+
+/// Save Bevy's frame and the reference as `view-NAME.png` and `view-NAME-reference.png`,
+/// then [`assert_flip`] them.
+pub fn compare_view(
+    name: &str,
+    reference: &image::RgbaImage,
+    bevy: &image::RgbaImage,
+    limit: f32,
+) -> f32 {
+    bevy.save(out_dir().join(format!("view-{name}.png")))
+        .unwrap();
+    reference
+        .save(out_dir().join(format!("view-{name}-reference.png")))
+        .unwrap();
+    assert_flip(name, reference, bevy, limit)
 }
 
 /// The trees' coverage in [`reference`]'s frame (MSAA off): its alpha over transparent black.
@@ -300,6 +368,7 @@ pub fn coverage(eye: Vec3, target: Vec3, epsilon: f32) -> Vec<u8> {
         expected_light(sun_dir()),
         1,
         wgpu::Color::TRANSPARENT,
+        ForestMethod::QuadStream,
     );
     img.pixels().map(|p| p[3]).collect()
 }
@@ -311,6 +380,7 @@ fn reference_over(
     light: Lighting,
     samples: u32,
     colour: wgpu::Color,
+    method: ForestMethod,
 ) -> image::RgbaImage {
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe)");
     let dir = assets();
@@ -327,7 +397,20 @@ fn reference_over(
         atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO),
         ..Default::default()
     };
-    let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
+    let stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
+    // The models, read back from the atlas as the plugin reads them.
+    let geometry = method.needs_models().then(|| {
+        let model = forest_format::model::PreparedModel::load(&dir.join("bush.atlas"))
+            .unwrap()
+            .expect("the test atlas holds its model");
+        let prepared = PreparedGeometry::new(&[GeometrySpecies::new(
+            model.into(),
+            &species[0].atlas.manifest,
+        )]);
+        GeometryRenderer::with_targets(&ctx, &prepared, &forest, &opts).unwrap()
+    });
+    let mut renderer = ForestRenderer::new(stream, geometry);
+    renderer.set_method(&ctx, method.method()).unwrap();
     // Bevy's own matrices (its glam release), as the forest crates' numbers.
     let g = |m: Mat4| glam::Mat4::from_cols_array(&m.to_cols_array());
     let frame = FrameParams {
@@ -368,8 +451,9 @@ fn reference_over(
     });
     // Frames until the stream holds the whole view.
     for _ in 0..8 {
-        stream.prepare(&ctx.queue, &frame).unwrap();
+        renderer.prepare(&ctx.queue, &frame).unwrap();
         let mut enc = ctx.device.create_command_encoder(&Default::default());
+        renderer.encode_compute(&mut enc);
         let targets = match &msaa {
             Some((c, d)) => Targets {
                 resolve: Some(&target_img.colour_view),
@@ -377,10 +461,14 @@ fn reference_over(
             },
             None => Targets::cleared(&target_img.colour_view, &target_img.depth_view, colour, 0.0),
         };
-        stream.encode_into(&mut enc, &targets);
+        {
+            let mut pass = targets.begin(&mut enc, "reference", renderer.draw_timestamps());
+            renderer.render(&mut pass);
+        }
+        renderer.resolve_times(&mut enc);
         ctx.queue.submit([enc.finish()]);
-        let stats = stream.read_stats(&ctx);
-        if !stream.fit(&ctx.device, &stats).unwrap() {
+        let stats = renderer.read_stats(&ctx);
+        if !renderer.fit(&ctx.device, &stats).unwrap() {
             break;
         }
     }
