@@ -55,6 +55,6 @@ pub mod hybrid;
 pub mod methods;
 pub mod shaders;
 
-pub use geometry::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
+pub use geometry::{GeometryRenderer, GeometrySpecies, GpuModels, MeshMethod, PreparedGeometry};
 pub use hybrid::{Hybrid, Near};
 pub use methods::{ForestRenderer, Method, MethodStats};

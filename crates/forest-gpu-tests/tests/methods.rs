@@ -47,6 +47,47 @@ fn save_on_failure(name: &str, images: &[(&str, &image::RgbaImage)]) {
     }
 }
 
+/// Two renderers built over one upload of the models (as each camera's view in a host is)
+/// draw exactly what a renderer with its own upload draws, and each counts the shared models
+/// in its memory once; models of another species count are refused before any upload.
+#[test]
+fn renderers_share_one_upload_of_the_models() {
+    use forest_baselines::geometry::GpuModels;
+    use std::sync::Arc;
+    let ctx = common::ctx();
+    let forest = common::forest(300);
+    let (_, cam) = common::cameras(forest.extent()).remove(0);
+    let lods = MeshMethod::Lods(Default::default());
+    let mut own = geometry(&ctx, &forest);
+    let alone = draw(&ctx, &mut own, lods, &cam);
+    let models = Arc::new(GpuModels::new(&ctx, common::prepared(), &forest).unwrap());
+    let opts = RendererOptions {
+        format: TARGET_FORMAT,
+        background: Background::Transparent,
+        ..Default::default()
+    };
+    let mut a = GeometryRenderer::with_models(&ctx, models.clone(), &opts).unwrap();
+    let mut b = GeometryRenderer::with_models(&ctx, models.clone(), &opts).unwrap();
+    assert_eq!(Arc::strong_count(&models), 3);
+    let (img_a, img_b) = (draw(&ctx, &mut a, lods, &cam), draw(&ctx, &mut b, lods, &cam));
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    assert!(covered(&alone) > 160 * 120 / 10, "trees in view");
+    for (name, img) in [("first", &img_a), ("second", &img_b)] {
+        if img != &alone {
+            save_on_failure("shared-models", &[("own", &alone), (name, img)]);
+            panic!("the {name} renderer over shared models differs from one with its own");
+        }
+    }
+    assert_eq!(a.gpu_bytes, own.gpu_bytes);
+    assert!(models.bytes() > 0 && models.bytes() < a.gpu_bytes);
+    let mut one_species = common::forest(10);
+    one_species.species.push("another".into());
+    let Err(e) = GpuModels::new(&ctx, common::prepared(), &one_species) else {
+        panic!("models of another species count accepted");
+    };
+    assert!(e.to_string().contains("models"), "{e}");
+}
+
 #[test]
 fn maximum_detail_draws_exactly_the_full_geometry() {
     let ctx = common::ctx();

@@ -13,13 +13,11 @@
 
 use std::path::PathBuf;
 
-use bevy::asset::RenderAssetUsages;
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use forest_bevy::{
-    ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats,
+    ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats, terrain_mesh,
 };
 
 /// The sun's azimuth and elevation, degrees.
@@ -30,51 +28,40 @@ struct SunAngles(f32, f32);
 #[derive(Resource)]
 struct Pending(Handle<ForestAsset>);
 
-#[derive(Component)]
-struct Sun;
-
 /// Where to save a screenshot before exiting, and the frames drawn so far.
 #[derive(Resource)]
 struct Shot(PathBuf, u32);
 
 fn main() -> AppExit {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let shot = args
-        .iter()
-        .position(|a| a == "--screenshot")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from);
-    let forest = args
-        .first()
-        .filter(|a| !a.starts_with("--"))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("out/forest-100k.forest"));
-    if !forest.is_file() {
+    let flag = args.iter().position(|a| a == "--screenshot");
+    let forest = match args.first().filter(|_| flag != Some(0)) {
+        Some(path) => PathBuf::from(path),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../out/forest-100k.forest"),
+    };
+    let Some((folder, name)) = forest.canonicalize().ok().and_then(|f| {
+        let name = f.file_name()?.to_string_lossy().into_owned();
+        Some((f.parent()?.to_string_lossy().into_owned(), name))
+    }) else {
         eprintln!(
-            "forest: no forest at {} (run `bash scripts/demo.sh` first)",
+            "forest: no forest at {} (run `bash scripts/demo.sh`)",
             forest.display()
         );
         return AppExit::error();
-    }
-    let folder = forest
-        .parent()
-        .unwrap_or(std::path::Path::new("."))
-        .canonicalize()
-        .unwrap();
-    let name = forest.file_name().unwrap().to_string_lossy().into_owned();
+    };
     let mut app = App::new();
-    if let Some(path) = shot {
-        app.insert_resource(Shot(path, 0))
+    if let Some(path) = flag.and_then(|i| args.get(i + 1)) {
+        app.insert_resource(Shot(path.into(), 0))
             .add_systems(Update, screenshot);
     }
+    let fog = Color::srgb(0.62, 0.72, 0.84);
     app.add_plugins(DefaultPlugins.set(AssetPlugin {
-        file_path: folder.to_string_lossy().into_owned(),
+        file_path: folder,
         ..default()
     }))
     .add_plugins(ForestPlugin)
     .insert_resource(SunAngles(30.0, 35.0))
-    .insert_resource(ClearColor(Color::srgb(0.62, 0.72, 0.84)))
+    .insert_resource(ClearColor(fog))
     .insert_resource(GlobalAmbientLight {
         color: Color::srgb(0.75, 0.85, 1.0),
         brightness: 1500.0,
@@ -83,23 +70,43 @@ fn main() -> AppExit {
     .add_systems(
         Startup,
         move |mut commands: Commands, assets: Res<AssetServer>| {
-            setup(&mut commands, &assets, &name)
+            let forest = assets.load::<ForestAsset>(name.clone());
+            commands.insert_resource(Pending(forest.clone()));
+            commands.spawn(ForestScene(forest));
+            commands.spawn((
+                Camera3d::default(),
+                // HDR: Bevy's tonemapping pass then maps the trees with everything else.
+                bevy::camera::Hdr,
+                Tonemapping::AcesFitted,
+                ForestCamera::default(),
+                DistanceFog {
+                    color: fog,
+                    falloff: FogFalloff::Exponential {
+                        density: 3.912 / 2000.0,
+                    },
+                    ..default()
+                },
+                Transform::from_xyz(0.0, 4.0, 0.0).looking_to(Vec3::new(1.0, -0.05, 0.3), Vec3::Y),
+            ));
+            commands.spawn(DirectionalLight {
+                illuminance: 20_000.0,
+                shadow_maps_enabled: true,
+                ..default()
+            });
         },
     )
     .add_systems(Update, (terrain, fly, sun, switch, title))
     .run()
 }
 
-/// Once the forest has drawn for a while: a screenshot, then exit.
+/// Once the forest has drawn for a few frames: a screenshot, then exit.
 fn screenshot(
     mut commands: Commands,
     mut shot: ResMut<Shot>,
     stats: Res<ForestStats>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    if stats.views.values().any(|s| s.quads > 0) {
-        shot.1 += 1;
-    }
+    shot.1 += u32::from(stats.views.values().any(|s| s.quads > 0));
     if shot.1 == 4 {
         commands
             .spawn(Screenshot::primary_window())
@@ -108,36 +115,6 @@ fn screenshot(
     if shot.1 > 4 && shot.0.exists() || shot.1 == 60 {
         exit.write(AppExit::Success);
     }
-}
-
-fn setup(commands: &mut Commands, assets: &AssetServer, name: &str) {
-    let forest = assets.load::<ForestAsset>(name.to_owned());
-    commands.insert_resource(Pending(forest.clone()));
-    commands.spawn(ForestScene(forest));
-    commands.spawn((
-        Camera3d::default(),
-        // HDR: Bevy's tonemapping pass then maps the trees with everything else.
-        bevy::camera::Hdr,
-        Tonemapping::AcesFitted,
-        ForestCamera::default(),
-        DistanceFog {
-            color: Color::srgb(0.62, 0.72, 0.84),
-            falloff: FogFalloff::Exponential {
-                density: 3.912 / 2000.0,
-            },
-            ..default()
-        },
-        Transform::from_xyz(0.0, 4.0, 0.0).looking_to(Vec3::new(1.0, -0.05, 0.3), Vec3::Y),
-    ));
-    commands.spawn((
-        Sun,
-        DirectionalLight {
-            illuminance: 20_000.0,
-            shadow_maps_enabled: true,
-            ..default()
-        },
-        Transform::default(),
-    ));
 }
 
 /// Once the forest has loaded: a terrain mesh under it (its height field, or flat ground) and
@@ -153,37 +130,16 @@ fn terrain(
         return;
     };
     let f = &forest.forest;
-    let (half, n) = (f.extent().min(3000.0), 256usize);
-    let step = 2.0 * half / n as f32;
-    let mut positions = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (i as f32 * step - half, j as f32 * step - half);
-            positions.push([x, f.ground_height(x, z) - 0.02, z]);
-        }
-    }
-    let mut indices = Vec::new();
-    let row = n as u32 + 1;
-    for j in 0..n as u32 {
-        for i in 0..n as u32 {
-            let a = j * row + i;
-            indices.extend([a, a + row, a + 1, a + 1, a + row, a + row + 1]);
-        }
-    }
-    let mut mesh = Mesh::new(
-        PrimitiveTopology::TriangleList,
-        RenderAssetUsages::default(),
-    )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-    .with_inserted_indices(Indices::U32(indices));
-    mesh.compute_smooth_normals();
+    let ground = terrain_mesh(f, f.extent().min(3000.0), 256).expect("a valid grid");
     commands.spawn((
-        Mesh3d(meshes.add(mesh)),
+        Mesh3d(meshes.add(ground)),
         MeshMaterial3d(materials.add(StandardMaterial {
             base_color: Color::srgb(0.30, 0.27, 0.18),
             perceptual_roughness: 1.0,
             ..default()
         })),
+        // 2 cm down, so that the trunks' bases do not fight it.
+        Transform::from_xyz(0.0, -0.02, 0.0),
     ));
     let at = Vec3::new(12.0, 0.0, 4.0);
     commands.spawn((
@@ -199,6 +155,11 @@ fn terrain(
     commands.remove_resource::<Pending>();
 }
 
+/// +1 while `plus` is held, -1 while `minus` is, 0 for both or neither.
+fn axis(keys: &ButtonInput<KeyCode>, plus: KeyCode, minus: KeyCode) -> f32 {
+    f32::from(u8::from(keys.pressed(plus))) - f32::from(u8::from(keys.pressed(minus)))
+}
+
 fn fly(
     keys: Res<ButtonInput<KeyCode>>,
     time: Res<Time>,
@@ -206,36 +167,26 @@ fn fly(
 ) {
     let Ok(mut t) = cams.single_mut() else { return };
     let dt = time.delta_secs();
-    let speed = if keys.pressed(KeyCode::ShiftLeft) {
-        60.0
-    } else {
-        8.0
-    } * dt;
-    let axis = |plus, minus| {
-        f32::from(u8::from(keys.pressed(plus))) - f32::from(u8::from(keys.pressed(minus)))
-    };
+    let speed = dt * [8.0, 60.0][usize::from(keys.pressed(KeyCode::ShiftLeft))];
+    let k = |plus, minus| axis(&keys, plus, minus);
     let (forward, right) = (t.forward().as_vec3(), t.right().as_vec3());
     t.translation += speed
-        * (forward * axis(KeyCode::KeyW, KeyCode::KeyS)
-            + right * axis(KeyCode::KeyD, KeyCode::KeyA)
-            + Vec3::Y * axis(KeyCode::KeyE, KeyCode::KeyQ));
-    t.rotate_y(1.2 * dt * axis(KeyCode::ArrowLeft, KeyCode::ArrowRight));
-    let pitch = 0.8 * dt * axis(KeyCode::ArrowUp, KeyCode::ArrowDown);
-    t.rotate_local_x(pitch);
+        * (forward * k(KeyCode::KeyW, KeyCode::KeyS)
+            + right * k(KeyCode::KeyD, KeyCode::KeyA)
+            + Vec3::Y * k(KeyCode::KeyE, KeyCode::KeyQ));
+    t.rotate_y(1.2 * dt * k(KeyCode::ArrowLeft, KeyCode::ArrowRight));
+    t.rotate_local_x(0.8 * dt * k(KeyCode::ArrowUp, KeyCode::ArrowDown));
 }
 
 fn sun(
     keys: Res<ButtonInput<KeyCode>>,
     time: Res<Time>,
     mut angles: ResMut<SunAngles>,
-    mut suns: Query<&mut Transform, With<Sun>>,
+    mut suns: Query<&mut Transform, With<DirectionalLight>>,
 ) {
     let rate = 40.0 * time.delta_secs();
-    let axis = |plus, minus| {
-        f32::from(u8::from(keys.pressed(plus))) - f32::from(u8::from(keys.pressed(minus)))
-    };
-    angles.0 += rate * axis(KeyCode::KeyL, KeyCode::KeyJ);
-    angles.1 = (angles.1 + rate * axis(KeyCode::KeyI, KeyCode::KeyK)).clamp(2.0, 89.0);
+    angles.0 += rate * axis(&keys, KeyCode::KeyL, KeyCode::KeyJ);
+    angles.1 = (angles.1 + rate * axis(&keys, KeyCode::KeyI, KeyCode::KeyK)).clamp(2.0, 89.0);
     let (az, el) = (angles.0.to_radians(), angles.1.to_radians());
     let to_sun = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
     for mut t in &mut suns {
@@ -243,20 +194,14 @@ fn sun(
     }
 }
 
-/// The methods M cycles through (full geometry left out: every tree of a large forest as its
-/// model takes seconds a frame on a CPU).
-const METHODS: [ForestMethod; 4] = [
-    ForestMethod::QuadStream,
-    ForestMethod::Hybrid,
-    ForestMethod::DiscreteLods,
-    ForestMethod::Impostors,
-];
-
 fn switch(keys: Res<ButtonInput<KeyCode>>, mut cams: Query<&mut ForestCamera>) {
     for mut c in &mut cams {
+        // Every method but full geometry (every tree of a large forest as its model takes
+        // seconds a frame on a CPU).
+        let methods = &ForestMethod::ALL[..4];
         if keys.just_pressed(KeyCode::KeyM) {
-            let i = METHODS.iter().position(|m| *m == c.method).unwrap_or(0);
-            c.method = METHODS[(i + 1) % METHODS.len()];
+            let i = methods.iter().position(|m| *m == c.method).unwrap_or(0);
+            c.method = methods[(i + 1) % methods.len()];
         }
         if keys.just_pressed(KeyCode::BracketLeft) {
             c.epsilon = (c.epsilon * 0.5).max(1.0);
@@ -276,17 +221,18 @@ fn title(
     let (Ok((camera, c)), Ok(mut window)) = (cams.single(), windows.single_mut()) else {
         return;
     };
-    // A method the forest cannot draw (atlases baked without models) says why.
-    let error = stats
-        .views
-        .iter()
-        .find_map(|((cam, _), s)| (*cam == camera).then_some(s.error.as_deref()).flatten());
     window.title = format!(
-        "forest in Bevy: {} ε {} px, {} quads, {:.1} ms (M method, [ ] ε, IJKL sun){}",
+        "forest in Bevy: {} ε {} px, {} quads, {} triangles, {:.1} ms (M method, [ ] ε, IJKL \
+         sun){}",
         c.method.name(),
         c.epsilon,
         stats.quads(camera),
+        stats.triangles(camera),
         time.delta_secs() * 1000.0,
-        error.map(|e| format!(": {e}")).unwrap_or_default()
+        // A method the forest cannot draw (atlases baked without models) says why.
+        stats
+            .error(camera)
+            .map(|e| format!(": {e}"))
+            .unwrap_or_default()
     );
 }

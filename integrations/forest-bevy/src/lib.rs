@@ -32,8 +32,9 @@
 //!     .run();
 //! ```
 //!
-//! Not yet: only the quad stream and static impostors are offered (the hybrid needs the
-//! geometry renderer of `forest-baselines`, which builds level-of-detail meshes at load).
+//! Each camera picks its method ([`ForestMethod`]): the quad stream, static impostors, or,
+//! from the prepared models that `forest bake` stores in each atlas (`model.bin`), the
+//! hybrid, the discrete LODs and full geometry.
 
 #![deny(missing_docs)]
 
@@ -43,6 +44,7 @@ pub mod light;
 pub mod render;
 pub mod shadows;
 pub mod stats;
+pub mod terrain;
 
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
@@ -53,6 +55,7 @@ use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 pub use assets::{AtlasLoader, ForestAsset, ForestAtlas, ForestLoader, LoadError};
 pub use components::{ForestCamera, ForestMethod, ForestScene};
 pub use stats::{ForestStats, ForestViewStats};
+pub use terrain::{TerrainMeshError, terrain_mesh};
 
 /// Registers the forest assets and their loaders, the statistics, and the render world's
 /// systems (see [`render`]).

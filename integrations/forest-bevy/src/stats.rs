@@ -49,6 +49,23 @@ impl ForestStats {
             .map(|(_, s)| u64::from(s.quads))
             .sum()
     }
+
+    /// Triangles drawn in `camera`'s view, over all forests.
+    pub fn triangles(&self, camera: Entity) -> u64 {
+        self.views
+            .iter()
+            .filter(|((c, _), _)| *c == camera)
+            .map(|(_, s)| s.triangles)
+            .sum()
+    }
+
+    /// Why a forest is not drawn into `camera`'s view, if one is not (the first such forest's
+    /// reason, e.g. a geometry method asked of atlases baked without models).
+    pub fn error(&self, camera: Entity) -> Option<&str> {
+        self.views
+            .iter()
+            .find_map(|((c, _), s)| (*c == camera).then_some(s.error.as_deref()).flatten())
+    }
 }
 
 /// The map both worlds hold: the render world writes it, the main world copies it.

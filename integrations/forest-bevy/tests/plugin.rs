@@ -113,6 +113,22 @@ fn the_model_methods_match_forest_render() {
             _ => s.triangles > 0,
         });
     }
+    // Both views draw from one upload of the forest's models.
+    let asset = app
+        .world()
+        .get::<forest_bevy::ForestScene>(forest)
+        .expect("the forest")
+        .0
+        .id();
+    let sharing = app
+        .sub_app(bevy::render::RenderApp)
+        .world()
+        .resource::<forest_bevy::render::ForestRenderState>()
+        .views_sharing_models(asset);
+    assert_eq!(
+        sharing, 2,
+        "views drawing from the one upload of the models"
+    );
     let images: Vec<_> = views
         .iter()
         .map(|(_, _, (_, image))| read(&mut app, image))

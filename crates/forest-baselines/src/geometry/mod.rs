@@ -15,6 +15,7 @@
 
 mod layout;
 mod light;
+mod models;
 mod params;
 mod prepare;
 mod renderer;
@@ -22,6 +23,7 @@ mod textures;
 
 pub use forest_format::model::BILLBOARD_RESOLUTION;
 pub use layout::{COMPUTE_SLOTS, compute_entries, draw_entries};
+pub use models::GpuModels;
 pub use params::{GeometrySpecies, GeometryStats, Lods, MeshMethod, SpeciesFigures, Stochastic};
 pub use prepare::PreparedGeometry;
 pub use renderer::{GeometryRenderer, RESET_WG};

@@ -20,9 +20,9 @@ use wgpu::util::DeviceExt;
 
 use super::layout::{compute_entries, draw_entries};
 use super::params::{GeometryStats, MeshMethod, SpeciesFigures};
+use super::models::GpuModels;
 use super::prepare::PreparedGeometry;
-use super::textures::{MATERIAL_TEXTURE_SIZE, layered_texture};
-use forest_format::model::BILLBOARD_RESOLUTION;
+use std::sync::Arc;
 
 /// Workgroup size of `geo_reset` (one invocation per segment); the other per-tree entry
 /// points use the runtime's `WG` (a test checks both against the WGSL).
@@ -54,7 +54,6 @@ pub struct GeometryRenderer {
     counting_draw: Option<[wgpu::RenderPipeline; 2]>,
     /// The attached counters' bind group, while counting fragments.
     fragment_counts: Option<wgpu::BindGroup>,
-    terrain: forest_render::terrain::GpuTerrain,
     atmosphere: Atmosphere,
     compute_bg: wgpu::BindGroup,
     draw_bg: wgpu::BindGroup,
@@ -65,18 +64,15 @@ pub struct GeometryRenderer {
     count_work: bool,
     /// Draws recorded by the last [`Self::record_draw`].
     draws: AtomicU32,
-    species: u32,
-    instances: u32,
     background: Background,
     depth_clear: f32,
     /// Per-species figures, in the forest's species order.
     pub figures: Vec<SpeciesFigures>,
-    /// Bytes of GPU memory the renderer allocated (buffers and textures).
+    /// Bytes of GPU memory the renderer allocated (buffers and textures), the models it
+    /// shares included.
     pub gpu_bytes: u64,
     /// Layout of the draw's group 2, the sun's shadow maps.
     shadow_layout: wgpu::BindGroupLayout,
-    /// The heights between which the forest's receivers lie (its own maps are fitted to it).
-    band: forest_render::shadow::ReceiverBand,
     /// The receivers' group while shadows are off.
     no_shadows: wgpu::BindGroup,
     /// The light views and the maps' receivers' group while shadows are on.
@@ -92,27 +88,12 @@ pub struct GeometryRenderer {
 /// The renderer's tables, textures and layouts that every view binds, the main view and the
 /// shadow cascades' light views alike.
 pub(super) struct Shared {
-    instances: wgpu::Buffer,
-    species: wgpu::Buffer,
-    consts: wgpu::Buffer,
+    /// The forest's models, trees and terrain, perhaps shared with other renderers.
+    models: Arc<GpuModels>,
     method: wgpu::Buffer,
-    leaf_end: wgpu::Buffer,
-    vertices: wgpu::Buffer,
-    materials: wgpu::Buffer,
-    material_view: wgpu::TextureView,
-    sampler: wgpu::Sampler,
-    billboard_surface_view: wgpu::TextureView,
     environment: wgpu::Buffer,
-    leaf_centre: wgpu::Buffer,
-    billboard_view: wgpu::TextureView,
-    heights: wgpu::Buffer,
-    opacity_view: wgpu::TextureView,
-    opacity_sampler: wgpu::Sampler,
     compute_layout: wgpu::BindGroupLayout,
     pub(super) draw_layout: wgpu::BindGroupLayout,
-    /// Draw segments (bands × species) and trees listed.
-    segments: usize,
-    listed: usize,
 }
 
 /// One view's own buffers and its two groups: its camera (the view's, then each cascade's
@@ -144,17 +125,22 @@ impl Shared {
             camera_bytes,
             U::UNIFORM | U::COPY_DST | U::COPY_SRC,
         );
-        let keys = zeros("segment keys", self.listed * 4, U::STORAGE);
+        let m = &*self.models;
+        let (segments, listed) = (
+            m.capacity.segments as usize,
+            m.capacity.instances as usize,
+        );
+        let keys = zeros("segment keys", listed * 4, U::STORAGE);
         let counts = zeros(
             "segment counts",
-            self.segments * 4,
+            segments * 4,
             U::STORAGE | U::COPY_SRC,
         );
-        let cursor = zeros("segment cursors", self.segments * 4, U::STORAGE);
-        let visible = zeros("visible instances", self.listed * 4, U::STORAGE);
+        let cursor = zeros("segment cursors", segments * 4, U::STORAGE);
+        let visible = zeros("visible instances", listed * 4, U::STORAGE);
         let args = zeros(
             "draw args",
-            self.segments * 16,
+            segments * 16,
             U::STORAGE | U::INDIRECT | U::COPY_SRC,
         );
         let bytes = [&camera, &keys, &counts, &cursor, &visible, &args]
@@ -166,41 +152,41 @@ impl Shared {
             layout: &self.compute_layout,
             entries: &forest_render::passes::numbered(vec![
                 camera.as_entire_binding(),
-                self.instances.as_entire_binding(),
-                self.species.as_entire_binding(),
+                m.instances.as_entire_binding(),
+                m.species.as_entire_binding(),
                 keys.as_entire_binding(),
                 counts.as_entire_binding(),
                 cursor.as_entire_binding(),
                 visible.as_entire_binding(),
                 args.as_entire_binding(),
-                self.consts.as_entire_binding(),
+                m.consts.as_entire_binding(),
                 self.method.as_entire_binding(),
-                self.leaf_end.as_entire_binding(),
+                m.leaf_end.as_entire_binding(),
             ]),
         });
         let resources = vec![
             (0, camera.as_entire_binding()),
-            (1, self.instances.as_entire_binding()),
-            (2, self.vertices.as_entire_binding()),
+            (1, m.instances.as_entire_binding()),
+            (2, m.vertices.as_entire_binding()),
             (3, visible.as_entire_binding()),
-            (4, self.materials.as_entire_binding()),
-            (5, wgpu::BindingResource::TextureView(&self.material_view)),
-            (6, wgpu::BindingResource::Sampler(&self.sampler)),
+            (4, m.materials.as_entire_binding()),
+            (5, wgpu::BindingResource::TextureView(&m.material_view)),
+            (6, wgpu::BindingResource::Sampler(&m.sampler)),
             (
                 7,
-                wgpu::BindingResource::TextureView(&self.billboard_surface_view),
+                wgpu::BindingResource::TextureView(&m.billboard_surface_view),
             ),
             (8, self.environment.as_entire_binding()),
-            (9, self.species.as_entire_binding()),
+            (9, m.species.as_entire_binding()),
             (10, self.method.as_entire_binding()),
-            (11, self.leaf_centre.as_entire_binding()),
-            (12, wgpu::BindingResource::TextureView(&self.billboard_view)),
+            (11, m.leaf_centre.as_entire_binding()),
+            (12, wgpu::BindingResource::TextureView(&m.billboard_view)),
             (
                 forest_render::terrain::HEIGHTS_BINDING,
-                self.heights.as_entire_binding(),
+                m.terrain.heights.as_entire_binding(),
             ),
-            (14, wgpu::BindingResource::TextureView(&self.opacity_view)),
-            (15, wgpu::BindingResource::Sampler(&self.opacity_sampler)),
+            (14, wgpu::BindingResource::TextureView(&m.opacity_view)),
+            (15, wgpu::BindingResource::Sampler(&m.opacity_sampler)),
         ];
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(label),
@@ -248,27 +234,19 @@ impl GeometryRenderer {
         forest: &Forest,
         opts: &RendererOptions,
     ) -> Result<Self, RenderError> {
-        let background = opts.background;
-        let PreparedGeometry {
-            vertices,
-            geo_species,
-            materials,
-            layers,
-            billboard_layers,
-            billboard_surface,
-            leaf_end,
-            leaf_centre,
-            opacity,
-            figures,
-        } = prepared;
         opts.atmosphere.validate().map_err(RenderError::Parameter)?;
-        if geo_species.len() != forest.species.len() {
-            return Err(RenderError::SpeciesCount {
-                forest: forest.species.len(),
-                given: geo_species.len(),
-                what: "models",
-            });
-        }
+        Self::with_models(ctx, Arc::new(GpuModels::new(ctx, prepared, forest)?), opts)
+    }
+
+    /// [`Self::with_targets`] over models already on the device, which this renderer shares
+    /// with every other built from them (a view per camera uploads the models once).
+    pub fn with_models(
+        ctx: &GpuContext,
+        models: Arc<GpuModels>,
+        opts: &RendererOptions,
+    ) -> Result<Self, RenderError> {
+        let background = opts.background;
+        opts.atmosphere.validate().map_err(RenderError::Parameter)?;
         if !ctx
             .device
             .features()
@@ -280,23 +258,15 @@ impl GeometryRenderer {
             });
         }
         let device = &ctx.device;
-        let instances = forest_render::scene::gpu_instances(forest);
-        let cap = forest_render::capacity::GeometryCapacity::new(
-            instances.len() as u32,
-            geo_species.len() as u32,
-            BANDS,
-        );
-        let (segments, listed) = (cap.segments as usize, cap.instances as usize);
+        let cap = models.capacity;
+        // This renderer's own allocations; the shared models' are added at the end.
         let gpu_bytes = std::cell::Cell::new(0u64);
         use wgpu::BufferUsages as U;
         let init = |label: &str, bytes: &[u8], usage: U| {
-            // Empty tables still bind one element of any of their types.
-            let pad = [0u8; 256];
-            let contents = if bytes.is_empty() { &pad[..] } else { bytes };
-            gpu_bytes.set(gpu_bytes.get() + contents.len() as u64);
+            gpu_bytes.set(gpu_bytes.get() + bytes.len() as u64);
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
-                contents,
+                contents: bytes,
                 usage,
             })
         };
@@ -307,87 +277,6 @@ impl GeometryRenderer {
             bytemuck::bytes_of(&method.to_gpu()),
             U::UNIFORM | U::COPY_DST,
         );
-        let inst_buf = init(
-            "geometry instances",
-            bytemuck::cast_slice(&instances),
-            U::STORAGE,
-        );
-        let species_buf = init(
-            "geometry species",
-            bytemuck::cast_slice(geo_species),
-            U::STORAGE,
-        );
-        let vertex_buf = init(
-            "geometry vertices",
-            bytemuck::cast_slice(vertices),
-            U::STORAGE,
-        );
-        let material_buf = init(
-            "geometry materials",
-            bytemuck::cast_slice(materials),
-            U::STORAGE,
-        );
-        let leaf_end_buf = init("leaf ends", bytemuck::cast_slice(leaf_end), U::STORAGE);
-        let leaf_centre_buf = init(
-            "leaf centres",
-            bytemuck::cast_slice(leaf_centre),
-            U::STORAGE,
-        );
-        let consts = init(
-            "geometry constants",
-            bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
-            U::UNIFORM,
-        );
-
-        let (material_view, material_bytes) = layered_texture(
-            ctx,
-            "material textures",
-            MATERIAL_TEXTURE_SIZE,
-            layers,
-            false,
-        );
-        let (billboard_view, billboard_bytes) = layered_texture(
-            ctx,
-            "billboards",
-            BILLBOARD_RESOLUTION,
-            billboard_layers,
-            false,
-        );
-        let (billboard_surface_view, billboard_surface_bytes) = layered_texture(
-            ctx,
-            "billboard surfaces",
-            BILLBOARD_RESOLUTION,
-            billboard_surface,
-            true,
-        );
-        let (opacity_texture, opacity_bytes) = forest_render::opacity::opacity_texture(
-            device,
-            &ctx.queue,
-            &opacity.iter().collect::<Vec<_>>(),
-        )?;
-        let opacity_view = opacity_texture.create_view(&Default::default());
-        let opacity_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("opacity"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
-        gpu_bytes.set(
-            gpu_bytes.get()
-                + material_bytes
-                + billboard_bytes
-                + billboard_surface_bytes
-                + opacity_bytes,
-        );
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("material"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
 
         let compute = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry cull"),
@@ -451,37 +340,20 @@ impl GeometryRenderer {
         );
         let terrain_pipeline =
             render_pipeline("vs_terrain", "fs_terrain", T::TriangleList, &draw_pl);
-        let terrain = forest_render::terrain::GpuTerrain::new(device, forest.terrain.as_ref())?;
-        gpu_bytes.set(gpu_bytes.get() + terrain.bytes());
         let environment_buf = init(
             "geometry environment",
             bytemuck::bytes_of(&forest_render::options::environment_uniform(
                 &opts.atmosphere,
-                &terrain.grid,
+                &models.terrain.grid,
             )),
             U::UNIFORM,
         );
         let shared = Shared {
-            instances: inst_buf,
-            species: species_buf,
-            consts,
+            models: models.clone(),
             method: method_buf.clone(),
-            leaf_end: leaf_end_buf,
-            vertices: vertex_buf,
-            materials: material_buf,
-            material_view,
-            sampler,
-            billboard_surface_view,
             environment: environment_buf,
-            leaf_centre: leaf_centre_buf,
-            billboard_view,
-            heights: terrain.heights.clone(),
-            opacity_view,
-            opacity_sampler,
             compute_layout,
             draw_layout: draw_layout.clone(),
-            segments,
-            listed,
         };
         let view = shared.view(device, "geometry");
         gpu_bytes.set(gpu_bytes.get() + view.bytes);
@@ -527,17 +399,11 @@ impl GeometryRenderer {
             targets: opts.clone(),
             counting_draw: None,
             fragment_counts: None,
-            terrain,
             atmosphere: opts.atmosphere,
             compute_bg: view.compute_bg,
             draw_bg: view.draw_bg,
             args: view.args,
             shadow_layout,
-            band: forest_render::shadow::ReceiverBand::of(
-                &instances,
-                &geo_species.iter().map(|s| s.sphere).collect::<Vec<_>>(),
-                forest.terrain.as_ref(),
-            ),
             no_shadows,
             shadows: None,
             parked: None,
@@ -547,12 +413,10 @@ impl GeometryRenderer {
             statistics,
             count_work: false,
             draws: AtomicU32::new(0),
-            species: geo_species.len() as u32,
-            instances: instances.len() as u32,
             background,
             depth_clear: opts.depth_clear(),
-            figures: figures.clone(),
-            gpu_bytes: gpu_bytes.get(),
+            figures: models.figures.clone(),
+            gpu_bytes: gpu_bytes.get() + models.bytes(),
         })
     }
 
@@ -691,7 +555,7 @@ impl GeometryRenderer {
                 device,
                 &o,
                 &self.shadow_layout,
-                self.band,
+                self.shared.models.band,
             )?)),
             None => None,
         };
@@ -829,12 +693,12 @@ impl GeometryRenderer {
     /// The four cull dispatches of a view (its compute group `group`).
     fn record_cull(&self, pass: &mut wgpu::ComputePass, group: &wgpu::BindGroup) {
         pass.set_bind_group(0, group, &[]);
-        let segments = BANDS * self.species;
+        let segments = BANDS * self.shared.models.species_count;
         pass.set_pipeline(&self.reset);
         pass.dispatch_workgroups(segments.div_ceil(RESET_WG).max(1), 1, 1);
         pass.set_pipeline(&self.classify);
         pass.dispatch_workgroups(
-            self.instances.div_ceil(forest_render::capacity::WG).max(1),
+            self.shared.models.instance_count.div_ceil(forest_render::capacity::WG).max(1),
             1,
             1,
         );
@@ -842,7 +706,7 @@ impl GeometryRenderer {
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(&self.scatter);
         pass.dispatch_workgroups(
-            self.instances.div_ceil(forest_render::capacity::WG).max(1),
+            self.shared.models.instance_count.div_ceil(forest_render::capacity::WG).max(1),
             1,
             1,
         );
@@ -905,7 +769,7 @@ impl GeometryRenderer {
         };
         pass.set_bind_group(2, receivers, &[]);
         let environment = if ground {
-            self.terrain
+            self.shared.models.terrain
                 .record_ground(pass, &self.environment, &self.terrain_pipeline)
         } else {
             0
@@ -926,7 +790,7 @@ impl GeometryRenderer {
             pass.end_pipeline_statistics_query();
         }
         self.draws.store(
-            BANDS * self.species + environment,
+            BANDS * self.shared.models.species_count + environment,
             std::sync::atomic::Ordering::Relaxed,
         );
     }
@@ -947,8 +811,8 @@ impl GeometryRenderer {
             if band == first_billboard {
                 pass.set_pipeline(billboard);
             }
-            for s in 0..self.species {
-                pass.draw_indirect(args, u64::from(band * self.species + s) * 16);
+            for s in 0..self.shared.models.species_count {
+                pass.draw_indirect(args, u64::from(band * self.shared.models.species_count + s) * 16);
             }
         }
     }
@@ -985,7 +849,7 @@ impl GeometryRenderer {
 
     /// Visible trees per segment (`band · species + s`) of the last submitted frame; waits.
     pub fn read_segment_counts(&self, ctx: &GpuContext) -> Vec<u32> {
-        let n = (BANDS * self.species) as usize;
+        let n = (BANDS * self.shared.models.species_count) as usize;
         let args: Vec<[u32; 4]> =
             bytemuck::pod_collect_to_vec(&ctx.read_buffer(&self.args, (n * 16) as u64)[..n * 16]);
         args.iter().map(|a| a[1]).collect()
@@ -993,7 +857,7 @@ impl GeometryRenderer {
 
     /// Counters and pass times of the last submitted frame; waits for the GPU.
     pub fn read_stats(&self, ctx: &GpuContext) -> GeometryStats {
-        let n = (BANDS * self.species) as usize;
+        let n = (BANDS * self.shared.models.species_count) as usize;
         let args = ctx.read_buffer(&self.args, (n * 16) as u64);
         let times = self
             .queries
@@ -1024,7 +888,7 @@ impl GeometryRenderer {
         times: Option<&[u8]>,
         statistics: Option<&[u8]>,
     ) -> GeometryStats {
-        let n = ((BANDS * self.species) as usize).min(args.len() / 16);
+        let n = ((BANDS * self.shared.models.species_count) as usize).min(args.len() / 16);
         let args: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&args[..n * 16]);
         let first_billboard = self.method.first_billboard_band();
         let mut stats = GeometryStats {
@@ -1032,7 +896,7 @@ impl GeometryRenderer {
             ..Default::default()
         };
         for (seg, a) in args.iter().enumerate() {
-            let band = seg as u32 / self.species.max(1);
+            let band = seg as u32 / self.shared.models.species_count.max(1);
             stats.visible_trees += a[1];
             stats.per_band[band as usize] += a[1];
             stats.triangles += u64::from(a[0] / 3) * u64::from(a[1]);

@@ -13,7 +13,7 @@ use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderAdapterInfo, RenderDevice, RenderQueue};
 use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
-use forest_baselines::{ForestRenderer, GeometryRenderer, PreparedGeometry};
+use forest_baselines::{ForestRenderer, GeometryRenderer, GpuModels, PreparedGeometry};
 use forest_format::forest::Forest;
 use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
 
@@ -49,8 +49,31 @@ pub(super) struct Caster {
     quads: u32,
 }
 
-/// A forest asset's trees and its species' prepared models, or why it has none.
-type Models = (Arc<Forest>, Result<Arc<PreparedGeometry>, String>);
+/// A forest asset's trees and its species' prepared models (or why it has none), and, once a
+/// view has drawn a model method, those models on the GPU, shared by every view.
+struct Models {
+    forest: Arc<Forest>,
+    prepared: Result<Arc<PreparedGeometry>, String>,
+    gpu: Option<Arc<GpuModels>>,
+}
+
+impl Models {
+    /// The models on the GPU, uploaded at the first call; why not, if they cannot be (an
+    /// upload that failed is not tried again).
+    fn gpu(&mut self, ctx: &GpuContext) -> Result<Arc<GpuModels>, String> {
+        if let Some(gpu) = &self.gpu {
+            return Ok(gpu.clone());
+        }
+        let prepared = self.prepared.as_ref().map_err(Clone::clone)?;
+        match GpuModels::new(ctx, prepared, &self.forest) {
+            Ok(gpu) => Ok(self.gpu.insert(Arc::new(gpu)).clone()),
+            Err(e) => {
+                self.prepared = Err(e.to_string());
+                Err(e.to_string())
+            }
+        }
+    }
+}
 
 /// The render world's forests: Bevy's device as a [`GpuContext`], one GPU scene per asset,
 /// one stream per (camera, forest).
@@ -59,7 +82,7 @@ pub struct ForestRenderState {
     ctx: Option<GpuContext>,
     scenes: HashMap<AssetId<ForestAsset>, Arc<GpuScene>>,
     /// Per asset, its trees and its prepared models for the geometry methods (or why it has
-    /// none).
+    /// none), uploaded once for all views.
     models: HashMap<AssetId<ForestAsset>, Models>,
     failed: HashMap<AssetId<ForestAsset>, String>,
     streams: HashMap<(Entity, Entity), ViewStream>,
@@ -78,6 +101,15 @@ impl ForestRenderState {
             .iter()
             .filter(move |((c, _), v)| *c == main && v.prepared)
             .map(|(_, v)| &v.renderer)
+    }
+
+    /// How many renderers draw from the models of `asset` uploaded once for all views (0
+    /// while no view has drawn a model method of it).
+    pub fn views_sharing_models(&self, asset: AssetId<ForestAsset>) -> usize {
+        self.models
+            .get(&asset)
+            .and_then(|m| m.gpu.as_ref())
+            .map_or(0, |g| Arc::strong_count(g) - 1)
     }
 }
 
@@ -122,9 +154,14 @@ pub fn prepare_forests(
         state.failed.remove(&id);
     }
     for (id, asset) in extracted.new_assets.drain(..) {
-        state
-            .models
-            .insert(id, (asset.forest.clone(), asset.geometry.clone()));
+        state.models.insert(
+            id,
+            Models {
+                forest: asset.forest.clone(),
+                prepared: asset.geometry.clone(),
+                gpu: None,
+            },
+        );
         match GpuScene::new(ctx, &asset.species, &asset.forest) {
             Ok(scene) => {
                 state.scenes.insert(id, Arc::new(scene));
@@ -200,15 +237,17 @@ pub fn prepare_forests(
             };
             let method = cam.settings.method;
             let models = if method.needs_models() {
-                match state.models.get(&forest.asset) {
-                    Some((trees, Ok(m))) => Some((trees.clone(), m.clone())),
-                    Some((_, Err(e))) => {
+                let Some(models) = state.models.get_mut(&forest.asset) else {
+                    continue;
+                };
+                match models.gpu(ctx) {
+                    Ok(gpu) => Some(gpu),
+                    Err(e) => {
                         state.streams.remove(&key_pair);
                         record.error = Some(format!("{}: {e}", method.name()));
                         stats.insert(key_pair, record);
                         continue;
                     }
-                    None => continue,
                 }
             } else {
                 None
@@ -224,7 +263,7 @@ pub fn prepare_forests(
                 let built = QuadStream::new(&ctx.device, scene.clone(), &opts).and_then(|stream| {
                     let geometry = models
                         .as_ref()
-                        .map(|(trees, m)| GeometryRenderer::with_targets(ctx, m, trees, &opts))
+                        .map(|m| GeometryRenderer::with_models(ctx, m.clone(), &opts))
                         .transpose()?;
                     Ok(ForestRenderer::new(stream, geometry))
                 });

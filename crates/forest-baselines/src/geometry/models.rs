@@ -1,0 +1,207 @@
+//! A forest's models and trees on the GPU: uploaded once, shared by every
+//! [`super::GeometryRenderer`] that draws that forest (each camera's view, each target
+//! format), as the quad stream's views share one `GpuScene`.
+
+use forest_format::forest::Forest;
+use forest_format::model::{BANDS, BILLBOARD_RESOLUTION};
+use forest_render::capacity::GeometryCapacity;
+use forest_render::context::{GpuContext, RenderError};
+use forest_render::shadow::ReceiverBand;
+use forest_render::terrain::GpuTerrain;
+use wgpu::util::DeviceExt;
+
+use super::params::SpeciesFigures;
+use super::prepare::PreparedGeometry;
+use super::textures::{MATERIAL_TEXTURE_SIZE, layered_texture};
+
+/// Every species' prepared model (vertices, materials and their textures, billboards, leaf
+/// tables, opacity volumes) and the forest's instances and terrain on one device. Read-only
+/// once built: renderers bind it and never write it. Share it with an `Arc`; a renderer
+/// built from it must be on the same device.
+pub struct GpuModels {
+    pub(super) instances: wgpu::Buffer,
+    pub(super) species: wgpu::Buffer,
+    /// `[instances, species, 0, 0]`, the classification's constants.
+    pub(super) consts: wgpu::Buffer,
+    pub(super) leaf_end: wgpu::Buffer,
+    pub(super) vertices: wgpu::Buffer,
+    pub(super) materials: wgpu::Buffer,
+    pub(super) material_view: wgpu::TextureView,
+    pub(super) sampler: wgpu::Sampler,
+    pub(super) billboard_surface_view: wgpu::TextureView,
+    pub(super) leaf_centre: wgpu::Buffer,
+    pub(super) billboard_view: wgpu::TextureView,
+    pub(super) opacity_view: wgpu::TextureView,
+    pub(super) opacity_sampler: wgpu::Sampler,
+    pub(super) terrain: GpuTerrain,
+    /// The lists' sizes: bands × species segments, every instance listed.
+    pub(super) capacity: GeometryCapacity,
+    pub(super) species_count: u32,
+    pub(super) instance_count: u32,
+    /// The heights between which the forest's receivers lie.
+    pub(super) band: ReceiverBand,
+    /// Per-species figures, in the forest's species order.
+    pub(super) figures: Vec<SpeciesFigures>,
+    /// Bytes of GPU memory uploaded (buffers and textures).
+    bytes: u64,
+}
+
+impl GpuModels {
+    /// Upload `prepared` (one entry per species of `forest`, in its order) with the forest's
+    /// instances and terrain. Refused, before anything is allocated, when the species counts
+    /// differ or the terrain exceeds the device's binding limit.
+    pub fn new(
+        ctx: &GpuContext,
+        prepared: &PreparedGeometry,
+        forest: &Forest,
+    ) -> Result<Self, RenderError> {
+        let PreparedGeometry {
+            vertices,
+            geo_species,
+            materials,
+            layers,
+            billboard_layers,
+            billboard_surface,
+            leaf_end,
+            leaf_centre,
+            opacity,
+            figures,
+        } = prepared;
+        if geo_species.len() != forest.species.len() {
+            return Err(RenderError::SpeciesCount {
+                forest: forest.species.len(),
+                given: geo_species.len(),
+                what: "models",
+            });
+        }
+        let device = &ctx.device;
+        let terrain = GpuTerrain::new(device, forest.terrain.as_ref())?;
+        let instances = forest_render::scene::gpu_instances(forest);
+        let mut bytes = terrain.bytes();
+        use wgpu::BufferUsages as U;
+        let mut init = |label: &str, contents: &[u8], usage: U| {
+            // Empty tables still bind one element of any of their types.
+            let pad = [0u8; 256];
+            let contents = if contents.is_empty() { &pad[..] } else { contents };
+            bytes += contents.len() as u64;
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let instance_buf = init(
+            "geometry instances",
+            bytemuck::cast_slice(&instances),
+            U::STORAGE,
+        );
+        let species_buf = init(
+            "geometry species",
+            bytemuck::cast_slice(geo_species),
+            U::STORAGE,
+        );
+        let vertex_buf = init(
+            "geometry vertices",
+            bytemuck::cast_slice(vertices),
+            U::STORAGE,
+        );
+        let material_buf = init(
+            "geometry materials",
+            bytemuck::cast_slice(materials),
+            U::STORAGE,
+        );
+        let leaf_end_buf = init("leaf ends", bytemuck::cast_slice(leaf_end), U::STORAGE);
+        let leaf_centre_buf = init(
+            "leaf centres",
+            bytemuck::cast_slice(leaf_centre),
+            U::STORAGE,
+        );
+        let consts = init(
+            "geometry constants",
+            bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
+            U::UNIFORM,
+        );
+        let (material_view, material_bytes) = layered_texture(
+            ctx,
+            "material textures",
+            MATERIAL_TEXTURE_SIZE,
+            layers,
+            false,
+        );
+        let (billboard_view, billboard_bytes) = layered_texture(
+            ctx,
+            "billboards",
+            BILLBOARD_RESOLUTION,
+            billboard_layers,
+            false,
+        );
+        let (billboard_surface_view, billboard_surface_bytes) = layered_texture(
+            ctx,
+            "billboard surfaces",
+            BILLBOARD_RESOLUTION,
+            billboard_surface,
+            true,
+        );
+        let (opacity_texture, opacity_bytes) = forest_render::opacity::opacity_texture(
+            device,
+            &ctx.queue,
+            &opacity.iter().collect::<Vec<_>>(),
+        )?;
+        bytes += material_bytes + billboard_bytes + billboard_surface_bytes + opacity_bytes;
+        let opacity_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("opacity"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("material"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Ok(Self {
+            instances: instance_buf,
+            species: species_buf,
+            consts,
+            leaf_end: leaf_end_buf,
+            vertices: vertex_buf,
+            materials: material_buf,
+            material_view,
+            sampler,
+            billboard_surface_view,
+            leaf_centre: leaf_centre_buf,
+            billboard_view,
+            opacity_view: opacity_texture.create_view(&Default::default()),
+            opacity_sampler,
+            capacity: GeometryCapacity::new(
+                instances.len() as u32,
+                geo_species.len() as u32,
+                BANDS,
+            ),
+            species_count: geo_species.len() as u32,
+            instance_count: instances.len() as u32,
+            band: ReceiverBand::of(
+                &instances,
+                &geo_species.iter().map(|s| s.sphere).collect::<Vec<_>>(),
+                forest.terrain.as_ref(),
+            ),
+            figures: figures.clone(),
+            terrain,
+            bytes,
+        })
+    }
+
+    /// Bytes of GPU memory the upload took (buffers and textures).
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Per-species figures, in the forest's species order.
+    pub fn figures(&self) -> &[SpeciesFigures] {
+        &self.figures
+    }
+}
