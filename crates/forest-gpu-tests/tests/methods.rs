@@ -69,7 +69,10 @@ fn renderers_share_one_upload_of_the_models() {
     let mut a = GeometryRenderer::with_models(&ctx, models.clone(), &opts).unwrap();
     let mut b = GeometryRenderer::with_models(&ctx, models.clone(), &opts).unwrap();
     assert_eq!(Arc::strong_count(&models), 3);
-    let (img_a, img_b) = (draw(&ctx, &mut a, lods, &cam), draw(&ctx, &mut b, lods, &cam));
+    let (img_a, img_b) = (
+        draw(&ctx, &mut a, lods, &cam),
+        draw(&ctx, &mut b, lods, &cam),
+    );
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     assert!(covered(&alone) > 160 * 120 / 10, "trees in view");
     for (name, img) in [("first", &img_a), ("second", &img_b)] {

@@ -82,7 +82,11 @@ impl GpuModels {
         let mut init = |label: &str, contents: &[u8], usage: U| {
             // Empty tables still bind one element of any of their types.
             let pad = [0u8; 256];
-            let contents = if contents.is_empty() { &pad[..] } else { contents };
+            let contents = if contents.is_empty() {
+                &pad[..]
+            } else {
+                contents
+            };
             bytes += contents.len() as u64;
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),

@@ -19,8 +19,8 @@ use std::sync::atomic::AtomicU32;
 use wgpu::util::DeviceExt;
 
 use super::layout::{compute_entries, draw_entries};
-use super::params::{GeometryStats, MeshMethod, SpeciesFigures};
 use super::models::GpuModels;
+use super::params::{GeometryStats, MeshMethod, SpeciesFigures};
 use super::prepare::PreparedGeometry;
 use std::sync::Arc;
 
@@ -126,16 +126,9 @@ impl Shared {
             U::UNIFORM | U::COPY_DST | U::COPY_SRC,
         );
         let m = &*self.models;
-        let (segments, listed) = (
-            m.capacity.segments as usize,
-            m.capacity.instances as usize,
-        );
+        let (segments, listed) = (m.capacity.segments as usize, m.capacity.instances as usize);
         let keys = zeros("segment keys", listed * 4, U::STORAGE);
-        let counts = zeros(
-            "segment counts",
-            segments * 4,
-            U::STORAGE | U::COPY_SRC,
-        );
+        let counts = zeros("segment counts", segments * 4, U::STORAGE | U::COPY_SRC);
         let cursor = zeros("segment cursors", segments * 4, U::STORAGE);
         let visible = zeros("visible instances", listed * 4, U::STORAGE);
         let args = zeros(
@@ -698,7 +691,11 @@ impl GeometryRenderer {
         pass.dispatch_workgroups(segments.div_ceil(RESET_WG).max(1), 1, 1);
         pass.set_pipeline(&self.classify);
         pass.dispatch_workgroups(
-            self.shared.models.instance_count.div_ceil(forest_render::capacity::WG).max(1),
+            self.shared
+                .models
+                .instance_count
+                .div_ceil(forest_render::capacity::WG)
+                .max(1),
             1,
             1,
         );
@@ -706,7 +703,11 @@ impl GeometryRenderer {
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(&self.scatter);
         pass.dispatch_workgroups(
-            self.shared.models.instance_count.div_ceil(forest_render::capacity::WG).max(1),
+            self.shared
+                .models
+                .instance_count
+                .div_ceil(forest_render::capacity::WG)
+                .max(1),
             1,
             1,
         );
@@ -769,8 +770,11 @@ impl GeometryRenderer {
         };
         pass.set_bind_group(2, receivers, &[]);
         let environment = if ground {
-            self.shared.models.terrain
-                .record_ground(pass, &self.environment, &self.terrain_pipeline)
+            self.shared.models.terrain.record_ground(
+                pass,
+                &self.environment,
+                &self.terrain_pipeline,
+            )
         } else {
             0
         };
@@ -812,7 +816,10 @@ impl GeometryRenderer {
                 pass.set_pipeline(billboard);
             }
             for s in 0..self.shared.models.species_count {
-                pass.draw_indirect(args, u64::from(band * self.shared.models.species_count + s) * 16);
+                pass.draw_indirect(
+                    args,
+                    u64::from(band * self.shared.models.species_count + s) * 16,
+                );
             }
         }
     }
