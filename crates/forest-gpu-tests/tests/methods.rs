@@ -49,7 +49,7 @@ fn save_on_failure(name: &str, images: &[(&str, &image::RgbaImage)]) {
 
 /// Two renderers built over one upload of the models (as each camera's view in a host is)
 /// draw exactly what a renderer with its own upload draws, and each counts the shared models
-/// in its memory once; models of another species count are refused before any upload.
+/// in its memory once; models for another number of species are refused.
 #[test]
 fn renderers_share_one_upload_of_the_models() {
     use forest_baselines::geometry::GpuModels;
@@ -83,9 +83,9 @@ fn renderers_share_one_upload_of_the_models() {
     }
     assert_eq!(a.gpu_bytes, own.gpu_bytes);
     assert!(models.bytes() > 0 && models.bytes() < a.gpu_bytes);
-    let mut one_species = common::forest(10);
-    one_species.species.push("another".into());
-    let Err(e) = GpuModels::new(&ctx, common::prepared(), &one_species) else {
+    let mut extra_species = common::forest(10);
+    extra_species.species.push("another".into());
+    let Err(e) = GpuModels::new(&ctx, common::prepared(), &extra_species) else {
         panic!("models of another species count accepted");
     };
     assert!(e.to_string().contains("models"), "{e}");

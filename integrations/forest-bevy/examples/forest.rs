@@ -8,8 +8,9 @@
 //! ```
 //! Keys: W A S D fly, Q E down and up, arrows turn, shift faster; J L turn the sun, I K
 //! raise and lower it; M switches method; [ ] halve and double ε. The title bar shows the
-//! method, ε, quads and frame time. `--screenshot PATH` saves a frame once the forest is
-//! drawn, and exits.
+//! method, ε, quads, triangles and frame time (or why the method cannot draw). With
+//! `SCREENSHOT=PATH.png` in the environment it saves a frame once the forest is drawn, and
+//! exits.
 
 use std::path::PathBuf;
 
@@ -28,21 +29,24 @@ struct SunAngles(f32, f32);
 #[derive(Resource)]
 struct Pending(Handle<ForestAsset>);
 
-/// Where to save a screenshot before exiting, and the frames drawn so far.
+/// Where to save a screenshot before exiting, the frames that drew the forest, all frames.
 #[derive(Resource)]
-struct Shot(PathBuf, u32);
+struct Shot(PathBuf, u32, u32);
 
 fn main() -> AppExit {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let flag = args.iter().position(|a| a == "--screenshot");
-    let forest = match args.first().filter(|_| flag != Some(0)) {
-        Some(path) => PathBuf::from(path),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../out/forest-100k.forest"),
-    };
-    let Some((folder, name)) = forest.canonicalize().ok().and_then(|f| {
-        let name = f.file_name()?.to_string_lossy().into_owned();
-        Some((f.parent()?.to_string_lossy().into_owned(), name))
-    }) else {
+    let forest = std::env::args_os().nth(1).map_or_else(
+        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../out/forest-100k.forest"),
+        PathBuf::from,
+    );
+    let Some((folder, name)) = forest
+        .canonicalize()
+        .ok()
+        .filter(|f| f.is_file())
+        .and_then(|f| {
+            let name = f.file_name()?.to_string_lossy().into_owned();
+            Some((f.parent()?.to_string_lossy().into_owned(), name))
+        })
+    else {
         eprintln!(
             "forest: no forest at {} (run `bash scripts/demo.sh`)",
             forest.display()
@@ -50,8 +54,8 @@ fn main() -> AppExit {
         return AppExit::error();
     };
     let mut app = App::new();
-    if let Some(path) = flag.and_then(|i| args.get(i + 1)) {
-        app.insert_resource(Shot(path.into(), 0))
+    if let Some(path) = std::env::var_os("SCREENSHOT") {
+        app.insert_resource(Shot(path.into(), 0, 0))
             .add_systems(Update, screenshot);
     }
     let fog = Color::srgb(0.62, 0.72, 0.84);
@@ -99,21 +103,28 @@ fn main() -> AppExit {
     .run()
 }
 
-/// Once the forest has drawn for a few frames: a screenshot, then exit.
+/// Once the forest has drawn for a few frames: a screenshot, then exit (with an error if
+/// nothing was drawn in 600 frames).
 fn screenshot(
     mut commands: Commands,
     mut shot: ResMut<Shot>,
     stats: Res<ForestStats>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    shot.1 += u32::from(stats.views.values().any(|s| s.quads > 0));
-    if shot.1 == 4 {
-        commands
-            .spawn(Screenshot::primary_window())
-            .observe(save_to_disk(shot.0.clone()));
+    shot.2 += 1;
+    if stats.views.values().any(|s| s.quads > 0 || s.triangles > 0) {
+        shot.1 += 1;
+        if shot.1 == 4 {
+            commands
+                .spawn(Screenshot::primary_window())
+                .observe(save_to_disk(shot.0.clone()));
+        }
     }
-    if shot.1 > 4 && shot.0.exists() || shot.1 == 60 {
+    if shot.1 > 4 && shot.0.exists() {
         exit.write(AppExit::Success);
+    } else if shot.2 == 600 {
+        eprintln!("forest: no forest drawn in 600 frames, no screenshot");
+        exit.write(AppExit::error());
     }
 }
 
@@ -130,7 +141,7 @@ fn terrain(
         return;
     };
     let f = &forest.forest;
-    let ground = terrain_mesh(f, f.extent().min(3000.0), 256).expect("a valid grid");
+    let ground = terrain_mesh(f, f.extent().clamp(1.0, 3000.0), 256).expect("a valid grid");
     commands.spawn((
         Mesh3d(meshes.add(ground)),
         MeshMaterial3d(materials.add(StandardMaterial {

@@ -59,8 +59,9 @@ impl ForestStats {
             .sum()
     }
 
-    /// Why a forest is not drawn into `camera`'s view, if one is not (the first such forest's
-    /// reason, e.g. a geometry method asked of atlases baked without models).
+    /// A problem with a forest in `camera`'s view, if any forest there has one: why it is not
+    /// drawn (e.g. a model method asked of atlases baked without models) or a fault while it
+    /// still draws (a shadow caster). With several forests in error, any one of them.
     pub fn error(&self, camera: Entity) -> Option<&str> {
         self.views
             .iter()

@@ -22,9 +22,10 @@ pub enum TerrainMeshError {
 /// The forest's ground over the square `[-half_extent, half_extent]²` (metres, in the forest's
 /// frame: place the mesh with the forest's `Transform`) as `cells` × `cells` quads of two
 /// triangles, every vertex at [`Forest::ground_height`] (flat at 0 for a forest without
-/// terrain), with smooth normals. Between its vertices the mesh is linear, as the forest's
-/// ground is on each half of a height-field cell, so the two agree exactly only where the
-/// mesh's grid is the height field's; a coarser mesh cuts across the field's bumps.
+/// terrain), with smooth normals. Each cell is split along the same diagonal as the forest's
+/// ground, so on the height field's own grid (`half_extent` and `cells` that put the mesh's
+/// vertices on its samples) the mesh is exactly the ground the trees stand on; a coarser mesh
+/// cuts across the field's bumps.
 pub fn terrain_mesh(
     forest: &Forest,
     half_extent: f32,
@@ -49,8 +50,9 @@ pub fn terrain_mesh(
     for j in 0..cells {
         for i in 0..cells {
             let a = j * row + i;
-            // Counter-clockwise seen from above (+Y).
-            indices.extend([a, a + row, a + 1, a + 1, a + row, a + row + 1]);
+            // Split along (i, j)–(i + 1, j + 1), as the forest's ground is; counter-clockwise
+            // seen from above (+Y).
+            indices.extend([a, a + row + 1, a + 1, a, a + row, a + row + 1]);
         }
     }
     let mut mesh = Mesh::new(
@@ -74,7 +76,11 @@ mod tests {
     fn the_mesh_lies_on_the_ground() {
         let n = 9usize;
         let heights: Vec<f32> = (0..n * n)
-            .map(|k| 0.3 * (k % n) as f32 + ((k / n) as f32).sin())
+            // A slope, bumps along z, and a twist (i·j) that makes every cell non-planar.
+            .map(|k| {
+                let (i, j) = ((k % n) as f32, (k / n) as f32);
+                0.3 * i + j.sin() + 0.05 * i * j
+            })
             .collect();
         let terrain = forest_format::terrain::Terrain {
             size: [n as u32, n as u32],
@@ -105,6 +111,29 @@ mod tests {
         };
         assert!(normals.iter().all(|n| n[1] > 0.0));
         assert_eq!(mesh.indices().map(|i| i.len()), Some(6 * 36));
+        // On the field's own grid, every triangle lies on the ground: its centroid's height is
+        // the ground's there (a cell split along the other diagonal would not be).
+        let mesh = terrain_mesh(&forest, 20.0, 8).expect("mesh");
+        let Some(VertexAttributeValues::Float32x3(p)) = mesh.attribute(Mesh::ATTRIBUTE_POSITION)
+        else {
+            panic!("no positions");
+        };
+        let indices: Vec<usize> = mesh.indices().expect("indices").iter().collect();
+        for t in indices.chunks(3) {
+            let c = t.iter().fold([0.0f32; 3], |c, &k| {
+                [
+                    c[0] + p[k][0] / 3.0,
+                    c[1] + p[k][1] / 3.0,
+                    c[2] + p[k][2] / 3.0,
+                ]
+            });
+            let ground = forest.ground_height(c[0], c[2]);
+            assert!(
+                (c[1] - ground).abs() < 1e-4,
+                "{t:?}: {} against {ground}",
+                c[1]
+            );
+        }
         assert_eq!(
             terrain_mesh(&forest, 0.0, 6).err(),
             Some(TerrainMeshError::HalfExtent(0.0))

@@ -49,7 +49,8 @@ pub struct GpuModels {
 impl GpuModels {
     /// Upload `prepared` (one entry per species of `forest`, in its order) with the forest's
     /// instances and terrain. Refused, before anything is allocated, when the species counts
-    /// differ or the terrain exceeds the device's binding limit.
+    /// differ, the device cannot draw the geometry methods (no indirect draws with a first
+    /// instance) or the terrain exceeds the device's binding limit.
     pub fn new(
         ctx: &GpuContext,
         prepared: &PreparedGeometry,
@@ -74,6 +75,7 @@ impl GpuModels {
                 what: "models",
             });
         }
+        super::renderer::require_indirect_first_instance(ctx)?;
         let device = &ctx.device;
         let terrain = GpuTerrain::new(device, forest.terrain.as_ref())?;
         let instances = forest_render::scene::gpu_instances(forest);

@@ -199,6 +199,23 @@ impl Shared {
     }
 }
 
+/// The geometry renderer draws each segment with an indirect draw whose first instance is
+/// the segment's offset in the visible list.
+pub(super) fn require_indirect_first_instance(ctx: &GpuContext) -> Result<(), RenderError> {
+    if ctx
+        .device
+        .features()
+        .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
+    {
+        Ok(())
+    } else {
+        Err(RenderError::MissingFeature {
+            method: "the geometry renderer",
+            feature: "indirect draws with a first instance (INDIRECT_FIRST_INSTANCE)",
+        })
+    }
+}
+
 impl GeometryRenderer {
     /// Upload prepared species with the forest's instances (their species order must match),
     /// for `format` colour targets with the crate's own depth target (Depth32Float, standard
@@ -240,16 +257,7 @@ impl GeometryRenderer {
     ) -> Result<Self, RenderError> {
         let background = opts.background;
         opts.atmosphere.validate().map_err(RenderError::Parameter)?;
-        if !ctx
-            .device
-            .features()
-            .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
-        {
-            return Err(RenderError::MissingFeature {
-                method: "the geometry renderer",
-                feature: "indirect draws with a first instance (INDIRECT_FIRST_INSTANCE)",
-            });
-        }
+        require_indirect_first_instance(ctx)?;
         let device = &ctx.device;
         let cap = models.capacity;
         // This renderer's own allocations; the shared models' are added at the end.

@@ -68,6 +68,7 @@ impl Models {
         match GpuModels::new(ctx, prepared, &self.forest) {
             Ok(gpu) => Ok(self.gpu.insert(Arc::new(gpu)).clone()),
             Err(e) => {
+                error!("forest models cannot be uploaded: {e}");
                 self.prepared = Err(e.to_string());
                 Err(e.to_string())
             }
@@ -103,8 +104,9 @@ impl ForestRenderState {
             .map(|(_, v)| &v.renderer)
     }
 
-    /// How many renderers draw from the models of `asset` uploaded once for all views (0
-    /// while no view has drawn a model method of it).
+    /// How many views' renderers hold the models of `asset`, uploaded once for all of them
+    /// (0 while no view draws a model method of it: the upload is freed with its last
+    /// renderer).
     pub fn views_sharing_models(&self, asset: AssetId<ForestAsset>) -> usize {
         self.models
             .get(&asset)
@@ -169,6 +171,8 @@ pub fn prepare_forests(
             }
             Err(e) => {
                 error!("forest {id:?} cannot be drawn: {e}");
+                // A reload that failed leaves nothing of the old scene to draw.
+                state.scenes.remove(&id);
                 state.failed.insert(id, e.to_string());
             }
         }
@@ -448,6 +452,12 @@ pub fn prepare_forests(
     }
     state.streams.retain(|k, _| live.contains(k));
     state.casters.retain(|k, _| live_casters.contains(k));
+    // Models no view's renderer holds any more are freed (a later view uploads them again).
+    for m in state.models.values_mut() {
+        if m.gpu.as_ref().is_some_and(|g| Arc::strong_count(g) == 1) {
+            m.gpu = None;
+        }
+    }
 }
 
 /// The format the forest's pipelines draw a view of `format` in: its sRGB twin for the
