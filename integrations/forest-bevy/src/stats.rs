@@ -41,31 +41,29 @@ impl ForestStats {
         self.views.get(&(camera, forest))
     }
 
-    /// Quads drawn in `camera`'s view, over all forests.
-    pub fn quads(&self, camera: Entity) -> u64 {
+    /// The counters of every forest in `camera`'s view.
+    fn of_camera(&self, camera: Entity) -> impl Iterator<Item = &ForestViewStats> {
         self.views
             .iter()
-            .filter(|((c, _), _)| *c == camera)
-            .map(|(_, s)| u64::from(s.quads))
-            .sum()
+            .filter(move |((c, _), _)| *c == camera)
+            .map(|(_, s)| s)
+    }
+
+    /// Quads drawn in `camera`'s view, over all forests.
+    pub fn quads(&self, camera: Entity) -> u64 {
+        self.of_camera(camera).map(|s| u64::from(s.quads)).sum()
     }
 
     /// Triangles drawn in `camera`'s view, over all forests.
     pub fn triangles(&self, camera: Entity) -> u64 {
-        self.views
-            .iter()
-            .filter(|((c, _), _)| *c == camera)
-            .map(|(_, s)| s.triangles)
-            .sum()
+        self.of_camera(camera).map(|s| s.triangles).sum()
     }
 
     /// A problem with a forest in `camera`'s view, if any forest there has one: why it is not
     /// drawn (e.g. a model method asked of atlases baked without models) or a fault while it
     /// still draws (a shadow caster). With several forests in error, any one of them.
     pub fn error(&self, camera: Entity) -> Option<&str> {
-        self.views
-            .iter()
-            .find_map(|((c, _), s)| (*c == camera).then_some(s.error.as_deref()).flatten())
+        self.of_camera(camera).find_map(|s| s.error.as_deref())
     }
 }
 
