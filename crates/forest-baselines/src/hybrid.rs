@@ -13,6 +13,7 @@
 
 use forest_render::camera::Camera;
 use forest_render::forms::{FORMS_GEOMETRY, GEOMETRY_ALWAYS};
+use forest_render::options::StreamOptions;
 
 use crate::geometry::MeshMethod;
 use forest_render::context::RenderError;
@@ -51,7 +52,19 @@ pub struct Hybrid {
     pub jitter: f32,
     /// How the near trees are drawn.
     pub near_form: MeshMethod,
+    /// Aspect sharpening of the trees drawn as quads, in units of
+    /// 1/[`forest_render::gpu_types::WEIGHT_ONE`] (0 to
+    /// [`forest_render::options::SHARPEN_MAX`]): it replaces the stream's own
+    /// ([`forest_render::options::StreamOptions::sharpen`]) while the hybrid draws. Default
+    /// [`HYBRID_SHARPEN_DEFAULT`]: the hybrid's quads are trees beyond its switch, where a
+    /// faint third aspect adds a layer of fragments and little to the image.
+    pub sharpen: u32,
 }
+
+/// Default [`Hybrid::sharpen`]: 20 % of a weight of one, against the stream's 10 %
+/// ([`forest_render::options::SHARPEN_DEFAULT`]). Chosen by the measurements under "The
+/// hybrid's aspect sharpening" in docs/rendering.md.
+pub const HYBRID_SHARPEN_DEFAULT: u32 = 819;
 
 impl Default for Hybrid {
     fn default() -> Self {
@@ -60,6 +73,7 @@ impl Default for Hybrid {
             band: 0.25,
             jitter: 0.25,
             near_form: MeshMethod::Full { depth_sort: true },
+            sharpen: HYBRID_SHARPEN_DEFAULT,
         }
     }
 }
@@ -81,6 +95,12 @@ impl Hybrid {
                 )));
             }
         }
+        StreamOptions {
+            sharpen: self.sharpen,
+            ..Default::default()
+        }
+        .validate()
+        .map_err(|e| RenderError::Parameter(format!("the hybrid's quads: {e}")))?;
         self.near_form.validate()
     }
 
@@ -112,6 +132,7 @@ pub fn auto_radii(camera: &Camera, levels: u32, pixels: f32) -> f32 {
 mod tests {
     use super::*;
     use forest_render::forms::DEFAULT_SWITCH_PIXELS;
+    use forest_render::options::SHARPEN_MAX;
     use glam::Vec3;
 
     fn cam(epsilon: f32) -> Camera {
@@ -197,6 +218,12 @@ mod tests {
             ..Default::default()
         };
         assert!(h.validate().unwrap_err().to_string().contains("band"));
+        let h = Hybrid {
+            sharpen: SHARPEN_MAX + 1,
+            ..Default::default()
+        };
+        let e = h.validate().unwrap_err().to_string();
+        assert!(e.contains("hybrid") && e.contains("sharpening"), "{e}");
         assert!(Hybrid::default().validate().is_ok());
         let inf = Hybrid {
             near: Near::Metres(f32::INFINITY),

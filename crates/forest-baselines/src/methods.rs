@@ -251,6 +251,12 @@ impl ForestRenderer {
             }
         }
         self.stream.set_forms(FORMS_QUADS);
+        // The hybrid's quads draw with its own sharpening; every other method with the
+        // stream's options.
+        self.stream.set_sharpen_override(match method {
+            Method::Hybrid(h) => Some(h.sharpen),
+            _ => None,
+        })?;
         if let Some(g) = &mut self.geometry {
             g.set_forms(FORMS_GEOMETRY);
         }

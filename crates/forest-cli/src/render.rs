@@ -267,9 +267,10 @@ pub struct MethodArgs {
     pub far_span: u32,
     /// Quad stream: aspect sharpening, 0 to 0.333: each of a tree's 1–3 blend weights loses
     /// this share and the rest are scaled back to one, so aspects of small weight fade out
-    /// (fewer layers of quads); 0 is the paper's blend
-    #[arg(long, default_value_t = f64::from(forest_render::options::SHARPEN_DEFAULT) / f64::from(WEIGHT_ONE), value_parser = parse_sharpen)]
-    pub sharpen: f64,
+    /// (fewer layers of quads); 0 is the paper's blend. Default 0.1, and 0.2 for the
+    /// hybrid's quads (the trees beyond its switch)
+    #[arg(long, value_parser = parse_sharpen)]
+    pub sharpen: Option<f64>,
     /// Quad stream: draw each slab of a far tree (see --far-span) as its own quad (by default
     /// its slabs are composited into one quad, sampled through their parallax).
     #[arg(long)]
@@ -317,8 +318,14 @@ impl MethodArgs {
             far_nearest: !self.far_blend,
             far_composite: !self.far_slabs,
             far_span: self.far_span,
-            sharpen: (self.sharpen * f64::from(WEIGHT_ONE)).round() as u32,
+            sharpen: self.sharpen_or(forest_render::options::SHARPEN_DEFAULT),
         }
+    }
+
+    /// `--sharpen` in units of 1/[`WEIGHT_ONE`], else `default`.
+    fn sharpen_or(&self, default: u32) -> u32 {
+        self.sharpen
+            .map_or(default, |s| (s * f64::from(WEIGHT_ONE)).round() as u32)
     }
 
     /// The geometry method `name` names (for the hybrid: its near trees' form; None for the
@@ -362,6 +369,7 @@ impl MethodArgs {
                     near: self.near,
                     band: self.band,
                     near_form,
+                    sharpen: self.sharpen_or(forest_baselines::hybrid::HYBRID_SHARPEN_DEFAULT),
                     ..Default::default()
                 };
                 h.validate()?;

@@ -1,5 +1,5 @@
-//! The hybrid method: at a switch distance of 0 it is the quad stream and at infinity the full
-//! geometry, byte for byte; a tree in the transition band is drawn by both forms through
+//! The hybrid method: at a switch distance of 0 it is the quad stream (at the hybrid's aspect
+//! sharpening) and at infinity the full geometry, byte for byte; a tree in the transition band is drawn by both forms through
 //! complementary masks (every pixel from exactly one of them); the GPU's classification equals
 //! the CPU mirror; a frame writes only the camera; empty, single-tree and 1M-tree forests
 //! render without validation errors.
@@ -7,12 +7,12 @@
 mod common;
 
 use forest_baselines::geometry::{MeshMethod, PreparedGeometry};
-use forest_baselines::hybrid::{Hybrid, Near};
+use forest_baselines::hybrid::{HYBRID_SHARPEN_DEFAULT, Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::atlas::HybridSwitch;
 use forest_format::forest::Forest;
 use forest_render::forms as hybrid;
-use forest_render::options::{Atmosphere, Background};
+use forest_render::options::{Atmosphere, Background, StreamOptions};
 use forest_render::target::Target;
 use forest_render::{Camera, GpuContext, SpeciesData, reference};
 use glam::Vec3;
@@ -94,8 +94,21 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
     ] {
         let mut r = renderer_in(&ctx, &forest, (160, 120), background, atmosphere);
         r.set_shadows(&ctx.device, shadows).unwrap();
+        let mut sharpened = 0;
         for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
+            // The hybrid's quads draw with its own aspect sharpening: the stream's options
+            // set to it draw the same quads.
+            let own = frame(&ctx, &mut r, Method::Quads, &cam);
+            let options = r.stream.options();
+            r.stream
+                .set_options(StreamOptions {
+                    sharpen: HYBRID_SHARPEN_DEFAULT,
+                    ..options
+                })
+                .unwrap();
             let quads = frame(&ctx, &mut r, Method::Quads, &cam);
+            r.stream.set_options(options).unwrap();
+            sharpened += usize::from(quads != own);
             let zero = frame(&ctx, &mut r, hybrid_at(0.0), &cam);
             let geometry = frame(
                 &ctx,
@@ -104,6 +117,11 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
                 &cam,
             );
             let infinity = frame(&ctx, &mut r, hybrid_at(f32::INFINITY), &cam);
+            // Switched back, the stream draws with its own options again.
+            assert!(
+                frame(&ctx, &mut r, Method::Quads, &cam) == own,
+                "{name}: the quad stream after the hybrid kept the hybrid's sharpening"
+            );
             assert_ne!(quads, geometry, "{name}: the two forms differ");
             for (what, got, want) in [
                 ("at 0", &zero, &quads),
@@ -125,6 +143,10 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
                 }
             }
         }
+        assert!(
+            sharpened > 0,
+            "{background:?}: the hybrid's sharpening changed no camera's quads"
+        );
     }
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
@@ -354,6 +376,9 @@ fn classification_matches(
         let forms = h.forms(&cam);
         let mut g = cam.to_gpu();
         g.forms = forms;
+        // The stream's options with the hybrid's own sharpening.
+        r.stream.drawn_options().apply(&mut g);
+        assert_eq!(r.stream.drawn_options().sharpen, h.sharpen);
         // Quads: the CPU reference skips the trees drawn as geometry alone.
         let cpu = reference::run(&r.stream.scene.tables, &g, r.stream.capacity.quads);
         assert!(

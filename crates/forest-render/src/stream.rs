@@ -103,6 +103,8 @@ pub struct QuadStream {
     prepared: bool,
     debug: DebugView,
     options: StreamOptions,
+    /// Replaces `options.sharpen` in the frames drawn ([`Self::set_sharpen_override`]).
+    sharpen_override: Option<u32>,
     forms: [f32; 4],
     light: forest_format::shading::Lighting,
     /// The sun's shadow maps, when on ([`Self::set_shadows`]).
@@ -253,6 +255,7 @@ impl QuadStream {
             prepared: false,
             debug: DebugView::Off,
             options: StreamOptions::default(),
+            sharpen_override: None,
             forms: crate::forms::FORMS_QUADS,
             light: opts.lighting,
             shadows: None,
@@ -322,7 +325,7 @@ impl QuadStream {
                 (self.opts.depth_format, compare),
             ));
         }
-        let g = light.camera(self.options);
+        let g = light.camera(self.drawn_options());
         crate::camera::upload(queue, &self.camera, &g, &mut self.writes);
         self.prepared = true;
         Ok(())
@@ -776,6 +779,31 @@ impl QuadStream {
         self.options
     }
 
+    /// An aspect sharpening (units of 1/[`crate::gpu_types::WEIGHT_ONE`], at most
+    /// [`crate::options::SHARPEN_MAX`]) that replaces [`StreamOptions::sharpen`] in the frames
+    /// written from the next camera on, whatever [`Self::set_options`] sets; None: the
+    /// options' own. A method that draws only some trees as quads sets its own with its
+    /// forms (the hybrid's trees beyond its switch). Refused out of range.
+    pub fn set_sharpen_override(&mut self, sharpen: Option<u32>) -> Result<(), RenderError> {
+        if let Some(s) = sharpen {
+            StreamOptions {
+                sharpen: s,
+                ..self.options
+            }
+            .validate()?;
+        }
+        self.sharpen_override = sharpen;
+        Ok(())
+    }
+
+    /// The options the frames are drawn with: [`Self::options`] with the sharpening override.
+    pub fn drawn_options(&self) -> StreamOptions {
+        StreamOptions {
+            sharpen: self.sharpen_override.unwrap_or(self.options.sharpen),
+            ..self.options
+        }
+    }
+
     /// What the trees are drawn over when the stream clears the targets itself.
     pub fn background(&self) -> Background {
         self.opts.background
@@ -845,7 +873,7 @@ impl QuadStream {
 
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
         g.viewport[2] = self.debug.shader_value() as f32;
-        self.options.apply(&mut g);
+        self.drawn_options().apply(&mut g);
         g.forms = self.forms;
         g.set_light(&self.light);
         if let Some(h) = &self.host_shadows {
@@ -856,7 +884,7 @@ impl QuadStream {
                 &g,
                 &self.light,
                 sh.options(),
-                self.options,
+                self.drawn_options(),
                 sh.targets().band(),
             ),
             None => vec![g],
