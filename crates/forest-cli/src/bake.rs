@@ -390,10 +390,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             let (first, last) = (d[0], d[d.len() - 1]);
             let (_, inside) = crate::switch::crossover(&ladder, h.tolerance);
             println!(
-                "  hybrid switch: the quad stream (ε {}) is within {:.0} % of the triangles' error \
-                 from {:.2} crown radii{} (finest quads {:.2} px at {}x{}, {}°)",
+                "  hybrid switch: the quad stream (ε {}) is {} from {:.2} crown radii{} \
+                 (finest quads {:.2} px at {}x{}, {}°)",
                 h.epsilon,
-                h.tolerance * 100.0,
+                crate::switch::accuracy_words(h.tolerance),
                 h.crown_radii,
                 if inside {
                     String::new()

@@ -149,19 +149,28 @@ pub fn finest_quad_pixels(levels: u32, radii: f32) -> f32 {
     auto_radii(&view, levels, radii)
 }
 
+/// How accurate the switch lets the quad stream be, in words: "as accurate as the triangles"
+/// at tolerance 0, else within that share of their error.
+pub fn accuracy_words(tolerance: f32) -> String {
+    if tolerance == 0.0 {
+        "as accurate as the triangles".into()
+    } else {
+        format!("within {:.0} % of the triangles' error", tolerance * 100.0)
+    }
+}
+
 /// The hybrid's automatic switch of an atlas in words: the finest quads' width there and,
 /// where the bake measured it, the crossover in crown radii at the measurement's view.
 pub fn describe(m: &forest_format::AtlasManifest) -> String {
     match &m.hybrid_switch {
         Some(h) => format!(
-            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, stream within {:.0} % of \
-             the triangles' error)",
+            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, stream {})",
             h.finest_quad_pixels,
             h.crown_radii,
             h.viewport[0],
             h.viewport[1],
             h.fov_y_deg,
-            h.tolerance * 100.0
+            accuracy_words(h.tolerance)
         ),
         None => format!(
             "finest quads {} px (not measured: the default)",
@@ -345,6 +354,12 @@ pub fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_strict_switch_reads_as_accurate_and_a_tolerance_as_its_share() {
+        assert_eq!(accuracy_words(0.0), "as accurate as the triangles");
+        assert_eq!(accuracy_words(0.25), "within 25 % of the triangles' error");
+    }
 
     #[test]
     fn bisection_finds_the_first_crossing_in_few_questions() {

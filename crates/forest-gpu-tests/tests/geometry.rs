@@ -19,7 +19,7 @@ fn quad_stream_resembles_the_supersampled_full_geometry() {
         Background::Transparent,
     )
     .unwrap();
-    assert_eq!(geo.figures.len(), 2);
+    assert_eq!(geo.figures().len(), 2);
     let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
     let opts = RendererOptions {
         viewport: (160, 120),

@@ -66,8 +66,6 @@ pub struct GeometryRenderer {
     draws: AtomicU32,
     background: Background,
     depth_clear: f32,
-    /// Per-species figures, in the forest's species order.
-    pub figures: Vec<SpeciesFigures>,
     /// Bytes of GPU memory the renderer allocated (buffers and textures), the models it
     /// shares included.
     pub gpu_bytes: u64,
@@ -416,9 +414,13 @@ impl GeometryRenderer {
             draws: AtomicU32::new(0),
             background,
             depth_clear: opts.depth_clear(),
-            figures: models.figures.clone(),
             gpu_bytes: gpu_bytes.get() + models.bytes(),
         })
+    }
+
+    /// Per-species figures of the models drawn, in the forest's species order.
+    pub fn figures(&self) -> &[SpeciesFigures] {
+        self.shared.models.figures()
     }
 
     /// Switch the method (a uniform write; nothing is rebuilt).
