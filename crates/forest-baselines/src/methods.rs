@@ -251,18 +251,18 @@ impl ForestRenderer {
             }
         }
         self.stream.set_forms(FORMS_QUADS);
-        // The hybrid's quads draw with its own sharpening; every other method with the
-        // stream's options.
-        self.stream.set_sharpen_override(match method {
-            Method::Hybrid(h) => Some(h.sharpen),
-            _ => None,
-        })?;
         if let Some(g) = &mut self.geometry {
             g.set_forms(FORMS_GEOMETRY);
         }
         if shadows_for(method, self.shadows) != shadows_for(self.method, self.shadows) {
             self.apply_shadows(&ctx.device, method, self.shadows)?;
         }
+        // The hybrid's quads draw with its own sharpening; every other method with the
+        // stream's options. Set with the method, once nothing can fail (validated above).
+        self.stream.set_sharpen_override(match method {
+            Method::Hybrid(h) => Some(h.sharpen),
+            _ => None,
+        })?;
         self.method = method;
         Ok(())
     }

@@ -323,7 +323,7 @@ impl MethodArgs {
     }
 
     /// `--sharpen` in units of 1/[`WEIGHT_ONE`], else `default`.
-    fn sharpen_or(&self, default: u32) -> u32 {
+    pub(crate) fn sharpen_or(&self, default: u32) -> u32 {
         self.sharpen
             .map_or(default, |s| (s * f64::from(WEIGHT_ONE)).round() as u32)
     }

@@ -261,7 +261,12 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
     };
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
     let chosen = m.chosen(mesh_method)?;
-    let methods = crate::window::offered(chosen, prepared.is_some());
+    // The hybrid offered beside another method takes --sharpen too, when given.
+    let hybrid = forest_baselines::hybrid::Hybrid {
+        sharpen: m.sharpen_or(forest_baselines::hybrid::HYBRID_SHARPEN_DEFAULT),
+        ..Default::default()
+    };
+    let methods = crate::window::offered(chosen, prepared.is_some(), hybrid);
     let start = methods.iter().position(|x| *x == chosen).unwrap_or(0);
     let (size, epsilon) = (args.size, args.epsilon);
     // Both builders hold the forest (the window calls them once, when it has a device).
@@ -271,8 +276,12 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
     let start_view = Some(crate::render::named_view("inside", &forest));
     let forest = Rc::new(forest);
     let f = forest.clone();
+    // The stream's run-time options from the command line (--blend, --far-span, --sharpen…).
+    let stream_options = m.stream_options();
     let build_stream: crate::window::BuildStream = Box::new(move |ctx, format, viewport, eps| {
-        quad_stream(ctx, &species, &f, format, viewport, eps, light)
+        let mut s = quad_stream(ctx, &species, &f, format, viewport, eps, light)?;
+        s.set_options(stream_options)?;
+        Ok(s)
     });
     let build_geometry: crate::window::BuildGeometry = Box::new(move |ctx, format| {
         prepared

@@ -377,8 +377,11 @@ fn classification_matches(
         let mut g = cam.to_gpu();
         g.forms = forms;
         // The stream's options with the hybrid's own sharpening.
-        r.stream.drawn_options().apply(&mut g);
-        assert_eq!(r.stream.drawn_options().sharpen, h.sharpen);
+        StreamOptions {
+            sharpen: h.sharpen,
+            ..r.stream.options()
+        }
+        .apply(&mut g);
         // Quads: the CPU reference skips the trees drawn as geometry alone.
         let cpu = reference::run(&r.stream.scene.tables, &g, r.stream.capacity.quads);
         assert!(

@@ -219,7 +219,8 @@ pub struct StreamOptions {
     /// 0) and the rest are scaled back to a sum of one, so an aspect of small weight fades out
     /// continuously (no pop) instead of adding a faint layer of quads. Default
     /// [`SHARPEN_DEFAULT`] (10 %), chosen by the measurements under "The far span and aspect
-    /// sharpening" in docs/rendering.md. 0 is the paper's barycentric blend.
+    /// sharpening" in docs/rendering.md. 0 is the paper's barycentric blend. The hybrid
+    /// draws its quads with its own (`QuadStream::set_sharpen_override`).
     pub sharpen: u32,
 }
 

@@ -774,7 +774,8 @@ impl QuadStream {
         Ok(())
     }
 
-    /// The run-time options in use.
+    /// The run-time options as [`Self::set_options`] set them (what frames draw with is
+    /// [`Self::drawn_options`]: these, with a method's own sharpening while it is set).
     pub fn options(&self) -> StreamOptions {
         self.options
     }

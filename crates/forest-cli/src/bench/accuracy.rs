@@ -487,6 +487,8 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
     } else {
         String::new()
     };
+    let hybrid_sharpen = f64::from(forest_baselines::hybrid::HYBRID_SHARPEN_DEFAULT)
+        / f64::from(forest_render::gpu_types::WEIGHT_ONE);
     let switches = b.switch_summary();
     let text = format!(
         "{trees} trees over {side:.0} m, {}x{}, transparent background (trees only). The \
@@ -496,9 +498,10 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
          and full geometry at 1× are single points. Lines are each method's Pareto front \
          (nothing both faster and more accurate). On a CPU rasteriser full geometry and \
          stochastic simplification are timed over one frame. The hybrid draws trees nearer \
-         than its switch distance as full geometry and the rest as the quad stream (`near=auto`: \
-         per species, where its finest quads project to the width at which its bake measured \
-         the stream as accurate as the triangles, at every ε: {switches}). The walkthrough \
+         than its switch distance as full geometry and the rest as the quad stream, its aspects \
+         sharpened by {hybrid_sharpen:.1} (`near=auto`: per species, where its finest quads project to the \
+         width at which its bake measured the stream against the triangles, at every ε: \
+         {switches}). The walkthrough \
          view is the mean over {walk} seeded random eye-height cameras inside the forest (seed \
          {WALK_SEED:#x}; none rejected){real}.\n\nThe work charts put the same settings against the shader invocations a \
          frame asks of a GPU (pipeline-statistics queries), which a CPU rasteriser's times \

@@ -224,7 +224,7 @@ pub fn run(b: &Bench) -> Result<Section> {
          FLIP minus the reference's over the same move (above 0: changes the reference does \
          not have); `pops` counts frames whose change exceeds the reference's by more than \
          {POP_MARGIN}. The hybrid (near trees as full geometry, switch per species where its \
-         bake measured the stream as accurate as the triangles: {}; a dithered band jittered \
+         bake measured the stream against the triangles: {}; a dithered band jittered \
          per tree) must add no pops at its switch. Worst case per method: quad stream {}; \
          impostors {}; stochastic {}; LODs {}; hybrid {}.",
         viewport.0,

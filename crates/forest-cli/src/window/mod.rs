@@ -25,6 +25,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use forest_baselines::geometry::GeometryRenderer;
 use forest_baselines::geometry::MeshMethod;
+use forest_baselines::hybrid::Hybrid;
 use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::camera_path::CameraPath;
 use forest_render::context::GpuContext;
@@ -633,7 +634,7 @@ impl ApplicationHandler for Viewer {
 /// The methods a viewer offers, in a fixed order (keys 1–6): quads, impostor, and with models
 /// LODs, stochastic, geometry, hybrid; the kind named on the command line (`chosen`) with its
 /// parameters.
-pub fn offered(chosen: Method, geometry: bool) -> Vec<Method> {
+pub fn offered(chosen: Method, geometry: bool, hybrid: Hybrid) -> Vec<Method> {
     let mut m = vec![Method::Quads, Method::Impostor];
     if geometry {
         let mesh = match chosen {
@@ -651,7 +652,7 @@ pub fn offered(chosen: Method, geometry: bool) -> Vec<Method> {
         }
         m.push(match chosen {
             Method::Hybrid(h) => Method::Hybrid(h),
-            _ => Method::Hybrid(Default::default()),
+            _ => Method::Hybrid(hybrid),
         });
     }
     m
@@ -664,11 +665,11 @@ mod tests {
     #[test]
     fn offered_methods_keep_their_order_with_the_named_parameters() {
         assert_eq!(
-            offered(Method::Quads, false),
+            offered(Method::Quads, false, Hybrid::default()),
             vec![Method::Quads, Method::Impostor]
         );
         let names = |m: &[Method]| m.iter().map(|x| x.name()).collect::<Vec<_>>();
-        let all = offered(Method::Quads, true);
+        let all = offered(Method::Quads, true, Hybrid::default());
         assert_eq!(
             names(&all),
             [
@@ -680,17 +681,33 @@ mod tests {
                 "hybrid"
             ]
         );
-        let unsorted = offered(Method::Mesh(MeshMethod::Full { depth_sort: false }), true);
+        let unsorted = offered(
+            Method::Mesh(MeshMethod::Full { depth_sort: false }),
+            true,
+            Hybrid::default(),
+        );
         assert_eq!(names(&unsorted)[4], "geometry-unsorted");
         assert_eq!(unsorted.len(), 6);
         let lods = MeshMethod::Lods(forest_baselines::geometry::Lods {
             distances: [1.0, 2.0, 3.0],
         });
-        assert_eq!(offered(Method::Mesh(lods), true)[2], Method::Mesh(lods));
+        assert_eq!(
+            offered(Method::Mesh(lods), true, Hybrid::default())[2],
+            Method::Mesh(lods)
+        );
         let near = Method::Hybrid(forest_baselines::hybrid::Hybrid {
             near: forest_baselines::hybrid::Near::Metres(7.0),
             ..Default::default()
         });
-        assert_eq!(offered(near, true)[5], near);
+        assert_eq!(offered(near, true, Hybrid::default())[5], near);
+        // Beside another method, the hybrid offered is the template (--sharpen's).
+        let sharp = Hybrid {
+            sharpen: 100,
+            ..Default::default()
+        };
+        assert_eq!(
+            offered(Method::Quads, true, sharp)[5],
+            Method::Hybrid(sharp)
+        );
     }
 }

@@ -420,6 +420,15 @@ pub fn prepare_forests(
                 let Some(caster) = state.casters.get_mut(&key) else {
                     continue;
                 };
+                // Cast with the aspect sharpening the view draws its quads with.
+                let sharpen = match wanted {
+                    forest_baselines::Method::Hybrid(h) => Some(h.sharpen),
+                    _ => None,
+                };
+                if let Err(e) = caster.stream.set_sharpen_override(sharpen) {
+                    record.error = Some(format!("shadow caster: {e}"));
+                    continue;
+                }
                 if let Some(s) = caster.stream.poll_stats(&ctx.device, &ctx.queue) {
                     if let Err(e) = caster.stream.fit(&ctx.device, &s) {
                         record.error = Some(format!("shadow caster: {e}"));
