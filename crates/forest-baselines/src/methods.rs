@@ -42,6 +42,15 @@ impl Method {
             Method::Hybrid(_) => "hybrid",
         }
     }
+
+    /// The aspect sharpening the method's quads draw with in place of the stream's own
+    /// ([`QuadStream::set_sharpen_override`]): the hybrid's; None for every other method.
+    pub fn quad_sharpen(&self) -> Option<u32> {
+        match self {
+            Method::Hybrid(h) => Some(h.sharpen),
+            _ => None,
+        }
+    }
 }
 
 /// Counters of the last frame of whichever method drew it.
@@ -259,10 +268,7 @@ impl ForestRenderer {
         }
         // The hybrid's quads draw with its own sharpening; every other method with the
         // stream's options. Set with the method, once nothing can fail (validated above).
-        self.stream.set_sharpen_override(match method {
-            Method::Hybrid(h) => Some(h.sharpen),
-            _ => None,
-        })?;
+        self.stream.set_sharpen_override(method.quad_sharpen())?;
         self.method = method;
         Ok(())
     }

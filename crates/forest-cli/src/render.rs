@@ -322,8 +322,13 @@ impl MethodArgs {
         }
     }
 
+    /// The hybrid's aspect sharpening: `--sharpen` when given, else the hybrid's default.
+    pub(crate) fn hybrid_sharpen(&self) -> u32 {
+        self.sharpen_or(forest_baselines::hybrid::HYBRID_SHARPEN_DEFAULT)
+    }
+
     /// `--sharpen` in units of 1/[`WEIGHT_ONE`], else `default`.
-    pub(crate) fn sharpen_or(&self, default: u32) -> u32 {
+    fn sharpen_or(&self, default: u32) -> u32 {
         self.sharpen
             .map_or(default, |s| (s * f64::from(WEIGHT_ONE)).round() as u32)
     }
@@ -369,7 +374,7 @@ impl MethodArgs {
                     near: self.near,
                     band: self.band,
                     near_form,
-                    sharpen: self.sharpen_or(forest_baselines::hybrid::HYBRID_SHARPEN_DEFAULT),
+                    sharpen: self.hybrid_sharpen(),
                     ..Default::default()
                 };
                 h.validate()?;

@@ -263,7 +263,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
     let chosen = m.chosen(mesh_method)?;
     // The hybrid offered beside another method takes --sharpen too, when given.
     let hybrid = forest_baselines::hybrid::Hybrid {
-        sharpen: m.sharpen_or(forest_baselines::hybrid::HYBRID_SHARPEN_DEFAULT),
+        sharpen: m.hybrid_sharpen(),
         ..Default::default()
     };
     let methods = crate::window::offered(chosen, prepared.is_some(), hybrid);

@@ -1,6 +1,6 @@
 //! The hybrid method: at a switch distance of 0 it is the quad stream (at the hybrid's aspect
-//! sharpening) and at infinity the full geometry, byte for byte; a tree in the transition band is drawn by both forms through
-//! complementary masks (every pixel from exactly one of them); the GPU's classification equals
+//! sharpening) and at infinity the full geometry, byte for byte; a tree in the transition
+//! band is drawn by both forms through complementary masks (every pixel from exactly one of them); the GPU's classification equals
 //! the CPU mirror; a frame writes only the camera; empty, single-tree and 1M-tree forests
 //! render without validation errors.
 

@@ -783,8 +783,8 @@ impl QuadStream {
     /// An aspect sharpening (units of 1/[`crate::gpu_types::WEIGHT_ONE`], at most
     /// [`crate::options::SHARPEN_MAX`]) that replaces [`StreamOptions::sharpen`] in the frames
     /// written from the next camera on, whatever [`Self::set_options`] sets; None: the
-    /// options' own. A method that draws only some trees as quads sets its own with its
-    /// forms (the hybrid's trees beyond its switch). Refused out of range.
+    /// options' own. A method that draws only some trees as quads sets its own when it is
+    /// chosen (the hybrid, for its trees beyond the switch). Refused out of range.
     pub fn set_sharpen_override(&mut self, sharpen: Option<u32>) -> Result<(), RenderError> {
         if let Some(s) = sharpen {
             StreamOptions {

@@ -421,11 +421,7 @@ pub fn prepare_forests(
                     continue;
                 };
                 // Cast with the aspect sharpening the view draws its quads with.
-                let sharpen = match wanted {
-                    forest_baselines::Method::Hybrid(h) => Some(h.sharpen),
-                    _ => None,
-                };
-                if let Err(e) = caster.stream.set_sharpen_override(sharpen) {
+                if let Err(e) = caster.stream.set_sharpen_override(wanted.quad_sharpen()) {
                     record.error = Some(format!("shadow caster: {e}"));
                     continue;
                 }
