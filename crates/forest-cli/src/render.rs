@@ -271,6 +271,12 @@ pub struct MethodArgs {
     /// hybrid's quads (the trees beyond its switch)
     #[arg(long, value_parser = parse_sharpen)]
     pub sharpen: Option<f64>,
+    /// Quad stream: trees narrower than this many far spans (see --far-span) are sharpened
+    /// more the narrower they are, up to 0.333 at the far span (1 to 15; 1: every tree
+    /// keeps --sharpen)
+    #[arg(long, default_value_t = forest_render::options::SHARPEN_REACH_DEFAULT,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(forest_render::options::SHARPEN_REACH_MAX)))]
+    pub sharpen_reach: u32,
     /// Quad stream: draw each slab of a far tree (see --far-span) as its own quad (by default
     /// its slabs are composited into one quad, sampled through their parallax).
     #[arg(long)]
@@ -319,6 +325,7 @@ impl MethodArgs {
             far_composite: !self.far_slabs,
             far_span: self.far_span,
             sharpen: self.sharpen_or(forest_render::options::SHARPEN_DEFAULT),
+            sharpen_reach: self.sharpen_reach,
         }
     }
 

@@ -7,7 +7,7 @@ struct Camera {
     eye: vec4<f32>,
     // xyz: unit view direction (world); w: the far span K, in units of ε: a tree narrower
     // than K·ε pixels whose nearest aspect's parallax stays within ε is a far tree
-    // (StreamOptions::far_span, far_tree in cull.wgsl).
+    // (StreamOptions::far_span, tree_class in cull.wgsl).
     forward: vec4<f32>,
     // x, y: viewport size in pixels; z: debug view of the draw pass (0 off, 1 levels,
     // 2 blend weights, 3 wireframe; see renderer::DebugView); w: stream flags (FLAG_*, see
@@ -307,6 +307,16 @@ const FLAG_FAR_SLABS: u32 = 32u;
 // Bits 8–19 of the flags: aspect sharpening in units of 1/WEIGHT_ONE (StreamOptions::sharpen).
 const SHARPEN_SHIFT: u32 = 8u;
 const SHARPEN_MASK: u32 = 4095u;
+// Largest sharpening (StreamOptions::sharpen); mirrors options::SHARPEN_MAX.
+const SHARPEN_MAX: u32 = 1364u;
+// Bits 20–23 of the flags: the sharpening reach R in units of the far span
+// (StreamOptions::sharpen_reach; 1: off), its steps and their width (1 / REACH_STEPS).
+const REACH_SHIFT: u32 = 20u;
+const REACH_MASK: u32 = 15u;
+const REACH_STEPS: u32 = 16u;
+const REACH_STEP: f32 = 0.0625;
+// tree_class of a far tree (cull.wgsl).
+const FAR_CLASS: u32 = 255u;
 // A far tree's slabs drawn as one quad: level 0 at column 1, which level 0 lacks (mirrors
 // Quad::COMPOSITE_POS); its node is the root of the front-most slab present.
 const COMPOSITE_POS: u32 = 16u;

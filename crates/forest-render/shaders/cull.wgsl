@@ -103,16 +103,19 @@ fn visible(inst: Instance, sp: Species) -> bool {
 
 const SQRT3: f32 = 1.7320508;
 
-// Whether a tree of bounding radius `r` (world) centred at `c` is far: seen at the depth of its
-// nearest level-0 corner, it spans S pixels across with S < far span × ε (forward.w × eye.w)
-// and S · sin θ < ε, θ the angle between the view (object space, `v`, unnormalised) and the
-// nearest aspect's direction `nd` (unit): the parallax its one aspect makes is then within ε.
-// Trees narrower than ε are always far. A far tree's level-0 quads are never refined, and it
-// is drawn with its nearest aspect alone (its slabs composited into one quad, unless
-// FLAG_FAR_SLABS), unless FLAG_FAR_BLEND. Mirrored by `far_tree` in reference.rs, operation
-// for operation; no division, so that both round alike.
-fn far_tree(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> bool {
-    if ((stream_flags(camera) & FLAG_FAR_BLEND) != 0u) { return false; }
+// How near a tree of bounding radius `r` (world) centred at `c` is, as a class: seen at the
+// depth of its nearest level-0 corner it spans S pixels across. FAR_CLASS: a far tree, with
+// S < far span × ε (forward.w × eye.w) and S · sin θ < ε, θ the angle between the view
+// (object space, `v`, unnormalised) and the nearest aspect's direction `nd` (unit): the
+// parallax its one aspect makes is then within ε. Trees narrower than ε are always far. A far
+// tree's level-0 quads are never refined, and it is drawn with its nearest aspect alone (its
+// slabs composited into one quad, unless FLAG_FAR_SLABS). Otherwise the number of the
+// sharpening reach's REACH_STEPS widths span · (1 + (R − 1) · i / REACH_STEPS), i = 1 …
+// REACH_STEPS, that S is under (R the flags' reach; 0 when R is 1): see tree_sharpen. With
+// FLAG_FAR_BLEND always 0. Mirrored by `tree_class` in reference.rs, operation for
+// operation; no division, so that both round alike.
+fn tree_class(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> u32 {
+    if ((stream_flags(camera) & FLAG_FAR_BLEND) != 0u) { return 0u; }
     let m = camera.view_proj;
     // The nearest a level-0 quad's corner can be: the slab squares' corners lie within
     // √3 r of the centre. An orthographic view (a light's: no row of w depends on the point)
@@ -121,18 +124,37 @@ fn far_tree(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> bool {
     if (m[0].w != 0.0 || m[1].w != 0.0 || m[2].w != 0.0) {
         w = m[0].w * c.x + m[1].w * c.y + m[2].w * c.z + m[3].w - SQRT3 * r;
     }
-    if (w <= 0.0) { return false; }
+    if (w <= 0.0) { return 0u; }
     let fy = m[0].y * m[0].y + m[1].y * m[1].y + m[2].y * m[2].y;
     let half = camera.viewport.y * 0.5;
     let d = 2.0 * r * half;
     let e = camera.eye.w * w;
     let span = camera.forward.w * e;
     let s2 = d * d * fy;
-    if (s2 >= span * span) { return false; }
+    let reach = f32((stream_flags(camera) >> REACH_SHIFT) & REACH_MASK);
+    var steps = 0u;
+    if (reach > 1.0) {
+        for (var i = 1u; i <= REACH_STEPS; i++) {
+            let k = span * (1.0 + (reach - 1.0) * (f32(i) * REACH_STEP));
+            if (s2 < k * k) { steps = steps + 1u; }
+        }
+    }
+    if (s2 >= span * span) { return steps; }
     // sin²θ |v|² = |v|² − (nd · v)²
     let vv = v.x * v.x + v.y * v.y + v.z * v.z;
     let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
-    return s2 * (vv - cv * cv) < e * e * vv;
+    if (s2 * (vv - cv * cv) < e * e * vv) { return FAR_CLASS; }
+    return steps;
+}
+
+// The aspect sharpening of a tree of class `class` (tree_class, not FAR_CLASS), in units of
+// 1/WEIGHT_ONE: the flags' sharpening, raised towards SHARPEN_MAX by one REACH_STEPS-th of
+// the way per step, so that a tree's faint aspects fade out as it narrows towards the far
+// span, where it is drawn with its nearest aspect alone. Mirrors reference::tree_sharpen.
+fn tree_sharpen(near_class: u32) -> u32 {
+    let t = (stream_flags(camera) >> SHARPEN_SHIFT) & SHARPEN_MASK;
+    if (t >= SHARPEN_MAX) { return t; }
+    return t + (SHARPEN_MAX - t) * min(near_class, REACH_STEPS) / REACH_STEPS;
 }
 
 // A blend's weights rounded to units of 1/WEIGHT_ONE. Quantising first puts every later
@@ -142,10 +164,10 @@ fn quantise(w: vec3<f32>) -> vec3<u32> {
     return vec3<u32>(unorm12(w.x), unorm12(w.y), unorm12(w.z));
 }
 
-// Blend weights from quantised ones `q`, summing to exactly WEIGHT_ONE: sharpened
-// (StreamOptions::sharpen), the remainder given to the largest (first on ties); with
-// FLAG_NEAREST or `nearest` the largest alone.
-fn aspect_weights(quantised: vec3<u32>, nearest: bool) -> vec3<u32> {
+// Blend weights from quantised ones `q`, summing to exactly WEIGHT_ONE: sharpened by `t`
+// (tree_sharpen), the remainder given to the largest (first on ties); with FLAG_NEAREST or
+// `nearest` the largest alone.
+fn aspect_weights(quantised: vec3<u32>, nearest: bool, t: u32) -> vec3<u32> {
     var q = quantised;
     let big = largest(q);
     if (nearest || (stream_flags(camera) & FLAG_NEAREST) != 0u) {
@@ -155,7 +177,6 @@ fn aspect_weights(quantised: vec3<u32>, nearest: bool) -> vec3<u32> {
     }
     // Sharpening: each weight less t, the rest scaled back up (integers, as the CPU mirror;
     // the largest keeps at least one since t < WEIGHT_ONE / 3).
-    let t = (stream_flags(camera) >> SHARPEN_SHIFT) & SHARPEN_MASK;
     if (t > 0u) {
         let s = vec3<u32>(max(q.x, t) - t, max(q.y, t) - t, max(q.z, t) - t);
         q = (s * WEIGHT_ONE) / (s.x + s.y + s.z);
@@ -195,8 +216,9 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, front: u32, last: b
     let bl = blend(sp, eye_obj);
     let q = quantise(bl.w);
     let nearest_dir = frames[sp.dir_base + bl.idx[largest(q)]].dir.xyz;
-    let far = far_tree(centre, sp.sphere.w * inst.scale, eye_obj, nearest_dir);
-    let w12 = aspect_weights(q, far);
+    let near_class = tree_class(centre, sp.sphere.w * inst.scale, eye_obj, nearest_dir);
+    let far = near_class == FAR_CLASS;
+    let w12 = aspect_weights(q, far, tree_sharpen(near_class));
     if (far && sp.slabs > 1u && (stream_flags(camera) & FLAG_FAR_SLABS) == 0u) {
         // One quad for all the slabs of the nearest aspect, on the front-most slab's root.
         var a = 0u;

@@ -222,6 +222,15 @@ pub struct StreamOptions {
     /// sharpening" in docs/rendering.md. 0 is the paper's barycentric blend. The hybrid
     /// draws its quads with its own (`QuadStream::set_sharpen_override`).
     pub sharpen: u32,
+    /// How far beyond the far span the sharpening grows, in units of the far span (1 to
+    /// [`SHARPEN_REACH_MAX`]; 1: not at all): a tree narrower than `sharpen_reach` × far
+    /// span × ε pixels is sharpened more the narrower it is, in [`REACH_STEPS`] steps from
+    /// [`Self::sharpen`] up to [`SHARPEN_MAX`] just outside the far span, where it becomes
+    /// far and keeps its nearest aspect alone. So a tree's faint aspects fade out as it
+    /// recedes instead of all at once at the far span, and the small trees, which make most
+    /// of a forest's layers, shade fewer. Default [`SHARPEN_REACH_DEFAULT`], chosen by the
+    /// measurements under "The sharpening reach" in docs/rendering.md.
+    pub sharpen_reach: u32,
 }
 
 impl Default for StreamOptions {
@@ -234,6 +243,7 @@ impl Default for StreamOptions {
             far_composite: true,
             far_span: FAR_SPAN_DEFAULT,
             sharpen: SHARPEN_DEFAULT,
+            sharpen_reach: SHARPEN_REACH_DEFAULT,
         }
     }
 }
@@ -247,6 +257,20 @@ pub const SHARPEN_MAX: u32 = 1364;
 pub const SHARPEN_SHIFT: u32 = 8;
 /// Mask of [`StreamOptions::sharpen`]'s 12 bits once shifted down by [`SHARPEN_SHIFT`].
 pub const SHARPEN_MASK: u32 = 0xfff;
+
+/// Default [`StreamOptions::sharpen_reach`].
+pub const SHARPEN_REACH_DEFAULT: u32 = 4;
+/// Largest [`StreamOptions::sharpen_reach`] (its 4 bits in the flags).
+pub const SHARPEN_REACH_MAX: u32 = 15;
+/// First bit of [`StreamOptions::sharpen_reach`] in the flags of `viewport.w` (bits 20–23:
+/// the flags stay below 2²⁴, exact in the f32 that carries them).
+pub const REACH_SHIFT: u32 = 20;
+/// Mask of [`StreamOptions::sharpen_reach`]'s 4 bits once shifted down by [`REACH_SHIFT`].
+pub const REACH_MASK: u32 = 0xf;
+/// Steps of the sharpening reach: the widths span · (1 + (R − 1) · i / `REACH_STEPS`).
+pub const REACH_STEPS: u32 = 16;
+/// 1 / [`REACH_STEPS`], exact in binary (the GPU and the CPU reference multiply by it).
+pub const REACH_STEP: f32 = 0.0625;
 
 /// Default [`StreamOptions::far_span`].
 pub const FAR_SPAN_DEFAULT: u32 = 4;
@@ -284,6 +308,13 @@ impl StreamOptions {
                 self.sharpen
             )));
         }
+        if !(1..=SHARPEN_REACH_MAX).contains(&self.sharpen_reach) {
+            return Err(crate::RenderError::Parameter(format!(
+                "sharpening reach {}: expected 1 to {SHARPEN_REACH_MAX} (a multiple of the \
+                 far span; 1: the sharpening does not grow)",
+                self.sharpen_reach
+            )));
+        }
         if !(1..=FAR_SPAN_MAX).contains(&self.far_span) {
             return Err(crate::RenderError::Parameter(format!(
                 "far span {}: expected 1 to {FAR_SPAN_MAX} (a multiple of ε)",
@@ -314,6 +345,7 @@ impl StreamOptions {
                 FLAG_FAR_SLABS
             }
             | self.sharpen.min(SHARPEN_MAX) << SHARPEN_SHIFT
+            | self.sharpen_reach.clamp(1, SHARPEN_REACH_MAX) << REACH_SHIFT
     }
 }
 
@@ -621,15 +653,15 @@ mod tests {
         use crate::reference::quantise;
         let w = [0.7, 0.25, 0.05];
         assert_eq!(
-            crate::reference::aspect_weights(quantise(w), flags(0)),
+            crate::reference::aspect_weights(quantise(w), flags(0), 0),
             [2866, 1024, 205]
         );
         assert_eq!(
-            crate::reference::aspect_weights(quantise(w), flags(410)),
+            crate::reference::aspect_weights(quantise(w), flags(410), 410),
             [3277, 818, 0]
         );
         assert_eq!((flags(410) >> SHARPEN_SHIFT) & SHARPEN_MASK, 410);
-        assert_eq!(flags(0) >> SHARPEN_SHIFT, 0);
+        assert_eq!((flags(0) >> SHARPEN_SHIFT) & SHARPEN_MASK, 0);
         let e = StreamOptions {
             sharpen: SHARPEN_MAX + 1,
             ..Default::default()
@@ -639,9 +671,65 @@ mod tests {
         .to_string();
         assert!(e.contains("sharpening"), "{e}");
         // The largest share a third of one can leave: the largest weight keeps the whole.
-        let q = crate::reference::aspect_weights(quantise([0.34, 0.33, 0.33]), flags(SHARPEN_MAX));
+        let q = crate::reference::aspect_weights(
+            quantise([0.34, 0.33, 0.33]),
+            flags(SHARPEN_MAX),
+            SHARPEN_MAX,
+        );
         assert_eq!(q.iter().sum::<u32>(), WEIGHT_ONE);
         assert_eq!(q[0], WEIGHT_ONE);
+    }
+
+    /// The reach rides in flag bits 20–23 beside the sharpening, and a reach out of
+    /// 1..=SHARPEN_REACH_MAX is refused naming it. A tree's sharpening climbs from the flags'
+    /// own (class 0: wider than the reach) to the largest (class REACH_STEPS: just outside
+    /// the far span) in equal integer steps: 410 + 954 · k / 16.
+    #[test]
+    fn the_sharpening_reach_climbs_to_the_largest_in_steps() {
+        use crate::reference::tree_sharpen;
+        let o = StreamOptions::default();
+        let f = o.flags();
+        assert_eq!((f >> REACH_SHIFT) & REACH_MASK, SHARPEN_REACH_DEFAULT);
+        assert_eq!((f >> SHARPEN_SHIFT) & SHARPEN_MASK, SHARPEN_DEFAULT);
+        assert!(f < 1 << 24, "the flags ride in an f32");
+        assert_eq!(f as f32 as u32, f);
+        let steps: Vec<u32> = (0..=REACH_STEPS).map(|k| tree_sharpen(f, k)).collect();
+        assert_eq!(
+            steps,
+            [
+                410, 469, 529, 588, 648, 708, 767, 827, 887, 946, 1006, 1065, 1125, 1185, 1244,
+                1304, 1364
+            ]
+        );
+        // Past the last step (and for the far class) it stays at the largest.
+        assert_eq!(tree_sharpen(f, crate::reference::FAR_CLASS), SHARPEN_MAX);
+        // A sharpening already at the largest stays there.
+        let max = StreamOptions {
+            sharpen: SHARPEN_MAX,
+            ..o
+        };
+        assert_eq!(tree_sharpen(max.flags(), 0), SHARPEN_MAX);
+        for bad in [0, SHARPEN_REACH_MAX + 1] {
+            let e = StreamOptions {
+                sharpen_reach: bad,
+                ..o
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("reach") && e.contains(&bad.to_string()), "{e}");
+        }
+        let widest = StreamOptions {
+            sharpen_reach: SHARPEN_REACH_MAX,
+            sharpen: SHARPEN_MAX,
+            ..o
+        };
+        widest.validate().unwrap();
+        assert_eq!(
+            (widest.flags() >> REACH_SHIFT) & REACH_MASK,
+            SHARPEN_REACH_MAX
+        );
+        assert!(widest.flags() < 1 << 24);
     }
 
     /// A far span out of 1..=FAR_SPAN_MAX is refused with a message naming it; the options

@@ -9,7 +9,8 @@ use forest_format::node::ERROR_BOUNDS;
 
 use crate::gpu_types::{GpuCamera, GpuInstance, GpuSpecies, Quad, WEIGHT_ONE, kept_composites};
 use crate::options::{
-    FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST, SHARPEN_MASK, SHARPEN_SHIFT,
+    FLAG_DEPTH_ERROR, FLAG_FAR_BLEND, FLAG_FAR_SLABS, FLAG_NEAREST, REACH_MASK, REACH_SHIFT,
+    REACH_STEP, REACH_STEPS, SHARPEN_MASK, SHARPEN_MAX, SHARPEN_SHIFT,
 };
 use crate::scene::SceneTables;
 
@@ -72,11 +73,11 @@ pub fn quantise(weight: [f32; 3]) -> [u32; 3] {
     weight.map(unorm12)
 }
 
-/// Blend weights from [`quantise`]d ones, summing to exactly [`WEIGHT_ONE`]: sharpened by the
-/// flags' [`SHARPEN_SHIFT`] bits (each less that share, the rest scaled back to one), the
-/// remainder given to the largest (first on ties); with [`FLAG_NEAREST`] the largest alone
-/// (see `aspect_weights` in `shaders/cull.wgsl`).
-pub fn aspect_weights(quantised: [u32; 3], flags: u32) -> [u32; 3] {
+/// Blend weights from [`quantise`]d ones, summing to exactly [`WEIGHT_ONE`]: sharpened by `t`
+/// (each less that share, the rest scaled back to one; [`tree_sharpen`]), the remainder given
+/// to the largest (first on ties); with [`FLAG_NEAREST`] in `flags` the largest alone (see
+/// `aspect_weights` in `shaders/cull.wgsl`).
+pub fn aspect_weights(quantised: [u32; 3], flags: u32, t: u32) -> [u32; 3] {
     let mut w = quantised;
     let big = largest(w);
     if flags & FLAG_NEAREST != 0 {
@@ -84,7 +85,6 @@ pub fn aspect_weights(quantised: [u32; 3], flags: u32) -> [u32; 3] {
         one[big] = WEIGHT_ONE;
         return one;
     }
-    let t = (flags >> SHARPEN_SHIFT) & SHARPEN_MASK;
     if t > 0 {
         let s = w.map(|x| x.max(t) - t);
         let sum = s[0] + s[1] + s[2];
@@ -110,13 +110,17 @@ fn largest(w: [u32; 3]) -> usize {
 /// √3 in f32, as `SQRT3` in `shaders/cull.wgsl`.
 const SQRT3: f32 = 1.732_050_8;
 
-/// Whether a tree is far: narrower than its far span (`forward.w` × ε) pixels, seen at the
-/// depth of its nearest level-0 corner, and its nearest aspect's parallax within ε (see
-/// `far_tree` in `shaders/cull.wgsl`; `v` the object-space view, `nd` that aspect's unit
-/// direction).
-fn far_tree(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> bool {
+/// [`tree_class`] of a far tree (`FAR_CLASS` in `shaders/common.wgsl`).
+pub const FAR_CLASS: u32 = 255;
+
+/// How near a tree is: [`FAR_CLASS`] when far (narrower than its far span, `forward.w` × ε,
+/// pixels, seen at the depth of its nearest level-0 corner, and its nearest aspect's parallax
+/// within ε), else how many of the sharpening reach's [`REACH_STEPS`] widths it is narrower
+/// than (see `tree_class` in `shaders/cull.wgsl`; `v` the object-space view, `nd` that
+/// aspect's unit direction).
+fn tree_class(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> u32 {
     if flags(cam) & FLAG_FAR_BLEND != 0 {
-        return false;
+        return 0;
     }
     let m = &cam.view_proj;
     let w = if m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 {
@@ -125,7 +129,7 @@ fn far_tree(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> bool {
         m[3][3]
     };
     if w <= 0.0 {
-        return false;
+        return 0;
     }
     let fy = m[0][1] * m[0][1] + m[1][1] * m[1][1] + m[2][1] * m[2][1];
     let half = cam.viewport[1] * 0.5;
@@ -133,12 +137,37 @@ fn far_tree(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> bool {
     let e = cam.eye[3] * w;
     let span = cam.forward[3] * e;
     let s2 = d * d * fy;
+    let reach = ((flags(cam) >> REACH_SHIFT) & REACH_MASK) as f32;
+    let mut steps = 0;
+    if reach > 1.0 {
+        for i in 1..=REACH_STEPS {
+            let k = span * (1.0 + (reach - 1.0) * (i as f32 * REACH_STEP));
+            if s2 < k * k {
+                steps += 1;
+            }
+        }
+    }
     if s2 >= span * span {
-        return false;
+        return steps;
     }
     let vv = v.x * v.x + v.y * v.y + v.z * v.z;
     let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
-    s2 * (vv - cv * cv) < e * e * vv
+    if s2 * (vv - cv * cv) < e * e * vv {
+        FAR_CLASS
+    } else {
+        steps
+    }
+}
+
+/// The aspect sharpening of a tree of class `class` ([`tree_class`], not [`FAR_CLASS`]), in
+/// units of 1/[`WEIGHT_ONE`]: the flags' own, raised towards [`SHARPEN_MAX`] by one
+/// [`REACH_STEPS`]-th of the way per step (see `tree_sharpen` in `shaders/cull.wgsl`).
+pub fn tree_sharpen(flags: u32, class: u32) -> u32 {
+    let t = (flags >> SHARPEN_SHIFT) & SHARPEN_MASK;
+    if t >= SHARPEN_MAX {
+        return t;
+    }
+    t + (SHARPEN_MAX - t) * class.min(REACH_STEPS) / REACH_STEPS
 }
 
 fn xyz(v: [f32; 4]) -> Vec3 {
@@ -186,8 +215,13 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     let bl = blend(&dirs, &upper, &lower, eye_obj);
     let q = quantise(bl.weight);
     let nearest = dirs[bl.index[largest(q)] as usize];
-    let far = far_tree(cam, centre, sp.sphere[3] * inst.scale, eye_obj, nearest);
-    let w12 = aspect_weights(q, flags(cam) | if far { FLAG_NEAREST } else { 0 });
+    let class = tree_class(cam, centre, sp.sphere[3] * inst.scale, eye_obj, nearest);
+    let far = class == FAR_CLASS;
+    let w12 = aspect_weights(
+        q,
+        flags(cam) | if far { FLAG_NEAREST } else { 0 },
+        tree_sharpen(flags(cam), class),
+    );
     if far && sp.slabs > 1 && flags(cam) & FLAG_FAR_SLABS == 0 {
         // One quad for all the slabs of the nearest aspect, on the front-most slab's root.
         let a = (0..3).rev().find(|&a| w12[a] > 0).unwrap_or(0);

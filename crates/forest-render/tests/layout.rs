@@ -169,7 +169,7 @@ fn constants_shared_with_the_wgsl_agree() {
     use forest_render::options::{self, DebugView, FLAG_DEPTH_ERROR, FLAG_DITHER, FLAG_NEAREST};
     let c = compute_source();
     let d = draw_source();
-    let pairs: [(&str, &str, f64); 13] = [
+    let pairs: [(&str, &str, f64); 19] = [
         (&c, "WG", f64::from(forest_render::capacity::WG)),
         (&c, "BLOCK", f64::from(forest_render::capacity::BLOCK)),
         (&c, "WEIGHT_ONE", f64::from(WEIGHT_ONE)),
@@ -180,6 +180,16 @@ fn constants_shared_with_the_wgsl_agree() {
         (&c, "FLAG_FAR_SLABS", f64::from(options::FLAG_FAR_SLABS)),
         (&c, "SHARPEN_SHIFT", f64::from(options::SHARPEN_SHIFT)),
         (&c, "SHARPEN_MASK", f64::from(options::SHARPEN_MASK)),
+        (&c, "SHARPEN_MAX", f64::from(options::SHARPEN_MAX)),
+        (&c, "REACH_SHIFT", f64::from(options::REACH_SHIFT)),
+        (&c, "REACH_MASK", f64::from(options::REACH_MASK)),
+        (&c, "REACH_STEPS", f64::from(options::REACH_STEPS)),
+        (&c, "REACH_STEP", f64::from(options::REACH_STEP)),
+        (
+            &c,
+            "FAR_CLASS",
+            f64::from(forest_render::reference::FAR_CLASS),
+        ),
         (&c, "NONE", f64::from(u32::MAX)),
         (
             &c,

@@ -89,6 +89,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             far_composite: false,
             far_span: 1,
             sharpen: 0,
+            sharpen_reach: 1,
         },
         epsilon: EPS,
         geometry: false,
