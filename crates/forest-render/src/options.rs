@@ -259,7 +259,7 @@ pub const SHARPEN_SHIFT: u32 = 8;
 pub const SHARPEN_MASK: u32 = 0xfff;
 
 /// Default [`StreamOptions::sharpen_reach`].
-pub const SHARPEN_REACH_DEFAULT: u32 = 4;
+pub const SHARPEN_REACH_DEFAULT: u32 = 8;
 /// Largest [`StreamOptions::sharpen_reach`] (its 4 bits in the flags).
 pub const SHARPEN_REACH_MAX: u32 = 15;
 /// First bit of [`StreamOptions::sharpen_reach`] in the flags of `viewport.w` (bits 20–23:
