@@ -110,7 +110,7 @@ fn largest(w: [u32; 3]) -> usize {
 /// √3 in f32, as `SQRT3` in `shaders/cull.wgsl`.
 const SQRT3: f32 = 1.732_050_8;
 
-/// [`tree_class`] of a far tree (`FAR_CLASS` in `shaders/common.wgsl`).
+/// The class `tree_class` gives a far tree (`FAR_CLASS` in `shaders/common.wgsl`).
 pub const FAR_CLASS: u32 = 255;
 
 /// How near a tree is: [`FAR_CLASS`] when far (narrower than its far span, `forward.w` × ε,
@@ -159,7 +159,7 @@ fn tree_class(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> u32 {
     }
 }
 
-/// The aspect sharpening of a tree of class `class` ([`tree_class`], not [`FAR_CLASS`]), in
+/// The aspect sharpening of a tree of class `class` (`tree_class`, not [`FAR_CLASS`]), in
 /// units of 1/[`WEIGHT_ONE`]: the flags' own, raised towards [`SHARPEN_MAX`] by one
 /// [`REACH_STEPS`]-th of the way per step (see `tree_sharpen` in `shaders/cull.wgsl`).
 pub fn tree_sharpen(flags: u32, class: u32) -> u32 {
