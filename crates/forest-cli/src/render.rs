@@ -273,7 +273,7 @@ pub struct MethodArgs {
     pub sharpen: Option<f64>,
     /// Quad stream: trees narrower than this many far spans (see --far-span) are sharpened
     /// more the narrower they are, up to 0.333 at the far span (1 to 15; 1: every tree
-    /// keeps --sharpen)
+    /// keeps --sharpen; off with --far-blend)
     #[arg(long, default_value_t = forest_render::options::SHARPEN_REACH_DEFAULT,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(forest_render::options::SHARPEN_REACH_MAX)))]
     pub sharpen_reach: u32,

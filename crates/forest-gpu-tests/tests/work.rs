@@ -581,9 +581,13 @@ fn trees_narrower_than_epsilon_draw_their_nearest_aspect_alone() {
         [
             StreamOptions {
                 far_nearest: false,
+                sharpen_reach: 1,
                 ..Default::default()
             },
-            StreamOptions::default(),
+            StreamOptions {
+                sharpen_reach: 1,
+                ..Default::default()
+            },
         ],
         true,
     );
@@ -758,8 +762,10 @@ fn a_wider_far_span_shades_fewer_fragments_at_the_same_accuracy() {
 fn sharpened_aspects_shade_fewer_fragments_at_the_same_accuracy() {
     use forest_render::options::{SHARPEN_DEFAULT, SHARPEN_MAX, StreamOptions};
 
+    // The reach off, so that sharpening 0 is the unsharpened blend.
     let with = |sharpen| StreamOptions {
         sharpen,
+        sharpen_reach: 1,
         ..Default::default()
     };
     fewer_quads_sweep(

@@ -147,7 +147,7 @@ fn tree_class(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> u32 {
     return steps;
 }
 
-// The aspect sharpening of a tree of class `class` (tree_class, not FAR_CLASS), in units of
+// The aspect sharpening of a tree of class `near_class` (tree_class, not FAR_CLASS), in units of
 // 1/WEIGHT_ONE: the flags' sharpening, raised towards SHARPEN_MAX by one REACH_STEPS-th of
 // the way per step, so that a tree's faint aspects fade out as it narrows towards the far
 // span, where it is drawn with its nearest aspect alone. Mirrors reference::tree_sharpen.

@@ -229,7 +229,8 @@ pub struct StreamOptions {
     /// far and keeps its nearest aspect alone. So a tree's faint aspects fade out as it
     /// recedes instead of all at once at the far span, and the small trees, which make most
     /// of a forest's layers, shade fewer. Default [`SHARPEN_REACH_DEFAULT`], chosen by the
-    /// measurements under "The sharpening reach" in docs/rendering.md.
+    /// measurements under "The sharpening reach" in docs/rendering.md. Off with
+    /// [`Self::far_nearest`] off (the paper's blend of every tree).
     pub sharpen_reach: u32,
 }
 
