@@ -270,8 +270,9 @@ pub const REACH_SHIFT: u32 = 20;
 pub const REACH_MASK: u32 = 0xf;
 /// Steps of the sharpening reach: the widths span · (1 + (R − 1) · i / `REACH_STEPS`).
 pub const REACH_STEPS: u32 = 16;
-/// 1 / [`REACH_STEPS`], exact in binary (the GPU and the CPU reference multiply by it).
-pub const REACH_STEP: f32 = 0.0625;
+/// 1 / [`REACH_STEPS`], exact in binary (the GPU and the CPU reference multiply by it;
+/// derived here, mirrored as a literal in `shaders/common.wgsl`).
+pub const REACH_STEP: f32 = 1.0 / REACH_STEPS as f32;
 
 /// Default [`StreamOptions::far_span`].
 pub const FAR_SPAN_DEFAULT: u32 = 4;
