@@ -132,18 +132,24 @@ fn tree_class(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> u32 {
     let span = camera.forward.w * e;
     let s2 = d * d * fy;
     let reach = f32((stream_flags(camera) >> REACH_SHIFT) & REACH_MASK);
+    if (s2 < span * span) {
+        // Narrower than the far span: far if its nearest aspect's parallax stays within ε
+        // (sin²θ |v|² = |v|² − (nd · v)²); else narrower than every step's width.
+        let vv = v.x * v.x + v.y * v.y + v.z * v.z;
+        let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
+        if (s2 * (vv - cv * cv) < e * e * vv) { return FAR_CLASS; }
+        return select(0u, REACH_STEPS, reach > 1.0);
+    }
+    // The step widths grow with i, so the tree is narrower than steps i0..REACH_STEPS: count
+    // them from the widest down, stopping at the first it is not narrower than.
     var steps = 0u;
     if (reach > 1.0) {
-        for (var i = 1u; i <= REACH_STEPS; i++) {
+        for (var i = REACH_STEPS; i >= 1u; i--) {
             let k = span * (1.0 + (reach - 1.0) * (f32(i) * REACH_STEP));
-            if (s2 < k * k) { steps = steps + 1u; }
+            if (!(s2 < k * k)) { break; }
+            steps = steps + 1u;
         }
     }
-    if (s2 >= span * span) { return steps; }
-    // sin²θ |v|² = |v|² − (nd · v)²
-    let vv = v.x * v.x + v.y * v.y + v.z * v.z;
-    let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
-    if (s2 * (vv - cv * cv) < e * e * vv) { return FAR_CLASS; }
     return steps;
 }
 

@@ -118,6 +118,7 @@ pub const FAR_CLASS: u32 = 255;
 /// within ε), else how many of the sharpening reach's [`REACH_STEPS`] widths it is narrower
 /// than (see `tree_class` in `shaders/cull.wgsl`; `v` the object-space view, `nd` that
 /// aspect's unit direction).
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn tree_class(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> u32 {
     if flags(cam) & FLAG_FAR_BLEND != 0 {
         return 0;
@@ -138,25 +139,28 @@ fn tree_class(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> u32 {
     let span = cam.forward[3] * e;
     let s2 = d * d * fy;
     let reach = ((flags(cam) >> REACH_SHIFT) & REACH_MASK) as f32;
+    if s2 < span * span {
+        let vv = v.x * v.x + v.y * v.y + v.z * v.z;
+        let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
+        if s2 * (vv - cv * cv) < e * e * vv {
+            return FAR_CLASS;
+        }
+        return if reach > 1.0 { REACH_STEPS } else { 0 };
+    }
+    // The step widths grow with i: count from the widest down to the first the tree is not
+    // narrower than.
     let mut steps = 0;
     if reach > 1.0 {
-        for i in 1..=REACH_STEPS {
+        for i in (1..=REACH_STEPS).rev() {
             let k = span * (1.0 + (reach - 1.0) * (i as f32 * REACH_STEP));
-            if s2 < k * k {
-                steps += 1;
+            // Negated as in the WGSL, so that a NaN counts as not narrower on both sides.
+            if !(s2 < k * k) {
+                break;
             }
+            steps += 1;
         }
     }
-    if s2 >= span * span {
-        return steps;
-    }
-    let vv = v.x * v.x + v.y * v.y + v.z * v.z;
-    let cv = nd.x * v.x + nd.y * v.y + nd.z * v.z;
-    if s2 * (vv - cv * cv) < e * e * vv {
-        FAR_CLASS
-    } else {
-        steps
-    }
+    steps
 }
 
 /// The aspect sharpening of a tree of class `class` (`tree_class`, not [`FAR_CLASS`]), in
