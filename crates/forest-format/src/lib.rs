@@ -12,6 +12,7 @@
 //!   height field the trees stand on;
 //! - [`camera_path`]: recorded camera paths for the viewer;
 //! - [`model`]: a species' prepared model for the geometry-based methods and the hybrid.
+//! - [`cutout`]: convex polygons in texture space that trim alpha-tested cards.
 //!
 //! A forest made and checked without a GPU or any file (the species are atlas names; `forest
 //! scene` writes the same with `Forest::save`), lit at eight in the morning:
@@ -43,6 +44,7 @@ pub mod atlas;
 pub mod atomic;
 pub mod bounded;
 pub mod camera_path;
+pub mod cutout;
 pub mod directions;
 pub mod error;
 pub mod forest;

@@ -289,7 +289,7 @@ fn trimmed_quads_draw_the_same_image_with_fewer_fragments() {
         assert_eq!(quads, whole_quads, "{name}: trimming changes no quad");
         let m = forest_metrics::compare(&whole, &trimmed).unwrap();
         if m.flip_mean > 0.01 {
-            let out = failure_images(&format!("trim-{name}"), &whole, &trimmed);
+            let out = common::failure_images(&format!("trim-{name}"), &whole, &trimmed);
             panic!(
                 "{name}: trimmed against untrimmed FLIP {} (images in {})",
                 m.flip_mean,
@@ -364,25 +364,6 @@ fn every_covered_texel_lies_in_its_nodes_box() {
         eprintln!("{nodes} nodes, {texels} covered texel visits, mean box area {area:.3}");
         assert!(area < 0.9, "mean box area {area}");
     }
-}
-
-/// Writes `NAME-expected.png`, `NAME-actual.png` and the FLIP map `NAME-difference.png` to
-/// target/test-output; returns the folder.
-fn failure_images(
-    name: &str,
-    expected: &image::RgbaImage,
-    actual: &image::RgbaImage,
-) -> std::path::PathBuf {
-    let out = common::root().join("target/test-output");
-    std::fs::create_dir_all(&out).unwrap();
-    expected
-        .save(out.join(format!("{name}-expected.png")))
-        .unwrap();
-    actual.save(out.join(format!("{name}-actual.png"))).unwrap();
-    let (_, map) = forest_metrics::flip(expected, actual).unwrap();
-    map.save(out.join(format!("{name}-difference.png")))
-        .unwrap();
-    out
 }
 
 /// A frame of `stream` with `options`: its counters, its final quads (checked equal to the
@@ -555,7 +536,7 @@ fn far_trees_composite_their_slabs_into_one_quad() {
     // trees whose level-0 corners project just past ε and are refined when drawn per slab);
     // slab samples repeating the image's edge texels gave 0.043 with visible streaks.
     if m.flip_mean > 0.03 {
-        let out = failure_images("composite", &slab_img, &comp_img);
+        let out = common::failure_images("composite", &slab_img, &comp_img);
         panic!(
             "FLIP {} against one quad per slab (images in {})",
             m.flip_mean,
@@ -703,7 +684,8 @@ fn sweep(
                 .flip_mean
         );
         if def > base + 0.01 {
-            let dir = failure_images(&format!("{label}-{name}"), &images[0].0, &images[1].0);
+            let dir =
+                common::failure_images(&format!("{label}-{name}"), &images[0].0, &images[1].0);
             panic!(
                 "{label} {name}: FLIP against the reference {def} at the default, {base} without \
                  (images in {})",

@@ -13,6 +13,7 @@
 //! rebuilding anything. Every tree is shaded with `forest_format::shading` in its object
 //! space, as the bake shades the atlases.
 
+mod cards;
 mod layout;
 mod light;
 mod models;
@@ -25,7 +26,7 @@ pub use forest_format::model::BILLBOARD_RESOLUTION;
 pub use layout::{COMPUTE_SLOTS, compute_entries, draw_entries};
 pub use models::GpuModels;
 pub use params::{GeometrySpecies, GeometryStats, Lods, MeshMethod, SpeciesFigures, Stochastic};
-pub use prepare::PreparedGeometry;
+pub use prepare::{Cards, PreparedGeometry};
 pub use renderer::{GeometryRenderer, RESET_WG};
 pub use textures::MATERIAL_TEXTURE_SIZE;
 

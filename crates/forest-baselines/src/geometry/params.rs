@@ -233,6 +233,9 @@ pub struct SpeciesFigures {
     pub leaves: u32,
     /// `r` of the area-preservation factor.
     pub r: f32,
+    /// Leaf cards cut to their texture's visible quadrilateral (all LODs; 0 with
+    /// [`super::Cards::Whole`]).
+    pub cards_cut: u32,
     /// Bytes of the species' model data on the GPU: vertices, tables, material and billboard
     /// textures with mips.
     pub model_bytes: u64,

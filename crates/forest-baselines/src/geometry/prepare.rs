@@ -5,9 +5,23 @@
 use forest_format::model::{NONE, RefVertex};
 use forest_format::opacity::{OpacityVolume, VOLUME_RESOLUTION};
 
+use super::cards::{card_quads, cut_cards};
 use super::params::{GeometrySpecies, SpeciesFigures};
 use super::textures::layer_bytes;
 use crate::gpu_types::{GpuGeoMaterial, GpuGeoSpecies};
+
+/// How the geometry methods draw their alpha-tested leaf cards.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Cards {
+    /// Each card that spans its whole texture is cut to the quadrilateral around what that
+    /// texture can show (the default; the vertex count is unchanged): a third to a half of
+    /// the bundled leaf cards' area, all of it fragments that would be shaded and discarded.
+    /// See `geometry/cards.rs`.
+    #[default]
+    Cut,
+    /// Every card drawn whole, as the model has it (for comparison).
+    Whole,
+}
 
 /// The species' models gathered (reference vertices with traced sky visibility, LOD set,
 /// billboard images), reusable for any forest of these species and any light.
@@ -28,8 +42,14 @@ pub struct PreparedGeometry {
 
 impl PreparedGeometry {
     /// Gather every species' prepared model into the arrays the renderer uploads (no tracing:
-    /// the bake prepared them, [`forest_format::model`]).
+    /// the bake prepared them, [`forest_format::model`]), with the leaf cards cut
+    /// ([`Cards::Cut`]).
     pub fn new(species: &[GeometrySpecies]) -> Self {
+        Self::with_cards(species, Cards::Cut)
+    }
+
+    /// As [`PreparedGeometry::new`], with the leaf cards cut or whole.
+    pub fn with_cards(species: &[GeometrySpecies], cards: Cards) -> Self {
         let mut vertices: Vec<RefVertex> = Vec::new();
         let mut geo_species = Vec::new();
         let mut materials = Vec::new();
@@ -41,7 +61,17 @@ impl PreparedGeometry {
         let mut figures = Vec::new();
         let mut opacity = Vec::new();
         for s in species {
-            let m = &*s.model;
+            let mut cards_cut = 0;
+            let cut;
+            let m = match cards {
+                Cards::Whole => &*s.model,
+                Cards::Cut => {
+                    let (model, n) = cut_cards(&s.model, &card_quads(&s.model));
+                    cards_cut = n as u32;
+                    cut = model;
+                    &cut
+                }
+            };
             let material_base = materials.len() as u32;
             let layer_base = layers.len() as u32;
             let (billboards_base, vertices_base, leaves_base) =
@@ -94,6 +124,7 @@ impl PreparedGeometry {
                 lod_triangles: counts.map(|c| u64::from(c) / 3),
                 leaves: leaves as u32,
                 r: m.r,
+                cards_cut,
                 model_bytes: (std::mem::size_of_val(&vertices[vertices_base..])
                     + std::mem::size_of::<GpuGeoSpecies>()
                     + std::mem::size_of_val(&materials[material_base as usize..])

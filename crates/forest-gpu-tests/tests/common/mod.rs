@@ -204,6 +204,14 @@ pub fn prepared() -> &'static forest_baselines::geometry::PreparedGeometry {
 /// The geometry methods' CPU preparation of bush and pine for `atlases` (their lighting and
 /// hybrid switch), not cached.
 pub fn prepared_for(atlases: &[Atlas]) -> forest_baselines::geometry::PreparedGeometry {
+    prepared_with(atlases, forest_baselines::geometry::Cards::Cut)
+}
+
+/// As [`prepared_for`], with the leaf cards `cards`.
+pub fn prepared_with(
+    atlases: &[Atlas],
+    cards: forest_baselines::geometry::Cards,
+) -> forest_baselines::geometry::PreparedGeometry {
     let species: Vec<forest_baselines::geometry::GeometrySpecies> = ["bush", "pine"]
         .iter()
         .zip(atlases)
@@ -216,7 +224,7 @@ pub fn prepared_for(atlases: &[Atlas]) -> forest_baselines::geometry::PreparedGe
             )
         })
         .collect();
-    forest_baselines::geometry::PreparedGeometry::new(&species)
+    forest_baselines::geometry::PreparedGeometry::with_cards(&species, cards)
 }
 
 /// The tests' small view: a quad stream over `scene` for a 160×120 target refined down to
@@ -366,4 +374,23 @@ pub fn forest_renderer(
         forest_render::QuadStream::new(&ctx.device, scene, &opts).unwrap(),
         Some(geometry),
     )
+}
+
+/// Writes `NAME-expected.png`, `NAME-actual.png` and the FLIP map `NAME-difference.png` to
+/// target/test-output; returns the folder.
+pub fn failure_images(
+    name: &str,
+    expected: &image::RgbaImage,
+    actual: &image::RgbaImage,
+) -> std::path::PathBuf {
+    let out = root().join("target/test-output");
+    std::fs::create_dir_all(&out).unwrap();
+    expected
+        .save(out.join(format!("{name}-expected.png")))
+        .unwrap();
+    actual.save(out.join(format!("{name}-actual.png"))).unwrap();
+    let (_, map) = forest_metrics::flip(expected, actual).unwrap();
+    map.save(out.join(format!("{name}-difference.png")))
+        .unwrap();
+    out
 }
