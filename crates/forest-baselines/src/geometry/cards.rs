@@ -15,9 +15,11 @@
 //! are lit at their own positions (the crown's self-shadowing is evaluated per vertex), so
 //! the shading within a card is sampled at other points than before.
 
-use forest_format::cutout::{Polygon, convex_hull, enclosing_quad, simplify_outward};
+use forest_format::cutout::{Polygon, clip_convex, convex_hull, enclosing_quad, simplify_outward};
 use forest_format::model::{NONE, PreparedModel, RefVertex};
 use glam::{Vec2, Vec3};
+
+use super::textures::ALPHA_TEST_BYTE;
 
 /// Mip levels, finest first, whose passing texels the cut keeps (levels 0–6: down to 8×8
 /// texels of a 512-texel layer).
@@ -40,8 +42,11 @@ pub(super) fn card_quads(model: &PreparedModel) -> Vec<Option<[Vec2; 4]>> {
                 return None;
             }
             let (chain, _) = super::textures::mip_chain(img);
+            // Simplifying outward can carry a corner past the card's edge; the card's square
+            // clips it back (the clipped hull still holds every passing texel inside it).
+            let square = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
             passable_hull(&chain, img.width(), CUT_LEVELS, HULL_VERTICES)
-                .and_then(|h| enclosing_quad(&h))
+                .and_then(|h| enclosing_quad(&clip_convex(&h, &square)))
         })
         .collect()
 }
@@ -49,9 +54,6 @@ pub(super) fn card_quads(model: &PreparedModel) -> Vec<Option<[Vec2; 4]>> {
 /// Most corners [`passable_hull`] keeps for [`card_quads`] (the quad search's candidate lines
 /// grow with them).
 const HULL_VERTICES: usize = 24;
-
-/// The smallest alpha byte that passes the geometry shaders' 0.5 alpha test.
-const ALPHA_TEST_BYTE: u8 = 128;
 
 /// The convex hull of every texture point (`uv`, OBJ convention: `v = 0` is the bottom row)
 /// where a sample of any of the first `levels` levels of mip chain `chain` (RGBA8 levels of a
@@ -112,10 +114,13 @@ pub(super) fn passable_hull(
 /// at texture coordinates (0,0), (1,0), (0,1), (1,1), on a parallelogram (within 10⁻³ of its
 /// size). Its two triangles become the quad's two: the vertex count, the leaf table and the
 /// LOD counts are unchanged. Each new corner takes what the rasteriser interpolated there over
-/// the whole card (position, normal, sky visibility), and the quad's texture coordinates, so
-/// every fragment the quad shades lay on the card with the same inputs (its vertex-lit sun
-/// visibility is evaluated at the new corners). Anything else is copied unchanged. Returns the
-/// model and the number of cards cut.
+/// the card (position, normal, sky visibility) and the quad's texture coordinates, so every
+/// fragment the quad shades lies on the card at the same position and texture point. Values
+/// that are not affine over the card (per-corner sky visibility or normals) now vary linearly
+/// between the new corners instead of over the card's own two triangles, and the vertex-lit
+/// sun visibility is evaluated at the new corners. Two triangles that do not tile the card
+/// (meeting along a diagonal) and pairs across a LOD's end stay as they are, as does
+/// anything else. Returns the model and the number of cards cut.
 pub(super) fn cut_cards(
     model: &PreparedModel,
     quads: &[Option<[Vec2; 4]>],
@@ -128,12 +133,16 @@ pub(super) fn cut_cards(
         quads.get(m.layer as usize)?.as_ref()
     };
     let v = &model.vertices;
+    let [l0, l1, _] = model.lod_vertices.map(|n| n as usize);
+    let lod_ends = [l0, l0 + l1];
     let mut vertices = Vec::with_capacity(v.len());
     let mut cut = 0;
     let mut i = 0;
     while i + 3 <= v.len() {
+        let crosses = lod_ends.iter().any(|&e| i < e && e < i + 6);
         let pair = v.get(i..i + 6).filter(|p| {
-            (1..6).all(|k| p[k].material == p[0].material && p[k].element == p[0].element)
+            !crosses
+                && (1..6).all(|k| p[k].material == p[0].material && p[k].element == p[0].element)
         });
         if let Some(pair) = pair
             && let Some(quad) = quad_of(pair[0].material)
@@ -166,7 +175,9 @@ pub(super) fn cut_cards(
 /// the first triangle turns counter-clockwise in texture space.
 fn card(pair: &[RefVertex]) -> Option<bool> {
     let mut corner: [Option<Vec3>; 4] = [None; 4];
-    for v in pair {
+    // Corners each triangle has, as bits.
+    let mut has = [0u8; 2];
+    for (n, v) in pair.iter().enumerate() {
         let k = match v.uv {
             [0.0, 0.0] => 0,
             [1.0, 0.0] => 1,
@@ -174,6 +185,7 @@ fn card(pair: &[RefVertex]) -> Option<bool> {
             [1.0, 1.0] => 3,
             _ => return None,
         };
+        has[n / 3] |= 1 << k;
         let p = Vec3::from(v.pos);
         match corner[k] {
             Some(q) if q != p => return None,
@@ -189,6 +201,18 @@ fn card(pair: &[RefVertex]) -> Option<bool> {
         return None;
     }
     let uv = |k: usize| Vec2::from(pair[k].uv);
+    // The two tile the square: three corners each, the corners they lack opposite (0 and 3,
+    // or 1 and 2), so that they meet along a diagonal without overlapping.
+    let lacks = has.map(|h| {
+        if h.count_ones() == 3 {
+            (!h & 0xf).trailing_zeros()
+        } else {
+            9
+        }
+    });
+    if lacks[0] + lacks[1] != 3 {
+        return None;
+    }
     Some((uv(1) - uv(0)).perp_dot(uv(2) - uv(0)) > 0.0)
 }
 
@@ -383,6 +407,17 @@ mod tests {
         }
         // Whole without a quad, and a card whose corners leave a parallelogram stays whole.
         assert_eq!(cut_cards(&model, &[None]).0.vertices, vertices);
+        let mut overlapping = model.clone();
+        overlapping.vertices[8] = at(1.0, 0.0);
+        overlapping.vertices[7] = at(0.0, 1.0);
+        overlapping.vertices[6] = at(0.0, 0.0);
+        let mut split = model.clone();
+        split.lod_vertices = [6, 6, 0];
+        split.leaf_end = vec![6];
+        for other in [overlapping, split] {
+            other.check_indices().unwrap();
+            assert_eq!(cut_cards(&other, &[Some(quad)]).1, 0);
+        }
         let mut bent = model.clone();
         bent.vertices[5].pos[2] += 1.0;
         bent.vertices[7].pos[2] += 1.0;

@@ -157,7 +157,7 @@ fn preserve_coverage(m: &mut image::RgbaImage, target: f64) {
 }
 
 /// The smallest alpha byte that passes the geometry shaders' 0.5 alpha test.
-const ALPHA_TEST_BYTE: u8 = 128;
+pub(super) const ALPHA_TEST_BYTE: u8 = 128;
 
 /// An sRGB RGBA8 2D-array texture with mips from square layers of side `size`.
 /// An array of `layers` with their mip chains: sRGB colour with coverage-preserving mips
