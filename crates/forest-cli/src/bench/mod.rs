@@ -670,7 +670,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "fidelity" => fidelity::run(&b)?,
             _ => unreachable!("clap checks the suite"),
         };
-        report::write(&b, s, &section)?;
+        report::write(&b, s, &section, !(s == "accuracy" && args.redraw))?;
     }
     Ok(())
 }
