@@ -52,29 +52,29 @@ impl Rect {
     }
 }
 
-/// Covered boxes of every aligned block of one layer at every level: `boxes[level][by · 2^level
-/// + bx]`, blocks of side `resolution >> level`, for levels `0..levels`.
-fn pyramid(alpha: impl Fn(u32, u32) -> bool, resolution: u32, levels: u32) -> Vec<Vec<Rect>> {
+/// A value of every aligned block of one layer at every level: `out[level][by · 2^level +
+/// bx]`, blocks of side `resolution >> level`, for levels `0..levels`; a block's value merges
+/// its texels' (`texel`) or its quadrants' values with `merge`, starting from `none`.
+fn pyramid<T: Copy>(
+    texel: impl Fn(u32, u32) -> T,
+    none: T,
+    merge: impl Fn(T, T) -> T,
+    resolution: u32,
+    levels: u32,
+) -> Vec<Vec<T>> {
     let finest = levels.saturating_sub(1);
     let blocks = 1u32 << finest;
     let side = (resolution >> finest).max(1);
-    let mut level: Vec<Rect> = (0..blocks * blocks)
+    let mut level: Vec<T> = (0..blocks * blocks)
         .map(|b| {
             let (bx, by) = (b % blocks, b / blocks);
-            let mut r = EMPTY;
+            let mut v = none;
             for y in by * side..(by + 1) * side {
                 for x in bx * side..(bx + 1) * side {
-                    if alpha(x, y) {
-                        r = r.union(Rect {
-                            x0: x,
-                            y0: y,
-                            x1: x + 1,
-                            y1: y + 1,
-                        });
-                    }
+                    v = merge(v, texel(x, y));
                 }
             }
-            r
+            v
         })
         .collect();
     let mut out = vec![Vec::new(); levels as usize];
@@ -86,10 +86,10 @@ fn pyramid(alpha: impl Fn(u32, u32) -> bool, resolution: u32, levels: u32) -> Ve
                     let (bx, by) = (b % n, b / n);
                     let child =
                         |dx: u32, dy: u32| level[((2 * by + dy) * 2 * n + 2 * bx + dx) as usize];
-                    child(0, 0)
-                        .union(child(1, 0))
-                        .union(child(0, 1))
-                        .union(child(1, 1))
+                    merge(
+                        merge(child(0, 0), child(1, 0)),
+                        merge(child(0, 1), child(1, 1)),
+                    )
                 })
                 .collect();
         }
@@ -108,18 +108,30 @@ fn packed(r: Rect, bx: u32, by: u32, side: u32) -> u32 {
     pack([lo(r.x0, bx), lo(r.y0, by)], [hi(r.x1, bx), hi(r.y1, by)])
 }
 
-/// The covered box of every node of one atlas, in node order. `layer_roots[l]` is the root
-/// (index into `nodes`) of layer `l` of `layers`; a node's children are its quadrants in the
-/// order of [`QuadNode::child_index`] (child `c` at `x · 2 + (c & 1)`, `y · 2 + (c >> 1)`).
-/// Nodes reached from no root, or deeper than `levels`, keep [`FULL`]. Cost: one pass over
+/// A node's opaque share in 1/255 steps: `floor(255 · opaque / box)` for its opaque texels
+/// (alpha 255) and the texels of its covered box; 0 for an empty box.
+fn opaque_share(opaque: u32, r: Rect) -> u32 {
+    if r.x0 >= r.x1 {
+        return 0;
+    }
+    let area = u64::from(r.x1 - r.x0) * u64::from(r.y1 - r.y0);
+    (u64::from(opaque) * 255 / area).min(255) as u32
+}
+
+/// The covered box of every node of one atlas, in node order, and its opaque share:
+/// `[box, share]`, the box packed as this module says, the share the fraction of the box's
+/// texels that are opaque (alpha 255) in 1/255 steps. `layer_roots[l]` is the root (index
+/// into `nodes`) of layer `l` of `layers`; a node's children are its quadrants in the order of
+/// [`QuadNode::child_index`] (child `c` at `x · 2 + (c & 1)`, `y · 2 + (c >> 1)`). Nodes
+/// reached from no root, or deeper than `levels`, keep `[FULL, 0]`. Cost: two passes over
 /// every texel of every non-blank layer, then a constant per block.
 pub fn node_trims(
     nodes: &[QuadNode],
     layer_roots: &[Option<u32>],
     layers: &Layers,
     levels: u32,
-) -> Vec<u32> {
-    let mut out = vec![FULL; nodes.len()];
+) -> Vec<[u32; 2]> {
+    let mut out = vec![[FULL, 0]; nodes.len()];
     let res = layers.resolution;
     for (l, root) in layer_roots.iter().enumerate() {
         let Some(root) = root else { continue };
@@ -127,8 +139,25 @@ pub fn node_trims(
             continue;
         }
         let rgba = layers.layer(l as u32);
-        let boxes = pyramid(
-            |x, y| rgba[((y * res + x) * 4 + 3) as usize] > 0,
+        let alpha = |x: u32, y: u32| rgba[((y * res + x) * 4 + 3) as usize];
+        // Each covered texel's own box, merged by union.
+        let covered = |x: u32, y: u32| {
+            if alpha(x, y) > 0 {
+                Rect {
+                    x0: x,
+                    y0: y,
+                    x1: x + 1,
+                    y1: y + 1,
+                }
+            } else {
+                EMPTY
+            }
+        };
+        let boxes = pyramid(covered, EMPTY, Rect::union, res, levels);
+        let opaque = pyramid(
+            |x, y| u32::from(alpha(x, y) == 255),
+            0,
+            |a, b| a + b,
             res,
             levels,
         );
@@ -141,7 +170,12 @@ pub fn node_trims(
                 continue;
             };
             let side = res >> level;
-            out[n as usize] = packed(level_boxes[(y * (1 << level) + x) as usize], x, y, side);
+            let block = (y * (1 << level) + x) as usize;
+            let r = level_boxes[block];
+            out[n as usize] = [
+                packed(r, x, y, side),
+                opaque_share(opaque[level as usize][block], r),
+            ];
             for c in 0..4 {
                 if let Some(k) = node.child_index(c) {
                     stack.push((k, level + 1, x * 2 + (c & 1), y * 2 + (c >> 1)));
@@ -177,7 +211,10 @@ mod tests {
             QuadNode::new(0, 0, [0; 4]),
             QuadNode::new(0, 0, [0; 4]),
         ];
-        let t = node_trims(&nodes, &[Some(0)], &layer(), 2);
+        let t: Vec<u32> = node_trims(&nodes, &[Some(0)], &layer(), 2)
+            .iter()
+            .map(|t| t[0])
+            .collect();
         // Root: texels x 2..6, y 1..4 of 8 → lo floor(255·2/8) = 63, floor(255/8) = 31;
         // hi ceil(255·6/8) = 192, ceil(255·4/8) = 128.
         assert_eq!(unpack(t[0]), unpack(pack([63, 31], [192, 128])));
@@ -191,6 +228,39 @@ mod tests {
         assert!(hi[1] * 8.0 >= 4.0);
     }
 
+    /// Opaque shares: a 4×4 layer, its top-left 2×2 quadrant opaque (255), one texel of the
+    /// top-right half covered (200), the bottom blank.
+    #[test]
+    fn opaque_share_of_the_box() {
+        let mut rgba = vec![0u8; 4 * 4 * 4];
+        for (x, y, a) in [
+            (0usize, 0usize, 255u8),
+            (1, 0, 255),
+            (0, 1, 255),
+            (1, 1, 255),
+            (3, 1, 200),
+        ] {
+            rgba[(y * 4 + x) * 4 + 3] = a;
+        }
+        let layers = Layers {
+            resolution: 4,
+            count: 1,
+            rgba,
+        };
+        let nodes = vec![
+            QuadNode::new(0b0011, 1, [0; 4]),
+            QuadNode::new(0, 0, [0; 4]),
+            QuadNode::new(0, 0, [0; 4]),
+        ];
+        let t = node_trims(&nodes, &[Some(0)], &layers, 2);
+        // Root: box x 0..4, y 0..2 (8 texels), 4 opaque → 255 · 4 / 8 = 127.
+        assert_eq!(t[0][1], 127);
+        // Top-left: all 4 opaque.
+        assert_eq!(t[1][1], 255);
+        // Top-right: its box is the one texel of alpha 200.
+        assert_eq!(t[2][1], 0);
+    }
+
     #[test]
     fn blank_and_unreached_nodes() {
         let blank = Layers {
@@ -202,7 +272,7 @@ mod tests {
         let t = node_trims(&nodes, &[Some(0)], &blank, 2);
         assert_eq!(
             t,
-            vec![0, FULL],
+            vec![[0, 0], [FULL, 0]],
             "empty box for the root, FULL for the unreached node"
         );
         assert_eq!(unpack(FULL), ([0.0, 0.0], [1.0, 1.0]));

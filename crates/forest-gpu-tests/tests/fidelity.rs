@@ -166,6 +166,7 @@ fn close_up_and_from_below_beat_the_papers_bake() {
         far_span: 1,
         sharpen: 0,
         sharpen_reach: 1,
+        opaque_first: false,
     };
     // Mean FLIP ceilings: what the defaults must reach and the paper's bake does not (measured
     // on lavapipe: close-up 0.120 against 0.189, from below 0.289 against 0.324).

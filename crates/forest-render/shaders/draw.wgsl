@@ -25,7 +25,9 @@
 // ordering comes from the stream and blending needs no depth writes; writing depth would make
 // semi-transparent quads hide what is drawn after them behind their transparent parts. The
 // quads are still depth-tested against the opaque ground drawn first, so trees are hidden by
-// hills and the ground hides the parts of slabs below it.
+// hills and the ground hides the parts of slabs below it. The opaque pass (FLAG_OPAQUE_FIRST,
+// vs_quad_opaque) writes depth only where a fragment is opaque, before every blended quad:
+// what lies behind such a fragment would have been covered by it.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -207,10 +209,64 @@ fn node_min_extent(sp: Species, f: Frame, inst: Instance, slab: u32, x: f32, y: 
 // are.
 @vertex
 fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
-    let v = quad_vertex(vi, kept_composites(state.composites, state.overflow_cull) + qi, true);
-    return QuadOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
+    return plain_quad(vi, qi, (stream_flags(camera) & FLAG_OPAQUE_FIRST) != 0u);
+}
+
+// The plain quads for the host's depth (fs_quad_depth): each at its own depth.
+@vertex
+fn vs_quad_host_depth(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
+    return plain_quad(vi, qi, false);
+}
+
+// Corner `vi` of plain quad `qi`. `pushed`: after the opaque pass, a tree's later aspects of
+// its front slab blend over its first aspect, whose opaque texels that pass has drawn with
+// depth, so they are tested a slab's thickness nearer (a uniform scale about the eye keeps
+// every point on its pixel and the interpolation unchanged) and the depth test keeps them.
+fn plain_quad(vi: u32, qi: u32, pushed: bool) -> QuadOut {
+    let i = kept_composites(state.composites, state.overflow_cull) + qi;
+    let v = quad_vertex(vi, i, true);
+    var clip = v.clip;
+    let q = quads[i];
+    if (pushed && quad_slab(q) == 0u && quad_lo(q) > 0u) {
+        let inst = instances[q.instance];
+        let sp = species[inst.species];
+        let reach = distance(to_world(inst, sp.sphere.xyz), camera.eye.xyz);
+        let push = 2.0 * sp.sphere.w * inst.scale / f32(max(sp.slabs, 1u));
+        let s = max(1.0 - push / max(reach, 1e-6), 0.5);
+        clip = camera.view_proj * vec4<f32>(camera.eye.xyz + (v.world - camera.eye.xyz) * s, 1.0);
+    }
+    return QuadOut(clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
                    v.sun_vis, v.tree);
 }
+
+// The opaque pass (FLAG_OPAQUE_FIRST), before every blended quad: the plain quads of each
+// tree's first aspect in its front slab (the aspect drawn with alpha 1, which the others blend
+// over), front to back (the stream reversed), their opaque fragments drawn with depth written
+// a little nearer than the blended draw's, so that the depth test rejects what they hide:
+// the same fragments again, the tree's back slab, and the trees behind. Other quads collapse
+// to a point outside the view.
+@vertex
+fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
+    let kept = kept_composites(state.composites, state.overflow_cull);
+    let i = state.n - 1u - qi;
+    let q = quads[i];
+    var out: QuadOut;
+    out.clip = vec4<f32>(2.0, 2.0, 0.5, 1.0);
+    if (quad_slab(q) != 0u || quad_lo(q) != 0u || quad_composite(q) || i < kept
+        || camera.viewport.z != 0.0) { return out; }
+    // Only nodes mostly opaque: the rest of its fragments the blended draw shades again.
+    let share = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).w;
+    if (share < OPAQUE_SHARE_MIN) { return out; }
+    let v = quad_vertex(vi, i, true);
+    if (v.share.w < WEIGHT_ONE) { return out; }
+    // Nearer by OPAQUE_PULL of the distance: a uniform scale about the eye.
+    let p = camera.eye.xyz + (v.world - camera.eye.xyz) * (1.0 - OPAQUE_PULL);
+    return QuadOut(camera.view_proj * vec4<f32>(p, 1.0), v.uv, v.ids, v.alpha, v.share, v.world,
+                   v.frame_right, v.frame_up, v.sun_vis, v.tree);
+}
+// Mirrors passes::draw::OPAQUE_PULL and OPAQUE_SHARE_MIN.
+const OPAQUE_PULL: f32 = 0.0009765625;
+const OPAQUE_SHARE_MIN: u32 = 128u;
 
 @vertex
 fn vs_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> CompositeOut {
@@ -404,15 +460,33 @@ fn direction_colour(dir: u32) -> vec3<f32> {
 @fragment
 fn fs_quad(in: QuadOut) -> @location(0) vec4<f32> {
     count_enter(in.clip);
+    let out = quad_colour(in);
+    count_shown(in.clip, out.a);
+    return out;
+}
+
+// A plain quad's fragment: its texel lit and shaded (see shade).
+fn quad_colour(in: QuadOut) -> vec4<f32> {
     let c = textureSample(colour, colour_sampler, in.uv, in.ids.x);
     let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
     // The crown's own shadow (the march) times the other casters' (the sun's shadow map).
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
                      in.frame_up, in.sun_vis * tree_shadow(in.world, in.tree));
-    let out = shade(f, lit_texel(f, c, g));
+    return shade(f, lit_texel(f, c, g));
+}
+
+@fragment
+fn fs_quad_opaque(in: QuadOut) -> @location(0) vec4<f32> {
+    count_enter(in.clip);
+    let out = quad_colour(in);
+    // The rest is drawn by fs_quad, blended.
+    if (out.a < OPAQUE_FRAGMENT) { discard; }
     count_shown(in.clip, out.a);
+    count_depth(in.clip);
     return out;
 }
+// What the opaque pass draws: as opaque as an 8-bit target tells.
+const OPAQUE_FRAGMENT: f32 = 1.0 - 0.5 / 255.0;
 
 @fragment
 fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {

@@ -232,6 +232,14 @@ pub struct StreamOptions {
     /// measurements under "The sharpening reach" in docs/rendering.md. Off with
     /// [`Self::far_nearest`] off (the paper's blend of every tree).
     pub sharpen_reach: u32,
+    /// The opaque pass (on by default; with [`AspectBlend::Over`] only): before the blended
+    /// quads, each tree's first aspect in its front slab draws its mostly opaque nodes front to
+    /// back, their opaque fragments with depth written, so that the depth test rejects what
+    /// they hide (the same fragments again, the tree's back slab, the trees behind), and the
+    /// tree's other aspects in its front slab are tested a slab's thickness nearer, so that
+    /// they still blend over it. It writes depth into the host's depth target; see "The opaque
+    /// pass" in docs/rendering.md.
+    pub opaque_first: bool,
 }
 
 impl Default for StreamOptions {
@@ -245,6 +253,7 @@ impl Default for StreamOptions {
             far_span: FAR_SPAN_DEFAULT,
             sharpen: SHARPEN_DEFAULT,
             sharpen_reach: SHARPEN_REACH_DEFAULT,
+            opaque_first: true,
         }
     }
 }
@@ -291,6 +300,8 @@ pub const FLAG_UNTRIMMED: u32 = 8;
 pub const FLAG_FAR_BLEND: u32 = 16;
 /// See [`FLAG_DITHER`].
 pub const FLAG_FAR_SLABS: u32 = 32;
+/// See [`FLAG_DITHER`].
+pub const FLAG_OPAQUE_FIRST: u32 = 64;
 
 impl StreamOptions {
     /// Write these options into a camera uniform: the flags to `viewport.w`, the far span to
@@ -345,6 +356,11 @@ impl StreamOptions {
                 0
             } else {
                 FLAG_FAR_SLABS
+            }
+            | if self.opaque_first && self.blend == AspectBlend::Over {
+                FLAG_OPAQUE_FIRST
+            } else {
+                0
             }
             | self.sharpen.min(SHARPEN_MAX) << SHARPEN_SHIFT
             | self.sharpen_reach.clamp(1, SHARPEN_REACH_MAX) << REACH_SHIFT

@@ -61,8 +61,9 @@ pub struct SceneTables {
     pub roots: Vec<u32>,
     /// All nodes, species after species.
     pub nodes: Vec<QuadNode>,
-    /// Each node's covered box (see [`forest_format::trim`]), in node order.
-    pub trims: Vec<u32>,
+    /// Each node's covered box and opaque share (see [`forest_format::trim::node_trims`]), in
+    /// node order.
+    pub trims: Vec<[u32; 2]>,
     /// Presort directions (xyz; w unused).
     pub presort_dirs: Vec<[f32; 4]>,
     /// Presort orders, one after another (`K × N`).
@@ -279,7 +280,7 @@ pub struct GpuScene {
     /// Opacity volumes of all species, stacked ([`crate::opacity`]).
     pub opacity: wgpu::Texture,
     /// Node texture (`Rgba32Uint`, [`NODE_TEXTURE_WIDTH`] wide): the node's two words, its
-    /// covered box, 0.
+    /// covered box and its opaque share ([`forest_format::trim::node_trims`]).
     pub nodes: wgpu::Texture,
     /// Presort texture (`R32Uint`, [`PRESORT_TEXTURE_WIDTH`] wide).
     pub presort: wgpu::Texture,
@@ -470,9 +471,9 @@ impl GpuScene {
             .nodes
             .iter()
             .zip(&tables.trims)
-            .map(|(n, &t)| {
+            .map(|(n, &[t, opaque])| {
                 let [child, depth]: [u32; 2] = bytemuck::cast(*n);
-                [child, depth, t, 0]
+                [child, depth, t, opaque]
             })
             .collect();
         let nodes = u32_texture(

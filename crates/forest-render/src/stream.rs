@@ -1086,6 +1086,7 @@ impl QuadStream {
             &self.sized.args,
             (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,
+            self.options.opaque_first && self.options.blend == crate::options::AspectBlend::Over,
             crate::passes::draw::Measured {
                 statistics: self.counting().map(|q| &q.set),
                 counted: self

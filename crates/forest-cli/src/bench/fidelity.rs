@@ -90,6 +90,7 @@ fn variants(quick: bool) -> Vec<Variant> {
             far_span: 1,
             sharpen: 0,
             sharpen_reach: 1,
+            opaque_first: false,
         },
         epsilon: EPS,
         geometry: false,
