@@ -96,13 +96,14 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
         r.set_shadows(&ctx.device, shadows).unwrap();
         let mut sharpened = 0;
         for (name, cam) in common::cameras(forest.extent()).into_iter().take(4) {
-            // The hybrid's quads draw with its own aspect sharpening: the stream's options
-            // set to it draw the same quads.
+            // The hybrid's quads draw with its own aspect sharpening and without the opaque
+            // pass: the stream's options set so draw the same quads.
             let own = frame(&ctx, &mut r, Method::Quads, &cam);
             let options = r.stream.options();
             r.stream
                 .set_options(StreamOptions {
                     sharpen: HYBRID_SHARPEN_DEFAULT,
+                    opaque_first: false,
                     ..options
                 })
                 .unwrap();
@@ -120,7 +121,7 @@ fn switch_at_zero_is_the_quad_stream_and_at_infinity_the_full_geometry() {
             // Switched back, the stream draws with its own options again.
             assert!(
                 frame(&ctx, &mut r, Method::Quads, &cam) == own,
-                "{name}: the quad stream after the hybrid kept the hybrid's sharpening"
+                "{name}: the quad stream after the hybrid kept the hybrid's options"
             );
             assert_ne!(quads, geometry, "{name}: the two forms differ");
             for (what, got, want) in [

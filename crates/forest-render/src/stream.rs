@@ -105,6 +105,8 @@ pub struct QuadStream {
     options: StreamOptions,
     /// Replaces `options.sharpen` in the frames drawn ([`Self::set_sharpen_override`]).
     sharpen_override: Option<u32>,
+    /// Replaces `options.opaque_first` in the frames drawn ([`Self::set_opaque_override`]).
+    opaque_override: Option<bool>,
     forms: [f32; 4],
     light: forest_format::shading::Lighting,
     /// The sun's shadow maps, when on ([`Self::set_shadows`]).
@@ -256,6 +258,7 @@ impl QuadStream {
             debug: DebugView::Off,
             options: StreamOptions::default(),
             sharpen_override: None,
+            opaque_override: None,
             forms: crate::forms::FORMS_QUADS,
             light: opts.lighting,
             shadows: None,
@@ -797,10 +800,20 @@ impl QuadStream {
         Ok(())
     }
 
-    /// The options the frames are drawn with: [`Self::options`] with the sharpening override.
+    /// Whether the opaque pass runs ([`StreamOptions::opaque_first`]) in the frames written
+    /// from the next camera on, whatever [`Self::set_options`] sets; None: the options' own.
+    /// The hybrid turns it off for its trees beyond the switch: there it shaded more
+    /// fragments than it saved (docs/rendering.md, "The opaque pass").
+    pub fn set_opaque_override(&mut self, opaque_first: Option<bool>) {
+        self.opaque_override = opaque_first;
+    }
+
+    /// The options the frames are drawn with: [`Self::options`] with the sharpening and
+    /// opaque-pass overrides.
     pub fn drawn_options(&self) -> StreamOptions {
         StreamOptions {
             sharpen: self.sharpen_override.unwrap_or(self.options.sharpen),
+            opaque_first: self.opaque_override.unwrap_or(self.options.opaque_first),
             ..self.options
         }
     }
@@ -1056,7 +1069,8 @@ impl QuadStream {
 
     /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
     /// or an earlier encoder of the submission): back to front, blended, depth-tested, no
-    /// depth written.
+    /// depth written, after the opaque pass ([`StreamOptions::opaque_first`]), which writes
+    /// the depth of the trees' opaque fronts.
     pub fn render(&self, pass: &mut wgpu::RenderPass) {
         self.record_draw(pass, false);
     }
@@ -1086,7 +1100,10 @@ impl QuadStream {
             &self.sized.args,
             (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,
-            self.options.opaque_first && self.options.blend == crate::options::AspectBlend::Over,
+            {
+                let o = self.drawn_options();
+                o.opaque_first && o.blend == crate::options::AspectBlend::Over
+            },
             crate::passes::draw::Measured {
                 statistics: self.counting().map(|q| &q.set),
                 counted: self
