@@ -117,7 +117,7 @@ fn the_stream_counts_its_work() {
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let off = stream.read_stats(&ctx);
     assert_eq!(off.work.passes, None);
-    assert!(off.work.dispatches > 0 && off.work.draws == 3);
+    assert!(off.work.dispatches > 0 && off.work.draws == 2);
     stream.set_pipeline_statistics(true);
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let stats = stream.read_stats(&ctx);
@@ -132,9 +132,9 @@ fn the_stream_counts_its_work() {
     // final length.
     let iterations = stream.scene.tables.max_levels - 1;
     assert_eq!(w.dispatches, 5 + 3 * iterations + 1);
-    // The stream's three draws (the opaque pass, far trees' composited quads, then the
-    // others), no ground over a transparent background.
-    assert_eq!(w.draws, 3, "quads only over a transparent background");
+    // The stream's two draws (far trees' composited quads, then the others; the opaque pass
+    // is off by default), no ground over a transparent background.
+    assert_eq!(w.draws, 2, "quads only over a transparent background");
     assert!(w.bytes >= stream.scene.bytes + stream.capacity.bytes());
     let Some(p) = w.passes else {
         eprintln!(
@@ -148,11 +148,10 @@ fn the_stream_counts_its_work() {
         p[work::REFINE as usize],
         p[work::DRAW as usize],
     );
-    // Every quad is a four-vertex strip in one of the two blended draws (its list's), and
-    // every plain quad once more in the opaque pass: two triangles unless clipped.
-    let strips = u64::from(stats.quads) + u64::from(stats.quads - stats.composites);
-    assert_eq!(draw.vertex_invocations, 4 * strips);
-    assert!(draw.primitives > 0 && draw.primitives <= 2 * strips);
+    // Every quad is a four-vertex strip in one of the two draws (its list's): two triangles
+    // unless clipped.
+    assert_eq!(draw.vertex_invocations, 4 * u64::from(stats.quads));
+    assert!(draw.primitives > 0 && draw.primitives <= 2 * u64::from(stats.quads));
     // Every covered pixel was shaded at least once.
     let covered = target.read(&ctx).pixels().filter(|px| px[3] > 0).count() as u64;
     assert!(
@@ -236,10 +235,10 @@ fn every_method_counts_its_work() {
         ..Default::default()
     }));
     // The hybrid's work is both forms' work in one frame: the stream's dispatches and its
-    // three draws, the geometry's four dispatches and its draws, both renderers' memory.
+    // two draws, the geometry's four dispatches and its draws, both renderers' memory.
     let h = &hybrid.work;
     assert_eq!(h.dispatches, quads.work.dispatches + 4);
-    assert_eq!(h.draws, 3 + segments);
+    assert_eq!(h.draws, 2 + segments);
     assert_eq!(h.bytes, quads.work.bytes + gpu_bytes);
     if let (Some(t), Some(_)) = (h.total(), quads.work.passes) {
         assert!(t.compute_invocations > 0 && t.vertex_invocations > 0);
@@ -485,7 +484,7 @@ fn far_trees_composite_their_slabs_into_one_quad() {
         .collect();
     assert!(!composited.is_empty(), "far trees are composited");
     // Their own draw only while the options can make composited quads.
-    assert_eq!((slabs.work.draws, comp.work.draws), (2, 3));
+    assert_eq!((slabs.work.draws, comp.work.draws), (1, 2));
     assert!(slab_quads.iter().all(|q| !q.composite()));
     for &tree in &composited {
         let of = |qs: &[forest_render::gpu_types::Quad]| {
@@ -545,14 +544,10 @@ fn far_trees_composite_their_slabs_into_one_quad() {
         );
     }
     if let (Some(a), Some(b)) = (work(&slabs), work(&comp)) {
-        // Fewer fragments; each quad's four vertices run once in its own list's draw, and a
-        // plain quad's once more in the opaque pass.
+        // Fewer fragments; each quad's four vertices run once, in its own list's draw.
         assert!(b.1 < a.1, "{a:?} -> {b:?}");
-        let strips = |s: &forest_render::stats::FrameStats| {
-            u64::from(s.quads) + u64::from(s.quads - s.composites)
-        };
-        assert_eq!(a.0, 4 * strips(&slabs));
-        assert_eq!(b.0, 4 * strips(&comp));
+        assert_eq!(a.0, 4 * u64::from(slabs.quads));
+        assert_eq!(b.0, 4 * u64::from(comp.quads));
     }
 }
 

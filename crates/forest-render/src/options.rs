@@ -232,13 +232,15 @@ pub struct StreamOptions {
     /// measurements under "The sharpening reach" in docs/rendering.md. Off with
     /// [`Self::far_nearest`] off (the paper's blend of every tree).
     pub sharpen_reach: u32,
-    /// The opaque pass (on by default; with [`AspectBlend::Over`] only): before the blended
+    /// The opaque pass (off by default; with [`AspectBlend::Over`] only): before the blended
     /// quads, each tree's first aspect in its front slab draws its mostly opaque nodes front to
     /// back, their opaque fragments with depth written, so that the depth test rejects what
     /// they hide (the same fragments again, the tree's back slab, the trees behind), and the
     /// tree's other aspects in its front slab are tested a slab's thickness nearer, so that
-    /// they still blend over it. It writes depth into the host's depth target; see "The opaque
-    /// pass" in docs/rendering.md.
+    /// they still blend over it. It writes depth into the host's depth target. Off by default
+    /// because that push lets those aspects show through opaque terrain or host geometry
+    /// that lies less than a slab's thickness in front of the tree; see "The opaque pass" in
+    /// docs/rendering.md.
     pub opaque_first: bool,
 }
 
@@ -253,7 +255,7 @@ impl Default for StreamOptions {
             far_span: FAR_SPAN_DEFAULT,
             sharpen: SHARPEN_DEFAULT,
             sharpen_reach: SHARPEN_REACH_DEFAULT,
-            opaque_first: true,
+            opaque_first: false,
         }
     }
 }
