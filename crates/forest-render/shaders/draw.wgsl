@@ -228,10 +228,10 @@ fn plain_quad(vi: u32, qi: u32, pushed: bool) -> QuadOut {
     var clip = v.clip;
     let q = quads[i];
     if (pushed && quad_slab(q) == 0u && quad_lo(q) > 0u) {
-        let inst = instances[q.instance];
-        let sp = species[inst.species];
-        let reach = distance(to_world(inst, sp.sphere.xyz), camera.eye.xyz);
-        let push = 2.0 * sp.sphere.w * inst.scale / f32(max(sp.slabs, 1u));
+        // v.tree: the tree's bounding sphere in world space.
+        let slabs = species[instances[q.instance].species].slabs;
+        let reach = distance(v.tree.xyz, camera.eye.xyz);
+        let push = 2.0 * v.tree.w / f32(max(slabs, 1u));
         let s = max(1.0 - push / max(reach, 1e-6), 0.5);
         clip = camera.view_proj * vec4<f32>(camera.eye.xyz + (v.world - camera.eye.xyz) * s, 1.0);
     }
@@ -247,13 +247,12 @@ fn plain_quad(vi: u32, qi: u32, pushed: bool) -> QuadOut {
 // to a point outside the view.
 @vertex
 fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
-    let kept = kept_composites(state.composites, state.overflow_cull);
+    // The plain list is [kept composites, n): instance qi is its (qi + 1)-th quad from the end.
     let i = state.n - 1u - qi;
     let q = quads[i];
     var out: QuadOut;
     out.clip = vec4<f32>(2.0, 2.0, 0.5, 1.0);
-    if (quad_slab(q) != 0u || quad_lo(q) != 0u || quad_composite(q) || i < kept
-        || camera.viewport.z != 0.0) { return out; }
+    if (quad_slab(q) != 0u || quad_lo(q) != 0u || camera.viewport.z != 0.0) { return out; }
     // Only nodes mostly opaque: the rest of its fragments the blended draw shades again.
     let share = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).w;
     if (share < OPAQUE_SHARE_MIN) { return out; }

@@ -339,6 +339,12 @@ impl StreamOptions {
         Ok(())
     }
 
+    /// Whether frames run the opaque pass: [`Self::opaque_first`] with the "over" blend, the
+    /// only one it serves.
+    pub fn opaque_pass(self) -> bool {
+        self.opaque_first && self.blend == AspectBlend::Over
+    }
+
     /// The flag bits written to the camera uniform's `viewport.w`.
     pub fn flags(self) -> u32 {
         let blend = match self.blend {
@@ -359,7 +365,7 @@ impl StreamOptions {
             } else {
                 FLAG_FAR_SLABS
             }
-            | if self.opaque_first && self.blend == AspectBlend::Over {
+            | if self.opaque_pass() {
                 FLAG_OPAQUE_FIRST
             } else {
                 0

@@ -1100,10 +1100,7 @@ impl QuadStream {
             &self.sized.args,
             (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
             self.options.far_nearest && self.options.far_composite,
-            {
-                let o = self.drawn_options();
-                o.opaque_first && o.blend == crate::options::AspectBlend::Over
-            },
+            self.drawn_options().opaque_pass(),
             crate::passes::draw::Measured {
                 statistics: self.counting().map(|q| &q.set),
                 counted: self
