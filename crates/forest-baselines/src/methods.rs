@@ -54,9 +54,8 @@ impl Method {
 
     /// Whether the method's quads run the opaque pass in place of the stream's own choice
     /// ([`QuadStream::set_opaque_override`]): off for the hybrid, whose quads are the trees
-    /// beyond its switch, where the pass shaded more fragments than it saved (the accuracy
-    /// suite's walkthroughs: +0.3 % at ε 16, +4 % at real sizes and ε 4); None for every other
-    /// method.
+    /// beyond its switch, where the pass shaded more fragments than it saved (see "The opaque
+    /// pass" in docs/rendering.md); None for every other method.
     pub fn quad_opaque_first(&self) -> Option<bool> {
         match self {
             Method::Hybrid(_) => Some(false),

@@ -281,11 +281,11 @@ pub struct MethodArgs {
     /// its slabs are composited into one quad, sampled through their parallax).
     #[arg(long)]
     pub far_slabs: bool,
-    /// Quad stream: first draw each tree's opaque front with depth written, so that the depth
-    /// test rejects what it hides (fewer fragments shaded; the tree's other aspects can show
-    /// through terrain less than a slab's thickness in front of it).
+    /// Quad stream: without the opaque pass, which first draws each tree's opaque front with
+    /// depth written a slab's thickness behind it, so that the depth test rejects what lies
+    /// further behind (the same image, fewer fragments shaded).
     #[arg(long)]
-    pub opaque_pass: bool,
+    pub no_opaque_pass: bool,
     /// Hybrid: trees nearer than this (metres, eye to crown centre) are drawn as full
     /// geometry; `auto`: per species, where its quad stream becomes less accurate than its
     /// triangles, i.e. where its finest quads project wider than the crossover its bake
@@ -331,7 +331,7 @@ impl MethodArgs {
             far_span: self.far_span,
             sharpen: self.sharpen_or(forest_render::options::SHARPEN_DEFAULT),
             sharpen_reach: self.sharpen_reach,
-            opaque_first: self.opaque_pass,
+            opaque_first: !self.no_opaque_pass,
         }
     }
 

@@ -367,8 +367,8 @@ fn the_geometry_renderer_draws_into_reverse_z_msaa_targets() {
 
 /// With `write_depth`, the quads leave the host their depth where they are opaque and nothing
 /// where no tree is, and the colour is the same as without it; without it, the opaque pass
-/// writes depth only where the image is opaque, and without both no depth is written at all
-/// (reverse-Z, cleared to 0).
+/// writes depth only where the image is opaque, and behind the quads' own depth there, and
+/// without both no depth is written at all (reverse-Z, cleared to 0).
 #[test]
 fn write_depth_leaves_the_trees_opaque_depth_to_the_host() {
     let ctx = common::ctx();
@@ -422,11 +422,9 @@ fn write_depth_leaves_the_trees_opaque_depth_to_the_host() {
                 p.0[3]
             );
             // With write_depth the same pass runs, and the quads' depth is written over it
-            // where they are nearer (larger in reverse-Z).
-            assert!(
-                d <= b,
-                "opaque pass depth {d} nearer than all of write_depth's {b}"
-            );
+            // where they are nearer (larger in reverse-Z): everywhere it wrote, since it writes
+            // a slab's thickness behind them.
+            assert!(d < b, "opaque pass depth {d} not behind write_depth's {b}");
             fronts += 1;
         }
     }
@@ -434,7 +432,7 @@ fn write_depth_leaves_the_trees_opaque_depth_to_the_host() {
     assert!(fronts > 0, "the opaque pass wrote no depth");
     let m = forest_metrics::compare(&blended, &plain).unwrap();
     assert!(
-        m.flip_mean < 0.01,
+        m.flip_mean < 0.001,
         "opaque pass against blended: FLIP {}",
         m.flip_mean
     );

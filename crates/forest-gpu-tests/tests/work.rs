@@ -117,7 +117,7 @@ fn the_stream_counts_its_work() {
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let off = stream.read_stats(&ctx);
     assert_eq!(off.work.passes, None);
-    assert!(off.work.dispatches > 0 && off.work.draws == 2);
+    assert!(off.work.dispatches > 0 && off.work.draws == 3);
     stream.set_pipeline_statistics(true);
     stream.render_frame(&ctx, &cam, &target).unwrap();
     let stats = stream.read_stats(&ctx);
@@ -132,9 +132,9 @@ fn the_stream_counts_its_work() {
     // final length.
     let iterations = stream.scene.tables.max_levels - 1;
     assert_eq!(w.dispatches, 5 + 3 * iterations + 1);
-    // The stream's two draws (far trees' composited quads, then the others; the opaque pass
-    // is off by default), no ground over a transparent background.
-    assert_eq!(w.draws, 2, "quads only over a transparent background");
+    // The stream's three draws (the opaque pass, far trees' composited quads, then the
+    // others), no ground over a transparent background.
+    assert_eq!(w.draws, 3, "quads only over a transparent background");
     assert!(w.bytes >= stream.scene.bytes + stream.capacity.bytes());
     let Some(p) = w.passes else {
         eprintln!(
@@ -148,10 +148,11 @@ fn the_stream_counts_its_work() {
         p[work::REFINE as usize],
         p[work::DRAW as usize],
     );
-    // Every quad is a four-vertex strip in one of the two draws (its list's): two triangles
-    // unless clipped.
-    assert_eq!(draw.vertex_invocations, 4 * u64::from(stats.quads));
-    assert!(draw.primitives > 0 && draw.primitives <= 2 * u64::from(stats.quads));
+    // Every quad is a four-vertex strip in one of the two blended draws (its list's), and
+    // every plain quad once more in the opaque pass: two triangles unless clipped.
+    let strips = u64::from(stats.quads) + u64::from(stats.quads - stats.composites);
+    assert_eq!(draw.vertex_invocations, 4 * strips);
+    assert!(draw.primitives > 0 && draw.primitives <= 2 * strips);
     // Every covered pixel was shaded at least once.
     let covered = target.read(&ctx).pixels().filter(|px| px[3] > 0).count() as u64;
     assert!(
@@ -235,7 +236,8 @@ fn every_method_counts_its_work() {
         ..Default::default()
     }));
     // The hybrid's work is both forms' work in one frame: the stream's dispatches and its
-    // two draws, the geometry's four dispatches and its draws, both renderers' memory.
+    // two draws (its quads run without the opaque pass), the geometry's four dispatches and
+    // its draws, both renderers' memory.
     let h = &hybrid.work;
     assert_eq!(h.dispatches, quads.work.dispatches + 4);
     assert_eq!(h.draws, 2 + segments);
@@ -484,7 +486,7 @@ fn far_trees_composite_their_slabs_into_one_quad() {
         .collect();
     assert!(!composited.is_empty(), "far trees are composited");
     // Their own draw only while the options can make composited quads.
-    assert_eq!((slabs.work.draws, comp.work.draws), (1, 2));
+    assert_eq!((slabs.work.draws, comp.work.draws), (2, 3));
     assert!(slab_quads.iter().all(|q| !q.composite()));
     for &tree in &composited {
         let of = |qs: &[forest_render::gpu_types::Quad]| {
@@ -544,10 +546,14 @@ fn far_trees_composite_their_slabs_into_one_quad() {
         );
     }
     if let (Some(a), Some(b)) = (work(&slabs), work(&comp)) {
-        // Fewer fragments; each quad's four vertices run once, in its own list's draw.
+        // Fewer fragments; each quad's four vertices run once in its own list's draw, and a
+        // plain quad's once more in the opaque pass.
         assert!(b.1 < a.1, "{a:?} -> {b:?}");
-        assert_eq!(a.0, 4 * u64::from(slabs.quads));
-        assert_eq!(b.0, 4 * u64::from(comp.quads));
+        let strips = |s: &forest_render::stats::FrameStats| {
+            u64::from(s.quads) + u64::from(s.quads - s.composites)
+        };
+        assert_eq!(a.0, 4 * strips(&slabs));
+        assert_eq!(b.0, 4 * strips(&comp));
     }
 }
 
@@ -789,19 +795,73 @@ fn the_sharpening_reach_shades_fewer_fragments_at_the_same_accuracy() {
     );
 }
 
-/// The opaque pass draws the image the blended quads alone draw (within FLIP 0.01 on the
-/// six test cameras and a close-up), and it rejects hidden fragments: their number at least
-/// halves. (Whether it shades fewer fragments in all depends on how much is hidden: in this
-/// sparse test forest about 3 % more, in the accuracy suite's walkthroughs 16–32 % fewer; the
-/// benchmarks report it.)
+/// The opaque pass draws the image the blended quads alone draw (within FLIP 0.001, the
+/// rounding of a blend at alpha 1 − 0.5/255, on the six test cameras and a close-up). It
+/// shades its own fragments twice, so in this sparse forest, where little lies more than a
+/// slab's thickness behind an opaque front, it shades a few per cent more; the benchmarks
+/// report the walkthroughs.
 #[test]
-fn opaque_pass_draws_the_same_image_with_fewer_fragments() {
+fn opaque_pass_draws_the_same_image() {
+    let forest = common::forest(40);
+    let side = forest.extent();
+    let mut cams = common::cameras(side);
+    cams.push((
+        "close_up",
+        common::camera(Vec3::new(3.0, 1.5, 3.0), Vec3::new(0.0, 1.5, 0.0), 1.0),
+    ));
+    let (blended, opaque) = opaque_pass_fragments(&common::species(), &forest, &cams, 0.001);
+    eprintln!("all: {opaque} fragments with the opaque pass, {blended} without");
+}
+
+/// The opaque pass rejects what lies more than a slab's thickness behind a tree's opaque
+/// front: in a thicket (200 trees at 4 m² each, atlases of 256 px whose leaves have opaque
+/// texels), seen from inside and along the horizon, it shades at most 0.95 of the fragments
+/// shaded without it (0.89 when written). The images stay within FLIP 0.01 (0.004 from
+/// inside when written): where crowns interpenetrate, the trees' presorted order is wrong at
+/// some pixels and the pass's depth test corrects it.
+#[test]
+fn opaque_pass_rejects_the_trees_behind() {
+    use forest_format::generate::{GenerateParams, generate};
+    let forest = generate(&GenerateParams {
+        trees: 200,
+        species: vec!["bush".into(), "pine".into()],
+        area_per_tree: 4.0,
+        seed: 5,
+        ..GenerateParams::default()
+    })
+    .unwrap();
+    let species = common::species_with(&forest_format::BakeParams {
+        directions: 5,
+        resolution: 256,
+        min_quad: 4,
+        spp: 4,
+        ..forest_format::BakeParams::default()
+    });
+    let cams = common::cameras(forest.extent());
+    let cams: Vec<_> = cams
+        .into_iter()
+        .filter(|(name, _)| ["inside", "horizon"].contains(name))
+        .collect();
+    let (blended, opaque) = opaque_pass_fragments(&species, &forest, &cams, 0.01);
+    assert!(
+        (opaque as f64) < 0.95 * blended as f64,
+        "{opaque} fragments with the opaque pass, {blended} without"
+    );
+}
+
+/// Fragments over `cams` without and with the opaque pass, each camera's two images within
+/// FLIP `max_flip` (written on failure), counting leaving each image unchanged.
+fn opaque_pass_fragments(
+    species: &[forest_render::SpeciesData],
+    forest: &forest_format::forest::Forest,
+    cams: &[(&str, forest_render::Camera)],
+    max_flip: f32,
+) -> (u64, u64) {
     use forest_render::fragments::{FragmentCounter, count_fragments};
     use forest_render::options::StreamOptions;
 
     let ctx = common::ctx();
-    let forest = common::forest(40);
-    let scene = GpuScene::new(&ctx, &common::species(), &forest).unwrap();
+    let scene = GpuScene::new(&ctx, species, forest).unwrap();
     let size = (160, 120);
     let opts = RendererOptions {
         viewport: size,
@@ -833,23 +893,16 @@ fn opaque_pass_draws_the_same_image_with_fewer_fragments() {
         assert!(image == target.read(&ctx), "counting changed the image");
         (image, counts.summary())
     };
-    let side = forest.extent();
-    let mut cams = common::cameras(side);
-    cams.push((
-        "close_up",
-        common::camera(Vec3::new(3.0, 1.5, 3.0), Vec3::new(0.0, 1.5, 0.0), 1.0),
-    ));
     let (mut blended_all, mut opaque_all) = (0u64, 0u64);
-    let (mut hidden_before, mut hidden_after) = (0.0, 0.0);
     for (name, cam) in cams {
-        let (blended, b) = frame(false, &cam);
-        let (opaque, o) = frame(true, &cam);
+        let (blended, b) = frame(false, cam);
+        let (opaque, o) = frame(true, cam);
         let m = forest_metrics::compare(&blended, &opaque).unwrap();
         eprintln!(
-            "{name}: fragments {} blended, {} with the opaque pass; hidden {:.3} → {:.3}; FLIP {:.4}",
-            b.fragments, o.fragments, b.hidden_share, o.hidden_share, m.flip_mean
+            "{name}: fragments {} blended, {} with the opaque pass; FLIP {:.5}",
+            b.fragments, o.fragments, m.flip_mean
         );
-        if m.flip_mean > 0.01 {
+        if m.flip_mean > max_flip {
             let out = common::failure_images(&format!("opaque-{name}"), &blended, &opaque);
             panic!(
                 "{name}: opaque pass against blended FLIP {} (images in {})",
@@ -859,12 +912,6 @@ fn opaque_pass_draws_the_same_image_with_fewer_fragments() {
         }
         blended_all += b.fragments;
         opaque_all += o.fragments;
-        hidden_before += b.hidden_share * b.fragments as f64;
-        hidden_after += o.hidden_share * o.fragments as f64;
     }
-    eprintln!("all: {opaque_all} fragments with the opaque pass, {blended_all} without");
-    assert!(
-        hidden_after < 0.5 * hidden_before,
-        "hidden fragments {hidden_after} with the opaque pass, {hidden_before} without"
-    );
+    (blended_all, opaque_all)
 }

@@ -304,7 +304,6 @@ const FLAG_DEPTH_ERROR: u32 = 4u;
 const FLAG_UNTRIMMED: u32 = 8u;
 const FLAG_FAR_BLEND: u32 = 16u;
 const FLAG_FAR_SLABS: u32 = 32u;
-const FLAG_OPAQUE_FIRST: u32 = 64u;
 // Bits 8–19 of the flags: aspect sharpening in units of 1/WEIGHT_ONE (StreamOptions::sharpen).
 const SHARPEN_SHIFT: u32 = 8u;
 const SHARPEN_MASK: u32 = 4095u;

@@ -25,9 +25,11 @@
 // ordering comes from the stream and blending needs no depth writes; writing depth would make
 // semi-transparent quads hide what is drawn after them behind their transparent parts. The
 // quads are still depth-tested against the opaque ground drawn first, so trees are hidden by
-// hills and the ground hides the parts of slabs below it. The opaque pass (FLAG_OPAQUE_FIRST,
-// vs_quad_opaque) writes depth only where a fragment is opaque, before every blended quad:
-// what lies behind such a fragment would have been covered by it.
+// hills and the ground hides the parts of slabs below it. The opaque pass (vs_quad_opaque,
+// StreamOptions::opaque_first), before every blended quad, writes depth only where a fragment
+// is opaque, and a slab's thickness behind it: what lies further behind would have been
+// covered by it, and what lies nearer (the tree's other aspects, which blend over it, and the
+// fragment itself, drawn again) is drawn as without the pass.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -209,42 +211,22 @@ fn node_min_extent(sp: Species, f: Frame, inst: Instance, slab: u32, x: f32, y: 
 // are.
 @vertex
 fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
-    return plain_quad(vi, qi, (stream_flags(camera) & FLAG_OPAQUE_FIRST) != 0u);
-}
-
-// The plain quads for the host's depth (fs_quad_depth): each at its own depth.
-@vertex
-fn vs_quad_host_depth(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
-    return plain_quad(vi, qi, false);
-}
-
-// Corner `vi` of plain quad `qi`. `pushed`: after the opaque pass, a tree's later aspects of
-// its front slab blend over its first aspect, whose opaque texels that pass has drawn with
-// depth, so they are tested a slab's thickness nearer (a uniform scale about the eye keeps
-// every point on its pixel and the interpolation unchanged) and the depth test keeps them.
-fn plain_quad(vi: u32, qi: u32, pushed: bool) -> QuadOut {
     let i = kept_composites(state.composites, state.overflow_cull) + qi;
     let v = quad_vertex(vi, i, true);
-    var clip = v.clip;
-    let q = quads[i];
-    if (pushed && quad_slab(q) == 0u && quad_lo(q) > 0u) {
-        // v.tree: the tree's bounding sphere in world space.
-        let slabs = species[instances[q.instance].species].slabs;
-        let reach = distance(v.tree.xyz, camera.eye.xyz);
-        let push = 2.0 * v.tree.w / f32(max(slabs, 1u));
-        let s = max(1.0 - push / max(reach, 1e-6), 0.5);
-        clip = camera.view_proj * vec4<f32>(camera.eye.xyz + (v.world - camera.eye.xyz) * s, 1.0);
-    }
-    return QuadOut(clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
+    return QuadOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
                    v.sun_vis, v.tree);
 }
 
-// The opaque pass (FLAG_OPAQUE_FIRST), before every blended quad: the plain quads of each
-// tree's first aspect in its front slab (the aspect drawn with alpha 1, which the others blend
-// over), front to back (the stream reversed), their opaque fragments drawn with depth written
-// a little nearer than the blended draw's, so that the depth test rejects what they hide:
-// the same fragments again, the tree's back slab, and the trees behind. Other quads collapse
-// to a point outside the view.
+// The opaque pass, before every blended quad: the plain quads of each tree's first aspect in
+// its front slab (the aspect drawn with alpha 1, which the others blend over), front to back
+// (the stream reversed), their opaque fragments drawn with depth written a slab's thickness
+// behind them, so that the depth test rejects what lies further behind: most of the tree's
+// back slab and the trees behind. The tree's other front-slab aspects lie within that
+// thickness and still blend over the fragment, which the blended draw draws again (the same
+// colour at alpha 1). Nothing moves nearer than its surface, so terrain and a host's geometry
+// hide what they hid without the pass; where they lie within the thickness behind a fragment,
+// the pass's fragment fails the depth test and the blended draw alone draws it. Other quads
+// collapse to a point outside the view.
 @vertex
 fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> QuadOut {
     // The plain list is [kept composites, n): instance qi is its (qi + 1)-th quad from the end.
@@ -258,13 +240,17 @@ fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u
     if (share < OPAQUE_SHARE_MIN) { return out; }
     let v = quad_vertex(vi, i, true);
     if (v.share.w < WEIGHT_ONE) { return out; }
-    // Nearer by OPAQUE_PULL of the distance: a uniform scale about the eye.
-    let p = camera.eye.xyz + (v.world - camera.eye.xyz) * (1.0 - OPAQUE_PULL);
+    // Behind its surface by the tree's slab thickness (2r / slabs): a uniform scale about the
+    // eye, at most doubling the distance, keeps every point on its pixel and the
+    // interpolation unchanged.
+    let slabs = species[instances[q.instance].species].slabs;
+    let reach = distance(v.tree.xyz, camera.eye.xyz);
+    let push = 2.0 * v.tree.w / f32(max(slabs, 1u));
+    let p = camera.eye.xyz + (v.world - camera.eye.xyz) * (1.0 + push / max(reach, push));
     return QuadOut(camera.view_proj * vec4<f32>(p, 1.0), v.uv, v.ids, v.alpha, v.share, v.world,
                    v.frame_right, v.frame_up, v.sun_vis, v.tree);
 }
-// Mirrors passes::draw::OPAQUE_PULL and OPAQUE_SHARE_MIN.
-const OPAQUE_PULL: f32 = 0.0009765625;
+// Mirrors passes::draw::OPAQUE_SHARE_MIN.
 const OPAQUE_SHARE_MIN: u32 = 128u;
 
 @vertex
@@ -478,8 +464,10 @@ fn quad_colour(in: QuadOut) -> vec4<f32> {
 fn fs_quad_opaque(in: QuadOut) -> @location(0) vec4<f32> {
     count_enter(in.clip);
     let out = quad_colour(in);
-    // The rest is drawn by fs_quad, blended.
-    if (out.a < OPAQUE_FRAGMENT) { discard; }
+    // The rest is drawn by fs_quad, blended. Pushed back, the quad reaches past the near
+    // plane where the blended draw's is clipped: only what that draw shows is drawn here.
+    let own = camera.view_proj * vec4<f32>(in.world, 1.0);
+    if (out.a < OPAQUE_FRAGMENT || own.w <= 0.0 || own.z < 0.0 || own.z > own.w) { discard; }
     count_shown(in.clip, out.a);
     count_depth(in.clip);
     return out;

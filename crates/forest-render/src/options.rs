@@ -232,15 +232,14 @@ pub struct StreamOptions {
     /// measurements under "The sharpening reach" in docs/rendering.md. Off with
     /// [`Self::far_nearest`] off (the paper's blend of every tree).
     pub sharpen_reach: u32,
-    /// The opaque pass (off by default; with [`AspectBlend::Over`] only): before the blended
+    /// The opaque pass (on by default; with [`AspectBlend::Over`] only): before the blended
     /// quads, each tree's first aspect in its front slab draws its mostly opaque nodes front to
-    /// back, their opaque fragments with depth written, so that the depth test rejects what
-    /// they hide (the same fragments again, the tree's back slab, the trees behind), and the
-    /// tree's other aspects in its front slab are tested a slab's thickness nearer, so that
-    /// they still blend over it. It writes depth into the host's depth target. Off by default
-    /// because that push lets those aspects show through opaque terrain or host geometry
-    /// that lies less than a slab's thickness in front of the tree; see "The opaque pass" in
-    /// docs/rendering.md.
+    /// back, their opaque fragments with depth written a slab's thickness behind their
+    /// surface, so that the depth test rejects what lies further behind (the tree's back
+    /// slab, the trees behind), which those fragments would cover. The blended draw moves
+    /// nothing, so it draws the same image as without the pass (the same fragments shaded
+    /// again, over what is left behind them). It writes that depth into the host's depth
+    /// target; see "The opaque pass" in docs/rendering.md.
     pub opaque_first: bool,
 }
 
@@ -255,7 +254,7 @@ impl Default for StreamOptions {
             far_span: FAR_SPAN_DEFAULT,
             sharpen: SHARPEN_DEFAULT,
             sharpen_reach: SHARPEN_REACH_DEFAULT,
-            opaque_first: false,
+            opaque_first: true,
         }
     }
 }
@@ -302,8 +301,6 @@ pub const FLAG_UNTRIMMED: u32 = 8;
 pub const FLAG_FAR_BLEND: u32 = 16;
 /// See [`FLAG_DITHER`].
 pub const FLAG_FAR_SLABS: u32 = 32;
-/// See [`FLAG_DITHER`].
-pub const FLAG_OPAQUE_FIRST: u32 = 64;
 
 impl StreamOptions {
     /// Write these options into a camera uniform: the flags to `viewport.w`, the far span to
@@ -364,11 +361,6 @@ impl StreamOptions {
                 0
             } else {
                 FLAG_FAR_SLABS
-            }
-            | if self.opaque_pass() {
-                FLAG_OPAQUE_FIRST
-            } else {
-                0
             }
             | self.sharpen.min(SHARPEN_MAX) << SHARPEN_SHIFT
             | self.sharpen_reach.clamp(1, SHARPEN_REACH_MAX) << REACH_SHIFT

@@ -1069,8 +1069,9 @@ impl QuadStream {
 
     /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
     /// or an earlier encoder of the submission): back to front, blended, depth-tested, no
-    /// depth written, after the opaque pass ([`StreamOptions::opaque_first`]), which writes
-    /// the depth of the trees' opaque fronts.
+    /// depth written, after the opaque pass ([`StreamOptions::opaque_first`], on by default),
+    /// which writes depth where the trees' fronts are opaque, a slab's thickness behind them
+    /// (so the host's depth attachment must be writable while it runs).
     pub fn render(&self, pass: &mut wgpu::RenderPass) {
         self.record_draw(pass, false);
     }

@@ -169,7 +169,7 @@ fn constants_shared_with_the_wgsl_agree() {
     use forest_render::options::{self, DebugView, FLAG_DEPTH_ERROR, FLAG_DITHER, FLAG_NEAREST};
     let c = compute_source();
     let d = draw_source();
-    let pairs: [(&str, &str, f64); 20] = [
+    let pairs: [(&str, &str, f64); 19] = [
         (&c, "WG", f64::from(forest_render::capacity::WG)),
         (&c, "BLOCK", f64::from(forest_render::capacity::BLOCK)),
         (&c, "WEIGHT_ONE", f64::from(WEIGHT_ONE)),
@@ -178,11 +178,6 @@ fn constants_shared_with_the_wgsl_agree() {
         (&c, "FLAG_DEPTH_ERROR", f64::from(FLAG_DEPTH_ERROR)),
         (&c, "FLAG_FAR_BLEND", f64::from(options::FLAG_FAR_BLEND)),
         (&c, "FLAG_FAR_SLABS", f64::from(options::FLAG_FAR_SLABS)),
-        (
-            &c,
-            "FLAG_OPAQUE_FIRST",
-            f64::from(options::FLAG_OPAQUE_FIRST),
-        ),
         (&c, "SHARPEN_SHIFT", f64::from(options::SHARPEN_SHIFT)),
         (&c, "SHARPEN_MASK", f64::from(options::SHARPEN_MASK)),
         (&c, "SHARPEN_MAX", f64::from(options::SHARPEN_MAX)),
@@ -215,18 +210,11 @@ fn constants_shared_with_the_wgsl_agree() {
         f64::from(forest_render::passes::draw::DEPTH_WRITE_ALPHA),
         "DEPTH_WRITE_ALPHA"
     );
-    for (name, rust) in [
-        (
-            "OPAQUE_SHARE_MIN",
-            f64::from(forest_render::passes::draw::OPAQUE_SHARE_MIN),
-        ),
-        (
-            "OPAQUE_PULL",
-            f64::from(forest_render::passes::draw::OPAQUE_PULL),
-        ),
-    ] {
-        assert_eq!(layout_check::wgsl_const(&d, name), rust, "{name}");
-    }
+    assert_eq!(
+        layout_check::wgsl_const(&d, "OPAQUE_SHARE_MIN"),
+        f64::from(forest_render::passes::draw::OPAQUE_SHARE_MIN),
+        "OPAQUE_SHARE_MIN"
+    );
     for (name, view) in [
         ("DEBUG_LEVELS", DebugView::Levels),
         ("DEBUG_WEIGHTS", DebugView::Weights),
