@@ -91,5 +91,10 @@ fn geo_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= geo_consts.x) { return; }
     let key = keys[i];
     if (key == NONE) { return; }
-    visible_list[atomicAdd(&cursor[key], 1u)] = i;
+    // The order bin its triangles are drawn in (geometry_draw.wgsl's draw_vertex), once per
+    // tree here rather than per vertex there.
+    let inst = instances[i];
+    let centre = to_world(inst, geo_species[inst.species].sphere.xyz);
+    let bin = order_bin(to_object_dir(inst, centre - camera.eye.xyz));
+    visible_list[atomicAdd(&cursor[key], 1u)] = i | (bin << VISIBLE_ID_BITS);
 }

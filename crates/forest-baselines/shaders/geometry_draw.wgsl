@@ -31,6 +31,10 @@
 // Every species' opacity volume, stacked (forest_render::opacity), and its clamping sampler.
 @group(0) @binding(14) var opacity: texture_3d<f32>;
 @group(0) @binding(15) var opacity_sampler: sampler;
+// The triangles' presorted draw orders (forest_baselines::geometry::draw_orders): for
+// view-direction bin k, entry k·T + t is the triangle drawn t-th, T = every species' LODs'
+// triangles (the vertices' count / 3).
+@group(0) @binding(16) var<storage, read> draw_order: array<u32>;
 
 struct GeoOut {
     @builtin(position) clip: vec4<f32>,
@@ -72,12 +76,24 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     return geo_vertex(vi, ii, true);
 }
 
+// The vertex a tree draws `vi`-th, its listed entry's order bin `bin` (visible_entry).
+// Depth-sorted (not under stochastic simplification, whose draws are prefixes of its shuffled
+// leaves), each triangle comes from the presorted order of that bin, nearest leaves first, so
+// that the depth test rejects what they hide before it is shaded; the image is the same.
+fn draw_vertex(vi: u32, bin: u32) -> u32 {
+    if (method.depth_sort == 0u || method.mode == 1u) { return vi; }
+    let triangles = arrayLength(&vertices) / 3u;
+    let t = draw_order[bin * triangles + vi / 3u];
+    return 3u * t + vi % 3u;
+}
+
 // Vertex `vi` of listed tree `ii`; `shaded`: with the march towards the sun (the draw), or
 // without (the light views' casting pass, geometry_cast.wgsl).
 fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
-    let id = visible_list[ii];
+    let entry = visible_list[ii];
+    let id = entry & VISIBLE_ID_MASK;
     let inst = instances[id];
-    let v = vertices[vi];
+    let v = vertices[draw_vertex(vi, entry >> VISIBLE_ID_BITS)];
     var p = v.pos;
     var contrast = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     if (method.mode == 1u && v.element != NONE) {
@@ -174,7 +190,7 @@ struct BillboardOut {
 @vertex
 fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32)
     -> BillboardOut {
-    let id = visible_list[ii];
+    let id = visible_list[ii] & VISIBLE_ID_MASK;
     let inst = instances[id];
     let sp = geo_species[inst.species];
     let c = to_world(inst, sp.sphere.xyz);

@@ -55,6 +55,8 @@ struct GeoSpecies {
 struct Method {
     // 0: full geometry, 1: stochastic simplification, 2: discrete LODs + billboards.
     mode: u32,
+    // Nearest distance bands first (full geometry) and each tree's triangles in their
+    // presorted front-to-back order (full geometry, LODs).
     depth_sort: u32,
     area: u32,
     contrast: u32,
@@ -70,6 +72,25 @@ struct Method {
 }
 
 const BANDS: u32 = 16u;
+
+// A visible-list entry (geometry.wgsl's geo_scatter): the instance's index in its low
+// VISIBLE_ID_BITS bits (forest_format::forest::MAX_INSTANCES fits), the order bin of the
+// direction from the view's eye to it (order_bin) above them.
+const VISIBLE_ID_BITS: u32 = 24u;
+const VISIBLE_ID_MASK: u32 = 0xFFFFFFu;
+
+// The bin of the object-space direction `v` from the eye to a tree (mirrors
+// forest_baselines::geometry::order_bin): 8 azimuths × 3 elevation bands.
+fn order_bin(v: vec3<f32>) -> u32 {
+    let len = length(v);
+    var u = vec3<f32>(1.0, 0.0, 0.0);
+    if (len > 1e-12) { u = v / len; }
+    let turns = atan2(u.z, u.x) / 6.283185307;
+    let azimuth = u32(floor(turns * 8.0 + 8.5)) % 8u;
+    var band = 1u;
+    if (u.y < -0.5) { band = 0u; } else if (u.y > 0.5) { band = 2u; }
+    return band * 8u + azimuth;
+}
 
 fn lod_lambda(m: Method, d: f32) -> f32 {
     if (d <= m.d0) { return 1.0; }

@@ -44,7 +44,9 @@ pub const FINEST_TEXTURES: f32 = -16.0;
 pub struct GpuMethod {
     /// 0 full geometry, 1 stochastic simplification, 2 discrete LODs + billboards.
     pub mode: u32,
-    /// Full geometry: draw the nearest distance bands first (0/1).
+    /// Full geometry: draw the nearest distance bands first (0/1). Full geometry and the
+    /// LODs: draw each tree's triangles in the presorted order of its view direction (0/1;
+    /// ignored under stochastic simplification).
     pub depth_sort: u32,
     /// Stochastic: area preservation on (0/1).
     pub area: u32,

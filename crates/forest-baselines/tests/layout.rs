@@ -142,6 +142,15 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
         layout_check::wgsl_const(&cull, "BANDS"),
         f64::from(forest_format::model::BANDS)
     );
+    let bits = forest_baselines::geometry::VISIBLE_ID_BITS;
+    assert_eq!(
+        layout_check::wgsl_const(&cull, "VISIBLE_ID_BITS"),
+        f64::from(bits)
+    );
+    assert_eq!(
+        layout_check::wgsl_const(&cull, "VISIBLE_ID_MASK"),
+        f64::from((1u32 << bits) - 1)
+    );
     for (entry, size) in layout_check::workgroup_sizes(&cull) {
         let want = match entry.as_str() {
             "geo_reset" => RESET_WG,

@@ -221,7 +221,8 @@ pub struct MethodArgs {
     /// Draw --models that are not the files their atlases were baked from (each is named on stderr)
     #[arg(long)]
     pub allow_other_models: bool,
-    /// Full geometry: draw trees in submission order instead of nearest distance band first.
+    /// Full geometry: draw trees in submission order instead of nearest distance band first,
+    /// and each tree's triangles in the model's order instead of front to back.
     #[arg(long)]
     pub unsorted: bool,
     /// Stochastic: distance (m, per unit tree scale) within which every leaf is drawn.

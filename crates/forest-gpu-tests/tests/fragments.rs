@@ -442,6 +442,97 @@ fn cut_cards_shade_fewer_fragments_at_the_same_accuracy() {
     );
 }
 
+/// Each tree's triangles drawn in the presorted order of its view direction
+/// (`geometry::draw_orders`, on with depth sorting) against the model's own order: the same
+/// image, fewer fragments shaded. One pine, rotated so that its bins are not the world's,
+/// seen at 2.5 crown radii from 8 azimuths, level with its centre and from 50° above and
+/// below, by full geometry and by the LODs at LOD 0. A vertex stage that picked its bin by
+/// another convention than `order_bin`'s would draw back to front from some of them.
+#[test]
+fn presorted_triangles_shade_fewer_fragments_for_the_same_image() {
+    let ctx = common::ctx();
+    let forest = common::one_tree(1, 0.7);
+    let sphere = common::atlases()[1].manifest.bounding_sphere;
+    let mut r = common::forest_renderer(
+        &ctx,
+        &common::species(),
+        common::prepared(),
+        &forest,
+        (160, 120),
+        Background::Transparent,
+        Default::default(),
+    );
+    let target = Target::new(&ctx, 160, 120);
+    let mut totals = [0u64; 2];
+    for k in 0..24 {
+        let azimuth = (k % 8) as f32 * std::f32::consts::FRAC_PI_4 + 0.2;
+        let elevation = [-50f32, 0.0, 50.0][k / 8].to_radians();
+        let dir = Vec3::new(
+            elevation.cos() * azimuth.cos(),
+            elevation.sin(),
+            elevation.cos() * azimuth.sin(),
+        );
+        let cam = common::camera(
+            sphere.center + dir * 2.5 * sphere.radius,
+            sphere.center,
+            2.0,
+        );
+        for (unsorted, sorted) in [
+            (
+                MeshMethod::Full { depth_sort: false },
+                MeshMethod::Full { depth_sort: true },
+            ),
+            (
+                MeshMethod::Stochastic(Stochastic {
+                    d0: 1e6,
+                    ..Default::default()
+                }),
+                MeshMethod::Lods(Lods {
+                    distances: [1e5, 2e5, 3e5],
+                }),
+            ),
+        ] {
+            let mut frame = |method: MeshMethod| {
+                r.set_method(&ctx, Method::Mesh(method)).unwrap();
+                let counts = r.count_fragments(&ctx, &cam, &target).unwrap();
+                assert_eq!(ctx.take_errors(), Vec::<String>::new(), "{method:?}");
+                (target.read(&ctx), counts.summary().fragments)
+            };
+            let (a, fa) = frame(unsorted);
+            let (b, fb) = frame(sorted);
+            let name = format!("{sorted:?} view {k}");
+            assert!(
+                a.pixels().filter(|p| p[3] > 0).count() > 300,
+                "{name}: tree in view"
+            );
+            let flip = forest_metrics::compare(&a, &b).unwrap().flip_mean;
+            if flip > 0.001 {
+                let out = common::failure_images(&format!("presorted-{k}"), &a, &b);
+                panic!(
+                    "{name}: FLIP {flip} against the model's order (images in {})",
+                    out.display()
+                );
+            }
+            assert!(
+                fb < fa,
+                "{name}: {fb} fragments presorted, {fa} in the model's order"
+            );
+            totals[0] += fa;
+            totals[1] += fb;
+        }
+    }
+    eprintln!(
+        "fragments in the model's order {}, presorted {}",
+        totals[0], totals[1]
+    );
+    assert!(
+        (totals[1] as f64) < 0.85 * totals[0] as f64,
+        "presorted {} fragments against {}",
+        totals[1],
+        totals[0]
+    );
+}
+
 #[test]
 fn a_counter_too_large_for_the_device_is_refused_before_allocating() {
     let ctx = common::ctx();

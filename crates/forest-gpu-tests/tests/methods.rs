@@ -110,15 +110,27 @@ fn maximum_detail_draws_exactly_the_full_geometry() {
     });
     let lod_zero = draw(&ctx, &mut geo, lod0, &cam);
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
-    for (name, img) in [
-        ("depth-sorted", &sorted),
-        ("stochastic λ=1", &lambda_one),
-        ("LOD 0", &lod_zero),
+    // Stochastic simplification keeps the model's triangle order; LOD 0 draws each tree's
+    // triangles in their presorted order, as depth-sorted full geometry does.
+    for (name, img, against) in [
+        ("stochastic λ=1", &lambda_one, &full),
+        ("LOD 0", &lod_zero, &sorted),
     ] {
-        if img != &full {
-            save_on_failure("max-detail", &[("full", &full), (name, img)]);
+        if img != against {
+            save_on_failure("max-detail", &[("full", against), (name, img)]);
             panic!("{name} differs from the full geometry");
         }
+    }
+    // Another triangle order changes only where two surfaces meet at the same depth, which
+    // the first drawn wins.
+    let differing = full
+        .pixels()
+        .zip(sorted.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    if differing * 1000 > covered(&full) {
+        save_on_failure("max-detail", &[("full", &full), ("depth-sorted", &sorted)]);
+        panic!("depth-sorted full geometry differs in {differing} pixels");
     }
 
     // Controls: real simplification changes the image and draws fewer triangles, yet stays

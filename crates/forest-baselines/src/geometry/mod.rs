@@ -7,7 +7,8 @@
 //!   ─► lod::build_lods (LOD 0 = every triangle, leaves shuffled; LODs 1, 2) + billboards
 //!   ─► the atlas's model.bin (forest_format::model), gathered by PreparedGeometry
 //! per frame: geo_reset ─► geo_classify (frustum, distance band) ─► geo_args (offsets,
-//!   indirect arguments per band × species) ─► geo_scatter ─► draw bands nearest first
+//!   indirect arguments per band × species) ─► geo_scatter ─► draw bands nearest first,
+//!   each tree's triangles in the presorted order of its view direction (order.rs)
 //! ```
 //! The method is a uniform: [`GeometryRenderer::set_method`] switches at run time without
 //! rebuilding anything. Every tree is shaded with `forest_format::shading` in its object
@@ -17,6 +18,7 @@ mod cards;
 mod layout;
 mod light;
 mod models;
+mod order;
 mod params;
 mod prepare;
 mod renderer;
@@ -25,6 +27,9 @@ mod textures;
 pub use forest_format::model::BILLBOARD_RESOLUTION;
 pub use layout::{COMPUTE_SLOTS, compute_entries, draw_entries};
 pub use models::GpuModels;
+pub use order::{
+    ORDER_BINS, VIRTUAL_EYE_RADII, VISIBLE_ID_BITS, bin_direction, draw_orders, order_bin,
+};
 pub use params::{GeometrySpecies, GeometryStats, Lods, MeshMethod, SpeciesFigures, Stochastic};
 pub use prepare::{Cards, PreparedGeometry};
 pub use renderer::{GeometryRenderer, RESET_WG};

@@ -25,6 +25,9 @@ pub struct GpuModels {
     pub(super) consts: wgpu::Buffer,
     pub(super) leaf_end: wgpu::Buffer,
     pub(super) vertices: wgpu::Buffer,
+    /// The triangles' presorted draw orders, one per view-direction bin
+    /// ([`super::order::draw_orders`]).
+    pub(super) draw_order: wgpu::Buffer,
     pub(super) materials: wgpu::Buffer,
     pub(super) material_view: wgpu::TextureView,
     pub(super) sampler: wgpu::Sampler,
@@ -66,6 +69,7 @@ impl GpuModels {
             leaf_end,
             leaf_centre,
             opacity,
+            draw_order,
             figures,
         } = prepared;
         if geo_species.len() != forest.species.len() {
@@ -109,6 +113,11 @@ impl GpuModels {
         let vertex_buf = init(
             "geometry vertices",
             bytemuck::cast_slice(vertices),
+            U::STORAGE,
+        );
+        let draw_order_buf = init(
+            "geometry draw orders",
+            bytemuck::cast_slice(draw_order),
             U::STORAGE,
         );
         let material_buf = init(
@@ -175,6 +184,7 @@ impl GpuModels {
             consts,
             leaf_end: leaf_end_buf,
             vertices: vertex_buf,
+            draw_order: draw_order_buf,
             materials: material_buf,
             material_view,
             sampler,

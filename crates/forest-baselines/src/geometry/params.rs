@@ -161,6 +161,8 @@ impl MeshMethod {
             },
             MeshMethod::Lods(l) => GpuMethod {
                 mode: 2,
+                // Each tree's triangles in their presorted front-to-back order.
+                depth_sort: 1,
                 lod: [l.distances[0], l.distances[1], l.distances[2], 0.0],
                 ..Default::default()
             },

@@ -36,6 +36,9 @@ pub struct PreparedGeometry {
     pub(super) leaf_end: Vec<u32>,
     pub(super) leaf_centre: Vec<[f32; 4]>,
     pub(super) opacity: Vec<OpacityVolume>,
+    /// The triangles' presorted draw orders ([`super::order::draw_orders`]): every species'
+    /// LODs sorted within themselves for each view-direction bin.
+    pub(super) draw_order: Vec<u32>,
     /// Per-species figures.
     pub figures: Vec<SpeciesFigures>,
 }
@@ -60,6 +63,7 @@ impl PreparedGeometry {
         let mut leaf_centre: Vec<[f32; 4]> = Vec::new();
         let mut figures = Vec::new();
         let mut opacity = Vec::new();
+        let mut ranges = Vec::new();
         for s in species {
             let mut cards_cut = 0;
             let cut;
@@ -108,6 +112,11 @@ impl PreparedGeometry {
                 opacity_depth: m.opacity.max_depth,
                 pad: [0; 3],
             });
+            let mut start = first as usize;
+            for c in counts {
+                ranges.push((m.sphere, start..start + c as usize));
+                start += c as usize;
+            }
             opacity.push(m.opacity.clone());
             leaf_end.extend(&m.leaf_end);
             leaf_centre.extend(m.leaf_centre.iter().map(|c| [c[0], c[1], c[2], 0.0]));
@@ -136,7 +145,14 @@ impl PreparedGeometry {
                     + 2 * layer_bytes(&billboard_layers[billboards_base..]),
             });
         }
+        let draw_order = super::order::draw_orders(&vertices, &ranges);
+        let orders_per_triangle = u64::from(super::order::ORDER_BINS) * 4;
+        for (f, s) in figures.iter_mut().zip(&geo_species) {
+            let triangles: u64 = s.lod_count[..3].iter().map(|&c| u64::from(c) / 3).sum();
+            f.model_bytes += triangles * orders_per_triangle;
+        }
         Self {
+            draw_order,
             vertices,
             geo_species,
             materials,

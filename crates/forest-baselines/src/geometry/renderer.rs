@@ -178,6 +178,7 @@ impl Shared {
             ),
             (14, wgpu::BindingResource::TextureView(&m.opacity_view)),
             (15, wgpu::BindingResource::Sampler(&m.opacity_sampler)),
+            (16, m.draw_order.as_entire_binding()),
         ];
         let draw_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(label),

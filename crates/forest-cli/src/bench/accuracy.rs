@@ -469,12 +469,19 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
         .filter(|v| view_names.iter().any(|n| n == *v))
         .map(|&view| {
             let rows: Vec<&Vec<String>> = table.rows.iter().filter(|r| r[2] == view).collect();
-            format!(
-                "In `{view}`, the hybrid with its automatic switch: {}. Fragments shaded per \
-                 covered pixel, each method at its default setting: {}.",
-                hybrid_against_quads(&rows, &cell),
+            // A run without the hybrid or the quad stream (`--methods`) has no comparison.
+            let against = hybrid_against_quads(&rows, &cell);
+            let fragments = format!(
+                "ragments shaded per covered pixel, each method at its default setting: {}.",
                 fragments_per_pixel(&rows)
-            )
+            );
+            if against.is_empty() {
+                format!("In `{view}`, f{fragments}")
+            } else {
+                format!(
+                    "In `{view}`, the hybrid with its automatic switch: {against}. F{fragments}"
+                )
+            }
         })
         .collect();
     let (real_trees, area) = real_scene(b);
