@@ -76,7 +76,7 @@ fn vs_geo(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> G
     return geo_vertex(vi, ii, true);
 }
 
-// The vertex a tree draws `vi`-th, its listed entry's order bin `bin` (visible_entry).
+// The vertex a tree draws `vi`-th, `bin` the order bin of its visible-list entry (geo_scatter).
 // Depth-sorted (not under stochastic simplification, whose draws are prefixes of its shuffled
 // leaves), each triangle comes from the presorted order of that bin, nearest leaves first, so
 // that the depth test rejects what they hide before it is shaded; the image is the same.

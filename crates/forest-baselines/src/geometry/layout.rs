@@ -79,7 +79,7 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
             ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             count: None,
         },
-        // The triangles' presorted draw orders, read by `draw_triangle`.
+        // The triangles' presorted draw orders, read by `draw_vertex`.
         buffer(16, S::VERTEX, read),
     ]
 }

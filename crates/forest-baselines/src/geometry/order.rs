@@ -5,8 +5,8 @@
 //! the cull pass's scatter picks the bin of the direction from the eye to the tree
 //! (`order_bin` in `shaders/geometry_types.wgsl`, mirrored by [`order_bin`]) and stores it
 //! in the tree's visible-list entry, and the vertex stage draws that bin's order
-//! (`draw_vertex` in `shaders/geometry_draw.wgsl`). Any order draws the same image (the leaves are alpha-tested and opaque);
-//! only the fragments shaded and rejected change.
+//! (`draw_vertex` in `shaders/geometry_draw.wgsl`). Any order draws the same image (the
+//! leaves are alpha-tested and opaque); only the fragments shaded and rejected change.
 
 use forest_format::model::RefVertex;
 use glam::Vec3;
@@ -29,7 +29,7 @@ const _: () = assert!(
 pub const VIRTUAL_EYE_RADII: f32 = 3.0;
 
 /// The bin of the object-space direction `v` from the eye towards the tree (any length; a
-/// zero vector falls in bin 0's band of azimuth 0): azimuth `atan2(z, x)` rounded to the
+/// zero vector falls in bin 8, level and at azimuth 0): azimuth `atan2(z, x)` rounded to the
 /// nearest of 8, elevation band 0 below −30°, 1 within ±30°, 2 above.
 pub fn order_bin(v: Vec3) -> u32 {
     let len = v.length();

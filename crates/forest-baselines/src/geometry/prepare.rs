@@ -142,15 +142,14 @@ impl PreparedGeometry {
                     as u64
                     + u64::from(VOLUME_RESOLUTION).pow(3)
                     + layer_bytes(&layers[layer_base as usize..])
-                    + 2 * layer_bytes(&billboard_layers[billboards_base..]),
+                    + 2 * layer_bytes(&billboard_layers[billboards_base..])
+                    // Its triangles' presorted draw orders, one u32 per bin.
+                    + (vertices.len() - vertices_base) as u64 / 3
+                        * u64::from(super::order::ORDER_BINS)
+                        * 4,
             });
         }
         let draw_order = super::order::draw_orders(&vertices, &ranges);
-        let orders_per_triangle = u64::from(super::order::ORDER_BINS) * 4;
-        for (f, s) in figures.iter_mut().zip(&geo_species) {
-            let triangles: u64 = s.lod_count[..3].iter().map(|&c| u64::from(c) / 3).sum();
-            f.model_bytes += triangles * orders_per_triangle;
-        }
         Self {
             draw_order,
             vertices,

@@ -471,15 +471,16 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
             let rows: Vec<&Vec<String>> = table.rows.iter().filter(|r| r[2] == view).collect();
             // A run without the hybrid or the quad stream (`--methods`) has no comparison.
             let against = hybrid_against_quads(&rows, &cell);
-            let fragments = format!(
-                "ragments shaded per covered pixel, each method at its default setting: {}.",
-                fragments_per_pixel(&rows)
-            );
+            let fragments = fragments_per_pixel(&rows);
             if against.is_empty() {
-                format!("In `{view}`, f{fragments}")
+                format!(
+                    "In `{view}`, fragments shaded per covered pixel, each method at its default \
+                     setting: {fragments}."
+                )
             } else {
                 format!(
-                    "In `{view}`, the hybrid with its automatic switch: {against}. F{fragments}"
+                    "In `{view}`, the hybrid with its automatic switch: {against}. Fragments \
+                     shaded per covered pixel, each method at its default setting: {fragments}."
                 )
             }
         })
