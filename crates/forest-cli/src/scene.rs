@@ -259,8 +259,13 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     } else {
         None
     };
+    let (footprint, foot_lines) = match &terrain {
+        Some(_) => footprints(&args.species)?,
+        None => (Vec::new(), Vec::new()),
+    };
     let forest = generate(&GenerateParams {
         terrain,
+        footprint,
         ground: GroundRules {
             max_slope_deg: args
                 .max_slope
@@ -303,8 +308,40 @@ pub fn run(args: &SceneArgs) -> Result<()> {
             x1 - x0
         );
     }
-    for l in size_lines {
+    for l in size_lines.iter().chain(&foot_lines) {
         println!("{l}");
     }
     Ok(())
+}
+
+/// Each species' foot ([`forest_format::model::footprint_radius`] of the model its atlas
+/// stores), so that trees on a slope are planted on the ground's lowest point under their
+/// trunk; and a line per species saying what was found. An atlas without a model gives 0 (the
+/// tree stands on the ground at its axis) and says so.
+fn footprints(atlases: &[PathBuf]) -> Result<(Vec<f32>, Vec<String>)> {
+    let mut radii = Vec::new();
+    let mut lines = Vec::new();
+    for a in atlases {
+        let name = a.file_stem().unwrap_or_default().to_string_lossy();
+        let model = forest_format::model::PreparedModel::load(a)
+            .with_context(|| format!("species {}", a.display()))?;
+        match model {
+            Some(m) => {
+                let r = m.footprint_radius();
+                lines.push(format!(
+                    "  {name}: foot {r:.3} m from its axis at scale 1; on slopes lowered to the \
+                     lowest ground under it"
+                ));
+                radii.push(r);
+            }
+            None => {
+                lines.push(format!(
+                    "  {name}: its atlas stores no model (bake it again to store one), so its \
+                     trees stand at their axis and may float on steep slopes"
+                ));
+                radii.push(0.0);
+            }
+        }
+    }
+    Ok((radii, lines))
 }

@@ -31,6 +31,11 @@ pub struct GenerateParams {
     /// for every species). `forest scene` sets it from each species' height range
     /// ([`species_height`]) and its model's height.
     pub species_scale: Vec<(f32, f32)>,
+    /// How far each species' foot reaches from its axis at scale 1, in species order
+    /// ([`crate::model::footprint_radius`], metres; empty: 0 for every species). On a terrain
+    /// a tree is lowered to the ground's lowest point under its foot scaled by its own scale
+    /// ([`Terrain::lowest_under`]), so that its trunk's downhill side does not float.
+    pub footprint: Vec<f32>,
     /// Random seed.
     pub seed: u64,
     /// Presort directions.
@@ -91,6 +96,7 @@ impl Default for GenerateParams {
             clump_size: 60.0,
             scale: (0.8, 1.25),
             species_scale: Vec::new(),
+            footprint: Vec::new(),
             seed: 1,
             presort_directions: crate::forest::DEFAULT_PRESORT_DIRECTIONS,
             terrain: None,
@@ -98,6 +104,9 @@ impl Default for GenerateParams {
         }
     }
 }
+
+/// Largest accepted [`GenerateParams::footprint`] radius (object space, metres).
+pub const MAX_FOOTPRINT: f32 = 1e4;
 
 /// Mature height ranges (metres) of common tree species, by name: what `forest scene` gives
 /// the trees of a species of that name unless told otherwise (typical heights of grown trees
@@ -220,6 +229,24 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             p.species[i]
         ));
     }
+    if !p.footprint.is_empty() && p.footprint.len() != p.species.len() {
+        return Err(format!(
+            "{} footprint radii for {} species",
+            p.footprint.len(),
+            p.species.len()
+        ));
+    }
+    if let Some((i, r)) = p
+        .footprint
+        .iter()
+        .enumerate()
+        .find(|(_, r)| !(r.is_finite() && **r >= 0.0 && **r <= MAX_FOOTPRINT))
+    {
+        return Err(format!(
+            "footprint radius {r} m of species {}: must be 0 to {MAX_FOOTPRINT} m",
+            p.species[i]
+        ));
+    }
     if !(1..=256).contains(&p.presort_directions) {
         return Err(format!(
             "presort directions = {}: must be 1 to 256",
@@ -316,10 +343,15 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             .get(pick as usize)
             .copied()
             .unwrap_or(p.scale);
+        let rotation = rng.next_f32() * std::f32::consts::TAU;
+        let scale = lo + (hi - lo) * rng.next_f32();
+        if let (Some((t, ..)), Some(r)) = (&ground, p.footprint.get(pick as usize)) {
+            y = t.lowest_under(x, z, r * scale);
+        }
         instances.push(Instance {
             position: [x, y, z],
-            rotation: rng.next_f32() * std::f32::consts::TAU,
-            scale: lo + (hi - lo) * rng.next_f32(),
+            rotation,
+            scale,
             species: pick,
         });
     }
@@ -399,6 +431,74 @@ mod tests {
         assert!(generate(&p).unwrap_err().contains("of species b"));
         assert_eq!(species_height("Pine"), Some((20.0, 35.0)));
         assert_eq!(species_height("baobab"), None);
+    }
+
+    #[test]
+    fn feet_are_planted_on_slopes_and_nothing_else_moves() {
+        use crate::terrain::TerrainParams;
+        let terrain = Terrain::generate(&TerrainParams {
+            half_extent: 300.0,
+            spacing: 5.0,
+            relief: 120.0,
+            hill_size: 150.0,
+            fade: 0.125,
+            seed: 3,
+        })
+        .unwrap();
+        let mut p = params(2000, 7);
+        p.area_per_tree = 100.0;
+        p.terrain = Some(terrain.clone());
+        let standing = generate(&p).unwrap();
+        p.footprint = vec![0.1, 0.0, 0.4];
+        let planted = generate(&p).unwrap();
+        assert_eq!(standing.instances.len(), planted.instances.len());
+        let mut sunk = 0;
+        for (a, b) in standing.instances.iter().zip(&planted.instances) {
+            // The same tree, place, size and turn: only its height may change.
+            assert_eq!(
+                (a.position[0], a.position[2], a.species, a.rotation, a.scale),
+                (b.position[0], b.position[2], b.species, b.rotation, b.scale)
+            );
+            let [x, y, z] = b.position;
+            let r = p.footprint[b.species as usize] * b.scale;
+            // No point of the foot's disk lies below the tree's base, and its base is no
+            // lower than the ground's lowest point there (checked on a finer ring here).
+            let (mut lowest, mut steepest) = (terrain.height(x, z), terrain.slope(x, z));
+            for k in 0..1024 {
+                let t = k as f32 * std::f32::consts::TAU / 1024.0;
+                for f in [0.5, 1.0] {
+                    let (px, pz) = (x + f * r * t.cos(), z + f * r * t.sin());
+                    lowest = lowest.min(terrain.height(px, pz));
+                    steepest = steepest.max(terrain.slope(px, pz));
+                }
+            }
+            // What the 32 points between crossings may miss (Terrain::lowest_under).
+            let slack = r * steepest * (1.0 - (std::f32::consts::PI / 32.0).cos()) + 1e-4;
+            assert!(
+                y <= lowest + slack && y >= lowest - slack,
+                "{b:?}: {y} against {lowest}"
+            );
+            if r == 0.0 {
+                assert_eq!(y, a.position[1]);
+            } else if y < a.position[1] - 1e-3 {
+                sunk += 1;
+            }
+        }
+        assert!(sunk > 100, "{sunk} trees lowered");
+        // Without a terrain a foot changes nothing.
+        p.terrain = None;
+        assert!(
+            generate(&p)
+                .unwrap()
+                .instances
+                .iter()
+                .all(|i| i.position[1] == 0.0)
+        );
+        // Bad footprints are refused, naming the species.
+        p.footprint = vec![0.1, f32::NAN, 0.4];
+        assert!(generate(&p).unwrap_err().contains("species b"));
+        p.footprint = vec![0.1];
+        assert!(generate(&p).unwrap_err().contains("footprint radii"));
     }
 
     #[test]

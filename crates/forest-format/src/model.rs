@@ -337,7 +337,40 @@ impl Header {
     }
 }
 
+/// Share of a model's height, above its lowest point, that counts as its foot
+/// ([`footprint_radius`]).
+pub const FOOT_BAND: f32 = 0.02;
+
+/// How far a model's foot reaches from its vertical axis (object space, metres): the largest
+/// horizontal distance from the axis x = z = 0 (where a tree stands on its ground) of the
+/// points within [`FOOT_BAND`] of its height above its lowest point. A tree planted on a slope
+/// is lowered to the ground's lowest point under that circle, so that no side of its trunk
+/// floats. 0 for no points, and the non-finite points are skipped.
+pub fn footprint_radius(points: impl Iterator<Item = [f32; 3]> + Clone) -> f32 {
+    let finite = |p: &[f32; 3]| p.iter().all(|c| c.is_finite());
+    let (lo, hi) = points
+        .clone()
+        .filter(finite)
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p[1]), hi.max(p[1]))
+        });
+    if lo > hi {
+        return 0.0;
+    }
+    let top = lo + FOOT_BAND * (hi - lo);
+    points
+        .filter(|p| finite(p) && p[1] <= top)
+        .map(|p| p[0].hypot(p[2]))
+        .fold(0.0, f32::max)
+}
+
 impl PreparedModel {
+    /// [`footprint_radius`] of LOD 0 (the full model).
+    pub fn footprint_radius(&self) -> f32 {
+        let n = (self.lod_vertices[0] as usize).min(self.vertices.len());
+        footprint_radius(self.vertices[..n].iter().map(|v| v.pos))
+    }
+
     /// The file's bytes.
     ///
     /// # Panics
@@ -622,6 +655,40 @@ impl PreparedModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn footprint_is_the_widest_point_of_the_foot() {
+        // A trunk of radius 0.3 m standing at x = 0.1 (so up to 0.4 m from the axis), 10 m
+        // tall, with a crown 3 m wide above 2 m and a branch tip 5 m out at 1 m.
+        let mut pts = Vec::new();
+        for k in 0..16 {
+            let a = k as f32 * std::f32::consts::TAU / 16.0;
+            for y in [0.0, 0.15, 2.0] {
+                pts.push([0.1 + 0.3 * a.cos(), y, 0.3 * a.sin()]);
+            }
+            pts.push([3.0 * a.cos(), 2.0 + 4.0 * a.sin().abs(), 3.0 * a.sin()]);
+        }
+        pts.push([5.0, 1.0, 0.0]);
+        pts.push([0.0, 10.0, 0.0]);
+        let r = footprint_radius(pts.iter().copied());
+        assert!((r - 0.4).abs() < 1e-6, "{r}");
+        // The band is 2 % of the height above the lowest point, wherever that lies.
+        let raised: Vec<_> = pts.iter().map(|p| [p[0], p[1] - 7.0, p[2]]).collect();
+        assert_eq!(footprint_radius(raised.iter().copied()), r);
+        // A point below the old foot makes a new one; non-finite points are skipped.
+        pts.push([0.0, -1.0, 0.05]);
+        pts.push([f32::NAN, -5.0, 9.0]);
+        assert!((footprint_radius(pts.iter().copied()) - 0.05).abs() < 1e-6);
+        assert_eq!(footprint_radius(std::iter::empty()), 0.0);
+        // Only LOD 0 counts: the tiny model's LOD 1 lies lower and wider.
+        let mut m = tiny();
+        for v in &mut m.vertices[9..] {
+            v.pos = [7.0, -3.0, 0.0];
+        }
+        let lod0 = footprint_radius(m.vertices[..9].iter().map(|v| v.pos));
+        assert_eq!(m.footprint_radius(), lod0);
+        assert!(lod0 < 7.0);
+    }
 
     /// A small model: one branch triangle, two leaf triangles, two materials (one textured).
     pub(crate) fn tiny() -> PreparedModel {
