@@ -3,7 +3,7 @@
 
 mod common;
 
-use forest_render::options::{Background, RendererOptions};
+use forest_render::options::{AspectBlend, Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::work::{self, StatisticsQueries};
 use forest_render::{GpuScene, QuadStream};
@@ -809,8 +809,27 @@ fn opaque_pass_draws_the_same_image() {
         "close_up",
         common::camera(Vec3::new(3.0, 1.5, 3.0), Vec3::new(0.0, 1.5, 0.0), 1.0),
     ));
-    let (blended, opaque) = opaque_pass_fragments(&common::species(), &forest, &cams, 0.001);
+    let (blended, opaque) =
+        opaque_pass_fragments(&common::species(), &forest, &cams, AspectBlend::Over, 0.001);
     eprintln!("all: {opaque} fragments with the opaque pass, {blended} without");
+}
+
+/// The opaque pass serves the "over" blend alone (`StreamOptions::opaque_pass`): under the
+/// dither and nearest blends, whose aspects do not blend over each other, asking for it
+/// changes nothing, the same fragments shaded and the same image, on the six test cameras.
+#[test]
+fn opaque_pass_is_off_under_the_other_blends() {
+    let forest = common::forest(40);
+    let cams = common::cameras(forest.extent());
+    for blend in [AspectBlend::Dither, AspectBlend::Nearest] {
+        let (blended, opaque) =
+            opaque_pass_fragments(&common::species(), &forest, &cams, blend, 0.0);
+        assert!(blended > 0, "{blend:?}: nothing drawn");
+        assert_eq!(
+            blended, opaque,
+            "{blend:?}: fragments without and with the pass"
+        );
+    }
 }
 
 /// The opaque pass rejects what lies more than a slab's thickness behind a tree's opaque
@@ -842,19 +861,22 @@ fn opaque_pass_rejects_the_trees_behind() {
         .into_iter()
         .filter(|(name, _)| ["inside", "horizon"].contains(name))
         .collect();
-    let (blended, opaque) = opaque_pass_fragments(&species, &forest, &cams, 0.01);
+    let (blended, opaque) =
+        opaque_pass_fragments(&species, &forest, &cams, AspectBlend::Over, 0.01);
     assert!(
         (opaque as f64) < 0.95 * blended as f64,
         "{opaque} fragments with the opaque pass, {blended} without"
     );
 }
 
-/// Fragments over `cams` without and with the opaque pass, each camera's two images within
-/// FLIP `max_flip` (written on failure), counting leaving each image unchanged.
+/// Fragments over `cams` without and with the opaque pass under aspect blend `blend`, each
+/// camera's two images within FLIP `max_flip` (written on failure), counting leaving each
+/// image unchanged.
 fn opaque_pass_fragments(
     species: &[forest_render::SpeciesData],
     forest: &forest_format::forest::Forest,
     cams: &[(&str, forest_render::Camera)],
+    blend: AspectBlend,
     max_flip: f32,
 ) -> (u64, u64) {
     use forest_render::fragments::{FragmentCounter, count_fragments};
@@ -876,6 +898,7 @@ fn opaque_pass_fragments(
         stream
             .set_options(StreamOptions {
                 opaque_first,
+                blend,
                 ..Default::default()
             })
             .unwrap();
@@ -903,7 +926,8 @@ fn opaque_pass_fragments(
             b.fragments, o.fragments, m.flip_mean
         );
         if m.flip_mean > max_flip {
-            let out = common::failure_images(&format!("opaque-{name}"), &blended, &opaque);
+            let out =
+                common::failure_images(&format!("opaque-{blend:?}-{name}"), &blended, &opaque);
             panic!(
                 "{name}: opaque pass against blended FLIP {} (images in {})",
                 m.flip_mean,
