@@ -193,3 +193,74 @@ fn per_vertex_sky_visibility_matches_the_ray_traced_pine() {
         ratios[1]
     );
 }
+
+/// A device too small for the models is refused before anything is allocated, by a message
+/// naming the buffer and both sizes: checked on limits just below each buffer's size, and on
+/// a real device opened with a storage-binding limit below the vertices' bytes, which reports
+/// no validation error.
+#[test]
+fn models_beyond_the_device_limits_are_refused_by_name() {
+    use forest_baselines::geometry::check_limits;
+    use forest_render::context::RenderError;
+    let prepared = common::prepared();
+    let trees = 300;
+    let vertex_bytes = prepared.vertex_bytes();
+    let adapter_limits = common::ctx().device.limits();
+    assert!(check_limits(&adapter_limits, prepared, trees).is_ok());
+    let refused = |limits: &wgpu::Limits, trees: usize| match check_limits(limits, prepared, trees)
+    {
+        Err(e @ RenderError::DeviceLimit { .. }) => e.to_string(),
+        other => panic!("not refused for the device's limit: {other:?}"),
+    };
+    let mut small = adapter_limits.clone();
+    small.max_storage_buffer_binding_size = vertex_bytes - 1;
+    let e = refused(&small, trees);
+    assert!(
+        e.contains("vertices") && e.contains(&vertex_bytes.to_string()) && e.contains("lighter"),
+        "{e}"
+    );
+    // The largest buffer counts as well as the binding limit.
+    let mut small = adapter_limits.clone();
+    small.max_buffer_size = vertex_bytes - 1;
+    assert!(refused(&small, trees).contains("vertices"));
+    // Enough for the models, too little for 2^24 trees' instances.
+    let mut small = adapter_limits.clone();
+    small.max_storage_buffer_binding_size = vertex_bytes;
+    let e = refused(&small, 1 << 24);
+    assert!(e.contains("instances") && e.contains("fewer trees"), "{e}");
+    // Texture arrays of too many layers.
+    let mut small = adapter_limits.clone();
+    small.max_texture_array_layers = prepared.material_layers() as u32 - 1;
+    assert!(refused(&small, trees).contains("material texture layers"));
+
+    // A real device with that binding limit: refused by the renderer, with no wgpu error.
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default())).unwrap();
+    let mut limits = adapter.limits();
+    limits.max_storage_buffer_binding_size = vertex_bytes - 1;
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_features: adapter.features() & wgpu::Features::INDIRECT_FIRST_INSTANCE,
+        required_limits: limits,
+        ..Default::default()
+    }))
+    .unwrap();
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let ctx = forest_render::GpuContext::from_device(adapter.get_info(), device, queue);
+    let made = GeometryRenderer::new(
+        &ctx,
+        prepared,
+        &common::forest(trees as u32),
+        TARGET_FORMAT,
+        Background::Transparent,
+    );
+    match made {
+        Err(e @ RenderError::DeviceLimit { .. }) => assert!(e.to_string().contains("vertices")),
+        Err(e) => panic!("refused for another cause: {e}"),
+        Ok(_) => panic!(
+            "a device binding {} bytes took the models",
+            vertex_bytes - 1
+        ),
+    }
+    let error = pollster::block_on(scope.pop());
+    assert!(error.is_none(), "wgpu error: {error:?}");
+}

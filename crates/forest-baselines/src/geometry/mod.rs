@@ -26,7 +26,7 @@ mod textures;
 
 pub use forest_format::model::BILLBOARD_RESOLUTION;
 pub use layout::{COMPUTE_SLOTS, compute_entries, draw_entries};
-pub use models::GpuModels;
+pub use models::{GpuModels, check_limits};
 pub use order::{
     ORDER_BINS, VIRTUAL_EYE_RADII, VISIBLE_ID_BITS, bin_direction, draw_orders, order_bin,
 };

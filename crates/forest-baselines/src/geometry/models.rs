@@ -49,11 +49,103 @@ pub struct GpuModels {
     bytes: u64,
 }
 
+/// Refuse, before anything is allocated, what a device of `limits` cannot bind: each storage
+/// buffer above the storage-binding limit (or the largest buffer), each layered texture with
+/// more layers than an array may have. `instances` is the forest's tree count. The message
+/// names the buffer, its size and the limit.
+pub fn check_limits(
+    limits: &wgpu::Limits,
+    prepared: &PreparedGeometry,
+    instances: usize,
+) -> Result<(), RenderError> {
+    let bytes = |n: usize, each: usize| (n as u64).saturating_mul(each as u64);
+    let lighter = ": draw fewer species or lighter models (fewer triangles)";
+    let storage = [
+        (
+            "the models' vertices, 3 per triangle of every LOD (bytes)",
+            std::mem::size_of_val(prepared.vertices.as_slice()) as u64,
+            lighter,
+        ),
+        (
+            "the models' presorted draw orders, 4 bytes per triangle and view-direction bin \
+             (bytes)",
+            std::mem::size_of_val(prepared.draw_order.as_slice()) as u64,
+            lighter,
+        ),
+        (
+            "the leaves' centres (bytes)",
+            std::mem::size_of_val(prepared.leaf_centre.as_slice()) as u64,
+            lighter,
+        ),
+        (
+            "the leaves' ends (bytes)",
+            std::mem::size_of_val(prepared.leaf_end.as_slice()) as u64,
+            lighter,
+        ),
+        (
+            "the models' materials (bytes)",
+            std::mem::size_of_val(prepared.materials.as_slice()) as u64,
+            ": draw fewer species or models with fewer materials",
+        ),
+        (
+            "the forest's instances (bytes)",
+            bytes(
+                instances,
+                std::mem::size_of::<forest_render::gpu_types::GpuInstance>(),
+            ),
+            ": draw fewer trees",
+        ),
+        (
+            "the geometry methods' visible list, 4 bytes per tree (bytes)",
+            bytes(instances, 4),
+            ": draw fewer trees",
+        ),
+    ];
+    let limit = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    for (what, needed, hint) in storage {
+        if needed > limit {
+            return Err(RenderError::DeviceLimit {
+                what: what.into(),
+                needed,
+                limit,
+                hint,
+            });
+        }
+    }
+    let layers = [
+        (
+            "the models' material texture layers",
+            prepared.layers.len(),
+            ": draw fewer species or models with fewer textures",
+        ),
+        (
+            "the billboards' texture layers",
+            prepared.billboard_layers.len(),
+            ": draw fewer species",
+        ),
+    ];
+    for (what, needed, hint) in layers {
+        let limit = u64::from(limits.max_texture_array_layers);
+        if needed as u64 > limit {
+            return Err(RenderError::DeviceLimit {
+                what: what.into(),
+                needed: needed as u64,
+                limit,
+                hint,
+            });
+        }
+    }
+    Ok(())
+}
+
 impl GpuModels {
     /// Upload `prepared` (one entry per species of `forest`, in its order) with the forest's
     /// instances and terrain. Refused, before anything is allocated, when the species counts
     /// differ, the device cannot draw the geometry methods (no indirect draws with a first
-    /// instance) or the terrain exceeds the device's binding limit.
+    /// instance), or a buffer or texture exceeds the device's limits ([`check_limits`], and the
+    /// terrain's).
     pub fn new(
         ctx: &GpuContext,
         prepared: &PreparedGeometry,
@@ -81,6 +173,7 @@ impl GpuModels {
         }
         super::renderer::require_indirect_first_instance(ctx)?;
         let device = &ctx.device;
+        check_limits(&device.limits(), prepared, forest.instances.len())?;
         let terrain = GpuTerrain::new(device, forest.terrain.as_ref())?;
         let instances = forest_render::scene::gpu_instances(forest);
         let mut bytes = terrain.bytes();

@@ -51,6 +51,17 @@ impl PreparedGeometry {
         Self::with_cards(species, Cards::Cut)
     }
 
+    /// Bytes of the vertex buffer, the largest storage buffer the models need: 48 per vertex,
+    /// 3 vertices per triangle of every species' LODs (see [`super::check_limits`]).
+    pub fn vertex_bytes(&self) -> u64 {
+        std::mem::size_of_val(self.vertices.as_slice()) as u64
+    }
+
+    /// Layers of the material texture array: every species' textures.
+    pub fn material_layers(&self) -> usize {
+        self.layers.len()
+    }
+
     /// As [`PreparedGeometry::new`], with the leaf cards cut or whole.
     pub fn with_cards(species: &[GeometrySpecies], cards: Cards) -> Self {
         let mut vertices: Vec<RefVertex> = Vec::new();
