@@ -101,21 +101,21 @@ fn parse_height(s: &str) -> Result<(String, f32, f32), String> {
 /// Scale ranges, one per species (empty: every model at its own size, ×0.8–1.25).
 type ScaleRanges = Vec<(f32, f32)>;
 
+/// A species' name: its atlas folder's, without the extension.
+fn species_name(atlas: &Path) -> String {
+    atlas
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
 /// Each species' scale range, and a line per species saying what was chosen; `manifests` are
 /// the species' atlases' manifests, in `args.species` order.
 fn species_scales(
     args: &SceneArgs,
     manifests: &[AtlasManifest],
 ) -> Result<(ScaleRanges, Vec<String>)> {
-    let names: Vec<String> = args
-        .species
-        .iter()
-        .map(|p| {
-            p.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        })
-        .collect();
+    let names: Vec<String> = args.species.iter().map(|p| species_name(p)).collect();
     if let Some((n, _, _)) = args
         .heights
         .iter()
@@ -260,7 +260,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         None
     };
     let (footprint, foot_lines) = match &terrain {
-        Some(_) => footprints(&args.species)?,
+        Some(_) => footprints(&args.species),
         None => (Vec::new(), Vec::new()),
     };
     let forest = generate(&GenerateParams {
@@ -316,32 +316,40 @@ pub fn run(args: &SceneArgs) -> Result<()> {
 
 /// Each species' foot ([`forest_format::model::footprint_radius`] of the model its atlas
 /// stores), so that trees on a slope are planted on the ground's lowest point under their
-/// trunk; and a line per species saying what was found. An atlas without a model gives 0 (the
-/// tree stands on the ground at its axis) and says so.
-fn footprints(atlases: &[PathBuf]) -> Result<(Vec<f32>, Vec<String>)> {
+/// trunk; and a line per species saying what was found. An atlas without a readable model
+/// gives 0 (its trees stand on the ground at their axis, as before feet were measured) and
+/// says why: the forest needs no model, only the geometry methods do.
+fn footprints(atlases: &[PathBuf]) -> (Vec<f32>, Vec<String>) {
     let mut radii = Vec::new();
     let mut lines = Vec::new();
     for a in atlases {
-        let name = a.file_stem().unwrap_or_default().to_string_lossy();
-        let model = forest_format::model::PreparedModel::load(a)
-            .with_context(|| format!("species {}", a.display()))?;
-        match model {
-            Some(m) => {
+        let name = species_name(a);
+        let (r, line) = match forest_format::model::PreparedModel::load(a) {
+            Ok(Some(m)) => {
                 let r = m.footprint_radius();
-                lines.push(format!(
+                let line = format!(
                     "  {name}: foot {r:.3} m from its axis at scale 1; on slopes lowered to the \
                      lowest ground under it"
-                ));
-                radii.push(r);
+                );
+                (r, line)
             }
-            None => {
-                lines.push(format!(
+            Ok(None) => (
+                0.0,
+                format!(
                     "  {name}: its atlas stores no model (bake it again to store one), so its \
                      trees stand at their axis and may float on steep slopes"
-                ));
-                radii.push(0.0);
-            }
-        }
+                ),
+            ),
+            Err(e) => (
+                0.0,
+                format!(
+                    "  {name}: its model could not be read ({e}), so its trees stand at their \
+                     axis and may float on steep slopes"
+                ),
+            ),
+        };
+        radii.push(r);
+        lines.push(line);
     }
-    Ok((radii, lines))
+    (radii, lines)
 }

@@ -105,8 +105,9 @@ impl Default for GenerateParams {
     }
 }
 
-/// Largest accepted [`GenerateParams::footprint`] radius (object space, metres).
-pub const MAX_FOOTPRINT: f32 = 1e4;
+/// Farthest a tree's foot may reach from its axis at its largest scale (metres): wider than
+/// any tree's roots, small enough that planting it reads few of a terrain's samples.
+pub const MAX_FOOT: f32 = 100.0;
 
 /// Mature height ranges (metres) of common tree species, by name: what `forest scene` gives
 /// the trees of a species of that name unless told otherwise (typical heights of grown trees
@@ -236,16 +237,16 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             p.species.len()
         ));
     }
-    if let Some((i, r)) = p
-        .footprint
-        .iter()
-        .enumerate()
-        .find(|(_, r)| !(r.is_finite() && **r >= 0.0 && **r <= MAX_FOOTPRINT))
-    {
-        return Err(format!(
-            "footprint radius {r} m of species {}: must be 0 to {MAX_FOOTPRINT} m",
-            p.species[i]
-        ));
+    for (i, &r) in p.footprint.iter().enumerate() {
+        let largest = p.species_scale.get(i).map_or(p.scale.1, |s| s.1);
+        if !(r.is_finite() && r >= 0.0 && r * largest <= MAX_FOOT) {
+            return Err(format!(
+                "species {}: its foot reaches {r} m from its axis, {} m at its largest scale \
+                 ({largest}); a tree's foot must reach 0 to {MAX_FOOT} m",
+                p.species[i],
+                r * largest
+            ));
+        }
     }
     if !(1..=256).contains(&p.presort_directions) {
         return Err(format!(
@@ -497,6 +498,13 @@ mod tests {
         // Bad footprints are refused, naming the species.
         p.footprint = vec![0.1, f32::NAN, 0.4];
         assert!(generate(&p).unwrap_err().contains("species b"));
+        // A foot wider than any tree's at the species' largest scale (1.25 by default).
+        p.footprint = vec![0.1, 0.0, MAX_FOOT / 1.2];
+        let e = generate(&p).unwrap_err();
+        assert!(
+            e.contains("species c") && e.contains("largest scale"),
+            "{e}"
+        );
         p.footprint = vec![0.1];
         assert!(generate(&p).unwrap_err().contains("footprint radii"));
     }

@@ -197,64 +197,72 @@ impl Terrain {
     /// point where it crosses a triangle's edge (a grid line or a cell's diagonal) and
     /// [`Self::FOOT_SAMPLES`] points between. So the result is never below the true minimum and
     /// at most `radius·s·(1 − cos(π/FOOT_SAMPLES))` above it, `s` the steepest slope under the
-    /// circle (2 mm for a 0.5 m foot on a 35° slope).
+    /// circle (2 mm for a 0.5 m foot on a 35° slope). Only the grid counts: the part of a disk
+    /// past its border (where the drawn ground drops to the plane) is left out. The work grows
+    /// with the grid lines and samples the disk covers, at most the grid's.
     pub fn lowest_under(&self, x: f32, z: f32, radius: f32) -> f32 {
         let mut lo = self.height(x, z);
         if !(radius.is_finite() && radius > 0.0) {
             return lo;
         }
+        // Only points on the grid count: past its border the drawn ground drops to the plane
+        // at y = 0, which a foot overhanging the border does not stand on.
+        let mut point = |px: f32, pz: f32| {
+            if self.contains(px, pz) {
+                lo = lo.min(self.height(px, pz));
+            }
+        };
         for k in 0..Self::FOOT_SAMPLES {
             let a = k as f32 * std::f32::consts::TAU / Self::FOOT_SAMPLES as f32;
-            lo = lo.min(self.height(x + radius * a.cos(), z + radius * a.sin()));
+            point(x + radius * a.cos(), z + radius * a.sin());
         }
-        // Where the circle crosses the triangles' edges: the lines x = const and z = const
-        // through the samples, and the diagonals x − z = const (see `triangle`).
+        // Where the circle crosses the triangles' edges: the grid lines x = const and
+        // z = const, and the cells' diagonals x − z = const (see `triangle`), each only where
+        // the grid has one (so a huge radius costs at most the grid's lines).
         let (ox, oz, sp) = (self.origin[0], self.origin[1], self.spacing);
-        // The lines o + k·sp between two coordinates.
-        let lines = |lo_w: f32, hi_w: f32, o: f32| {
-            let first = ((lo_w - o) / sp).ceil() as i64;
-            let last = ((hi_w - o) / sp).floor() as i64;
+        let [nx, nz] = self.size.map(i64::from);
+        // Offsets k·sp from `o`, for k in kmin..=kmax, between two coordinates.
+        let lines = |lo_w: f32, hi_w: f32, o: f32, kmin: i64, kmax: i64| {
+            let first = (((lo_w - o) / sp).ceil() as i64).max(kmin);
+            let last = (((hi_w - o) / sp).floor() as i64).min(kmax);
             (first..=last).map(move |k| o + k as f32 * sp)
         };
-        let mut crossing = |px: f32, pz: f32| lo = lo.min(self.height(px, pz));
-        for gx in lines(x - radius, x + radius, ox) {
+        for gx in lines(x - radius, x + radius, ox, 0, nx - 1) {
             let h = (radius * radius - (gx - x) * (gx - x)).max(0.0).sqrt();
-            crossing(gx, z - h);
-            crossing(gx, z + h);
+            point(gx, z - h);
+            point(gx, z + h);
         }
-        for gz in lines(z - radius, z + radius, oz) {
+        for gz in lines(z - radius, z + radius, oz, 0, nz - 1) {
             let h = (radius * radius - (gz - z) * (gz - z)).max(0.0).sqrt();
-            crossing(x - h, gz);
-            crossing(x + h, gz);
+            point(x - h, gz);
+            point(x + h, gz);
         }
-        // Diagonals x − z = ox − oz + k·sp: signed distance d of the centre from each.
+        // Diagonals x − z = ox − oz + k·sp (k = i − j): signed distance d of the centre.
         let reach = radius * std::f32::consts::SQRT_2;
         let c0 = x - z - (ox - oz);
-        for k in lines(c0 - reach, c0 + reach, 0.0) {
+        for k in lines(c0 - reach, c0 + reach, 0.0, 1 - nz, nx - 1) {
             let d = (c0 - k) / std::f32::consts::SQRT_2;
             let h = (radius * radius - d * d).max(0.0).sqrt() / std::f32::consts::SQRT_2;
             let (fx, fz) = (
                 x - d / std::f32::consts::SQRT_2,
                 z + d / std::f32::consts::SQRT_2,
             );
-            crossing(fx + h, fz + h);
-            crossing(fx - h, fz - h);
+            point(fx + h, fz + h);
+            point(fx - h, fz - h);
         }
-        // Grid samples inside the disk (clamped to the grid: outside it the ground is flat).
-        let [nx, nz] = self.size;
-        let index = |w: f32, o: f32, n: u32| ((w - o) / self.spacing).clamp(0.0, (n - 1) as f32);
+        // Grid samples inside the disk.
+        let index = |w: f32, o: f32, n: i64| ((w - o) / sp).clamp(0.0, (n - 1) as f32);
         let (i0, i1) = (
-            index(x - radius, self.origin[0], nx).ceil() as usize,
-            index(x + radius, self.origin[0], nx).floor() as usize,
+            index(x - radius, ox, nx).ceil() as usize,
+            index(x + radius, ox, nx).floor() as usize,
         );
         let (j0, j1) = (
-            index(z - radius, self.origin[1], nz).ceil() as usize,
-            index(z + radius, self.origin[1], nz).floor() as usize,
+            index(z - radius, oz, nz).ceil() as usize,
+            index(z + radius, oz, nz).floor() as usize,
         );
         for j in j0..=j1 {
             for i in i0..=i1 {
-                let sx = self.origin[0] + i as f32 * self.spacing;
-                let sz = self.origin[1] + j as f32 * self.spacing;
+                let (sx, sz) = (ox + i as f32 * sp, oz + j as f32 * sp);
                 if (sx - x).hypot(sz - z) <= radius {
                     lo = lo.min(self.sample(i, j));
                 }
@@ -596,6 +604,29 @@ mod tests {
         // With the sample outside the disk, only the pit's slopes reach the circle.
         let near = pit.lowest_under(-5.3, 8.2, 0.3);
         assert!(near > -3.0 && near < 1.0, "{near}");
+        // Creases along a cell's diagonal (h = |x − z|) and along a grid line (h = |x − 4|),
+        // crossed by disks whose circle points alone miss the bottom.
+        let field = |h: &dyn Fn(f32, f32) -> f32| Terrain {
+            size: [9, 9],
+            origin: [0.0, 0.0],
+            spacing: 1.0,
+            heights: (0..9)
+                .flat_map(|j| (0..9).map(move |i| (i as f32, j as f32)))
+                .map(|(x, z)| h(x, z))
+                .collect(),
+        };
+        let diagonal = field(&|x, z| (x - z).abs());
+        assert!((diagonal.height(4.3, 3.6) - 0.7).abs() < 1e-5);
+        assert!(diagonal.lowest_under(4.3, 3.6, 0.6).abs() < 1e-5);
+        let line = field(&|x, _| (x - 4.0).abs());
+        assert!(line.lowest_under(4.45, 2.3, 0.5).abs() < 1e-5);
+        // Past the border the ground drops to the plane, which a foot does not stand on; a
+        // huge radius takes the grid's lowest sample, and returns.
+        let high = plane(0.0, 0.0, 50.0);
+        assert_eq!(high.lowest_under(-9.9, 3.1, 2.0), 50.0);
+        let lowest = t.heights.iter().copied().fold(f32::INFINITY, f32::min);
+        assert_eq!(t.lowest_under(-5.0, 6.0, 1e30), lowest);
+        assert_eq!(t.lowest_under(-5.0, 6.0, f32::MAX), lowest);
         // Independently: no point of the disk lies below the result.
         let hills = Terrain::generate(&TerrainParams::default()).unwrap();
         for k in 0..50 {

@@ -205,14 +205,14 @@ fn models_beyond_the_device_limits_are_refused_by_name() {
     let prepared = common::prepared();
     let trees = 300;
     let vertex_bytes = prepared.vertex_bytes();
-    let adapter_limits = common::ctx().device.limits();
-    assert!(check_limits(&adapter_limits, prepared, trees).is_ok());
+    let device_limits = common::ctx().device.limits();
+    assert!(check_limits(&device_limits, prepared, trees).is_ok());
     let refused = |limits: &wgpu::Limits, trees: usize| match check_limits(limits, prepared, trees)
     {
         Err(e @ RenderError::DeviceLimit { .. }) => e.to_string(),
         other => panic!("not refused for the device's limit: {other:?}"),
     };
-    let mut small = adapter_limits.clone();
+    let mut small = device_limits.clone();
     small.max_storage_buffer_binding_size = vertex_bytes - 1;
     let e = refused(&small, trees);
     assert!(
@@ -220,22 +220,33 @@ fn models_beyond_the_device_limits_are_refused_by_name() {
         "{e}"
     );
     // The largest buffer counts as well as the binding limit.
-    let mut small = adapter_limits.clone();
+    let mut small = device_limits.clone();
     small.max_buffer_size = vertex_bytes - 1;
     assert!(refused(&small, trees).contains("vertices"));
     // Enough for the models, too little for 2^24 trees' instances.
-    let mut small = adapter_limits.clone();
+    let mut small = device_limits.clone();
     small.max_storage_buffer_binding_size = vertex_bytes;
     let e = refused(&small, 1 << 24);
     assert!(e.contains("instances") && e.contains("fewer trees"), "{e}");
-    // Texture arrays of too many layers.
-    let mut small = adapter_limits.clone();
+    // Texture arrays of too many layers, and opacity volumes stacked too deep.
+    assert!(
+        prepared.material_layers() > 0,
+        "the test models have textures"
+    );
+    let mut small = device_limits.clone();
     small.max_texture_array_layers = prepared.material_layers() as u32 - 1;
     assert!(refused(&small, trees).contains("material texture layers"));
+    let mut small = device_limits.clone();
+    small.max_texture_dimension_3d = forest_format::opacity::VOLUME_RESOLUTION * 2 - 1;
+    assert!(refused(&small, trees).contains("opacity volumes"));
 
     // A real device with that binding limit: refused by the renderer, with no wgpu error.
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
-    let adapter = pollster::block_on(instance.request_adapter(&Default::default())).unwrap();
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        ..Default::default()
+    }))
+    .unwrap();
     let mut limits = adapter.limits();
     limits.max_storage_buffer_binding_size = vertex_bytes - 1;
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

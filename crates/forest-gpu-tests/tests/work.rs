@@ -821,6 +821,14 @@ fn opaque_pass_draws_the_same_image() {
 fn opaque_pass_is_off_under_the_other_blends() {
     let forest = common::forest(40);
     let cams = common::cameras(forest.extent());
+    // Under the over blend the pass changes what is shaded in this scene, so equal counts
+    // below mean it did not run.
+    let (blended, opaque) =
+        opaque_pass_fragments(&common::species(), &forest, &cams, AspectBlend::Over, 0.001);
+    assert_ne!(
+        blended, opaque,
+        "the over blend's pass changed nothing here"
+    );
     for blend in [AspectBlend::Dither, AspectBlend::Nearest] {
         let (blended, opaque) =
             opaque_pass_fragments(&common::species(), &forest, &cams, blend, 0.0);

@@ -24,6 +24,23 @@ pub fn opacity_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// Refuse, before anything is allocated, `species` opacity volumes stacked deeper than a 3D
+/// texture of a device of `limits` may be ([`opacity_texture`] stacks them along z).
+pub fn check_volumes(limits: &wgpu::Limits, species: usize) -> Result<(), RenderError> {
+    let r = VOLUME_RESOLUTION;
+    let depth = u64::from(r) * species.max(1) as u64;
+    let limit = limits.max_texture_dimension_3d;
+    if depth > u64::from(limit) {
+        return Err(RenderError::DeviceLimit {
+            what: format!("the opacity volumes ({species} species × {r} slices)"),
+            needed: depth,
+            limit: limit.into(),
+            hint: ": split the forest into scenes of fewer species",
+        });
+    }
+    Ok(())
+}
+
 /// Upload `volumes` (every one [`VOLUME_RESOLUTION`] a side; one empty volume when there are
 /// none) as one stacked 3D texture. Returns it and its bytes; the error names the device limit
 /// a scene of too many species exceeds.
@@ -33,19 +50,8 @@ pub fn opacity_texture(
     volumes: &[&OpacityVolume],
 ) -> Result<(wgpu::Texture, u64), RenderError> {
     let r = VOLUME_RESOLUTION;
+    check_volumes(&device.limits(), volumes.len())?;
     let depth = r as u64 * volumes.len().max(1) as u64;
-    let limit = device.limits().max_texture_dimension_3d;
-    if depth > u64::from(limit) {
-        return Err(RenderError::DeviceLimit {
-            what: format!(
-                "the opacity volumes ({} species × {r} slices)",
-                volumes.len()
-            ),
-            needed: depth,
-            limit: limit.into(),
-            hint: ": split the forest into scenes of fewer species",
-        });
-    }
     for v in volumes {
         assert_eq!(
             v.resolution, r,

@@ -51,8 +51,9 @@ pub struct GpuModels {
 
 /// Refuse, before anything is allocated, what a device of `limits` cannot bind: each storage
 /// buffer above the storage-binding limit (or the largest buffer), each layered texture with
-/// more layers than an array may have. `instances` is the forest's tree count. The message
-/// names the buffer, its size and the limit.
+/// more layers than an array may have, and the species' opacity volumes stacked deeper than a
+/// 3D texture may be. `instances` is the forest's tree count. The message names the buffer,
+/// its size and the limit.
 pub fn check_limits(
     limits: &wgpu::Limits,
     prepared: &PreparedGeometry,
@@ -63,7 +64,7 @@ pub fn check_limits(
     let storage = [
         (
             "the models' vertices, 3 per triangle of every LOD (bytes)",
-            std::mem::size_of_val(prepared.vertices.as_slice()) as u64,
+            prepared.vertex_bytes(),
             lighter,
         ),
         (
@@ -81,6 +82,11 @@ pub fn check_limits(
             "the leaves' ends (bytes)",
             std::mem::size_of_val(prepared.leaf_end.as_slice()) as u64,
             lighter,
+        ),
+        (
+            "the species' table (bytes)",
+            std::mem::size_of_val(prepared.geo_species.as_slice()) as u64,
+            ": draw fewer species",
         ),
         (
             "the models' materials (bytes)",
@@ -117,12 +123,17 @@ pub fn check_limits(
     let layers = [
         (
             "the models' material texture layers",
-            prepared.layers.len(),
+            prepared.material_layers(),
             ": draw fewer species or models with fewer textures",
         ),
         (
             "the billboards' texture layers",
             prepared.billboard_layers.len(),
+            ": draw fewer species",
+        ),
+        (
+            "the billboards' surface layers",
+            prepared.billboard_surface.len(),
             ": draw fewer species",
         ),
     ];
@@ -137,7 +148,7 @@ pub fn check_limits(
             });
         }
     }
-    Ok(())
+    forest_render::opacity::check_volumes(limits, prepared.opacity.len())
 }
 
 impl GpuModels {
