@@ -703,20 +703,27 @@ fn a_forest_on_hills_or_a_height_field_stands_on_it_and_bad_height_fields_are_na
         args.extend_from_slice(extra);
         forest(&args)
     };
-    // Generated hills: every tree's base on the drawn surface; the named views render.
+    // Generated hills: every tree's base on the lowest drawn ground under its model's foot
+    // (the foot scene prints); the named views render.
     let hills = p("hills.forest");
     let text = ok(&scene("hills", &hills, &["--relief", "40"]));
     assert!(text.contains("terrain:"), "{text}");
+    let foot = forest_format::model::PreparedModel::load(&d.join("bush.atlas"))
+        .unwrap()
+        .expect("the bake stores the model")
+        .footprint_radius();
+    assert!(
+        foot > 0.0 && text.contains(&format!("bush: foot {foot:.3} m")),
+        "{foot}: {text}"
+    );
     let f = forest_format::forest::Forest::load(Path::new(&hills)).unwrap();
     let t = f.terrain.as_ref().expect("a terrain");
     let (lo, hi) = t.height_range();
     assert!(hi - lo > 10.0, "{lo}..{hi}");
     for i in &f.instances {
-        assert_eq!(
-            i.position[1],
-            t.height(i.position[0], i.position[2]),
-            "{i:?}"
-        );
+        let [x, y, z] = i.position;
+        assert_eq!(y, t.lowest_under(x, z, foot * i.scale), "{i:?}");
+        assert!(y <= t.height(x, z), "{i:?}");
     }
     let out = ok(&forest(&[
         "render",
@@ -752,9 +759,10 @@ fn a_forest_on_hills_or_a_height_field_stands_on_it_and_bad_height_fields_are_na
     assert_eq!(t.size, [64, 64]);
     for i in &f.instances {
         let [x, y, z] = i.position;
-        let want = (x - t.origin[0]) / 3.0 * 1040.0 / 65535.0 * 30.0;
+        // Planted at the foot's downhill edge, `foot · scale` towards −x.
+        let want = (x - foot * i.scale - t.origin[0]) / 3.0 * 1040.0 / 65535.0 * 30.0;
         assert!((y - want).abs() < 1e-3, "{i:?}: {want}");
-        assert_eq!(y, t.height(x, z));
+        assert!(y < t.height(x, z), "{i:?}");
     }
     // Bad height fields and options: one line naming the cause, nothing written.
     let eight = d.join("eight.png");

@@ -180,12 +180,27 @@ mod tests {
         let forest = forest_format::forest::Forest::load(&demo.forest).unwrap();
         assert_eq!(forest.instances.len(), TREES as usize);
         let terrain = forest.terrain.as_ref().expect("the demo stands on hills");
-        assert!(
-            forest
-                .instances
-                .iter()
-                .all(|i| i.position[1] == terrain.height(i.position[0], i.position[2]))
-        );
+        // Every tree planted: on the lowest ground under its model's foot at its scale.
+        let feet: Vec<f32> = SPECIES
+            .iter()
+            .map(|s| {
+                let atlas = tmp.path().join(format!("out/atlases/{s}.atlas"));
+                let model = forest_format::model::PreparedModel::load(&atlas).unwrap();
+                model
+                    .expect("the demo's atlases store their models")
+                    .footprint_radius()
+            })
+            .collect();
+        assert!(feet.iter().all(|&r| r > 0.0), "{feet:?}");
+        let mut lowered = 0;
+        for i in &forest.instances {
+            let [x, y, z] = i.position;
+            let foot = feet[i.species as usize] * i.scale;
+            assert_eq!(y, terrain.lowest_under(x, z, foot), "{i:?}");
+            assert!(y <= terrain.height(x, z));
+            lowered += usize::from(y < terrain.height(x, z));
+        }
+        assert!(lowered > 0, "no tree stands on a slope");
         let manifest = |s: &str| {
             tmp.path()
                 .join(format!("out/atlases/{s}.atlas/manifest.json"))
