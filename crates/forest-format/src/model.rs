@@ -63,46 +63,54 @@ pub fn lambda_band(lambda: f32) -> u32 {
 /// texels that pass a 0.5 alpha test keep their colour (an alpha-tested texture's fringe of
 /// faint texels, often matted against another colour, never shows).
 pub fn dilate_colour_from(img: &mut image::RgbaImage, min_alpha: u8) {
-    let (w, h) = img.dimensions();
+    let (w, h) = (img.width() as usize, img.height() as usize);
     let min_alpha = min_alpha.max(1);
     let mut known: Vec<bool> = img.pixels().map(|p| p[3] >= min_alpha).collect();
     if !known.iter().any(|k| *k) {
         return;
     }
-    loop {
-        let mut next = known.clone();
-        let mut changed = false;
-        for y in 0..h {
-            for x in 0..w {
-                let i = (y * w + x) as usize;
-                if known[i] {
-                    continue;
-                }
-                let mut acc = [0u32; 3];
-                let mut c = 0;
-                for (dx, dy) in [(-1i32, 0i32), (1, 0), (0, -1), (0, 1)] {
-                    let (nx, ny) = (x as i32 + dx, y as i32 + dy);
-                    if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
-                        continue;
-                    }
-                    if known[(ny as u32 * w + nx as u32) as usize] {
-                        let p = img.get_pixel(nx as u32, ny as u32);
-                        (0..3).for_each(|k| acc[k] += u32::from(p[k]));
-                        c += 1;
-                    }
-                }
-                if c > 0 {
-                    let p = img.get_pixel_mut(x, y);
-                    (0..3).for_each(|k| p[k] = (acc[k] / c) as u8);
-                    next[i] = true;
-                    changed = true;
+    // Ring by ring from the known texels, visiting only each ring (every texel once in all):
+    // a texel of the next ring averages its 4-neighbours known before that ring.
+    let neighbours = |i: usize| {
+        let (x, y) = (i % w, i / w);
+        [
+            (x > 0).then(|| i - 1),
+            (x + 1 < w).then(|| i + 1),
+            (y > 0).then(|| i - w),
+            (y + 1 < h).then(|| i + w),
+        ]
+        .into_iter()
+        .flatten()
+    };
+    let mut queued = known.clone();
+    let mut ring: Vec<usize> = (0..w * h)
+        .filter(|&i| !known[i] && neighbours(i).any(|n| known[n]))
+        .collect();
+    ring.iter().for_each(|&i| queued[i] = true);
+    let raw = &mut **img;
+    let mut colours = Vec::new();
+    while !ring.is_empty() {
+        colours.clear();
+        for &i in &ring {
+            let (mut acc, mut c) = ([0u32; 3], 0u32);
+            for n in neighbours(i).filter(|&n| known[n]) {
+                (0..3).for_each(|k| acc[k] += u32::from(raw[4 * n + k]));
+                c += 1;
+            }
+            colours.push(acc.map(|a| (a / c) as u8));
+        }
+        let mut next = Vec::new();
+        for (&i, c) in ring.iter().zip(&colours) {
+            raw[4 * i..4 * i + 3].copy_from_slice(c);
+            known[i] = true;
+            for n in neighbours(i) {
+                if !queued[n] {
+                    queued[n] = true;
+                    next.push(n);
                 }
             }
         }
-        known = next;
-        if !changed {
-            break;
-        }
+        ring = next;
     }
 }
 
@@ -655,6 +663,86 @@ impl PreparedModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The dilation as first written, a whole-image scan per ring: the reference.
+    fn dilate_by_scans(img: &mut image::RgbaImage, min_alpha: u8) {
+        let (w, h) = img.dimensions();
+        let mut known: Vec<bool> = img.pixels().map(|p| p[3] >= min_alpha.max(1)).collect();
+        if !known.iter().any(|k| *k) {
+            return;
+        }
+        loop {
+            let mut next = known.clone();
+            let mut changed = false;
+            for y in 0..h {
+                for x in 0..w {
+                    let i = (y * w + x) as usize;
+                    if known[i] {
+                        continue;
+                    }
+                    let (mut acc, mut c) = ([0u32; 3], 0);
+                    for (dx, dy) in [(-1i32, 0i32), (1, 0), (0, -1), (0, 1)] {
+                        let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+                        if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                            continue;
+                        }
+                        if known[(ny as u32 * w + nx as u32) as usize] {
+                            let p = img.get_pixel(nx as u32, ny as u32);
+                            (0..3).for_each(|k| acc[k] += u32::from(p[k]));
+                            c += 1;
+                        }
+                    }
+                    if c > 0 {
+                        let p = img.get_pixel_mut(x, y);
+                        (0..3).for_each(|k| p[k] = (acc[k] / c) as u8);
+                        next[i] = true;
+                        changed = true;
+                    }
+                }
+            }
+            known = next;
+            if !changed {
+                break;
+            }
+        }
+    }
+
+    #[test]
+    fn dilation_equals_the_whole_image_scans_and_fills_from_one_texel() {
+        let mut rng = crate::generate::SplitMix64(0x9e37_79b9_7f4a_7c15);
+        let mut next = move || rng.next_u64();
+        for (w, h, density) in [
+            (64, 64, 2),
+            (37, 11, 20),
+            (1, 50, 10),
+            (50, 1, 10),
+            (128, 96, 1),
+            (16, 16, 0),
+            (16, 16, 100),
+        ] {
+            let img = image::RgbaImage::from_fn(w, h, |_, _| {
+                let r = next();
+                let [a, b, c, _, _, _, _, _] = r.to_le_bytes();
+                let alpha = if (r >> 40) % 100 < density {
+                    200
+                } else {
+                    (r >> 50) as u8 % 128
+                };
+                image::Rgba([a, b, c, alpha])
+            });
+            let (mut fast, mut slow) = (img.clone(), img.clone());
+            dilate_colour_from(&mut fast, 128);
+            dilate_by_scans(&mut slow, 128);
+            assert!(fast == slow, "{w}x{h} at {density} %");
+            // Alpha is never touched.
+            assert!(fast.pixels().zip(img.pixels()).all(|(a, b)| a[3] == b[3]));
+        }
+        // One known texel colours the whole image.
+        let mut one = image::RgbaImage::from_pixel(9, 7, image::Rgba([1, 2, 3, 0]));
+        one.put_pixel(6, 2, image::Rgba([200, 100, 50, 255]));
+        dilate_colour_from(&mut one, 128);
+        assert!(one.pixels().all(|p| p.0[..3] == [200, 100, 50]));
+    }
 
     #[test]
     fn footprint_is_the_widest_point_of_the_foot() {
