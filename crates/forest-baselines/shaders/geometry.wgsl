@@ -1,7 +1,9 @@
 // Culling of the geometry-based methods: every instance is frustum-tested and given a draw
 // segment (distance band × species, see method_band); a count, one serial pass of offsets and
 // indirect arguments, and a scatter build the visible list segment by segment, nearest band
-// first. In the hybrid method (camera.forms) trees drawn as quads alone get no segment.
+// first. In the hybrid method (camera.forms) trees drawn as quads alone get no segment, and
+// a species with mesh-LOD bands lists each near tree once per mesh LOD that draws some of its
+// pixels (tree_keys): once, or twice or three times in a crossfade.
 // Appended after common.wgsl and geometry_types.wgsl.
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -47,10 +49,36 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
         keys[i] = NONE;
         return;
     }
-    let d = distance(camera.form_eye.xyz, c) / inst.scale;
-    let key = method_band(method, d) * geo_consts.y + inst.species;
-    keys[i] = key;
-    atomicAdd(&counts[key], 1u);
+    let k = tree_keys(i, inst, sp, c);
+    keys[i] = k.x;
+    for (var j = 0u; j < 3u; j++) {
+        if (k[j] != NONE) { atomicAdd(&counts[k[j]], 1u); }
+    }
+}
+
+// The segments (band · species + species) listing tree `i`, centred at `c`, which the cull
+// keeps: one, the first; under the hybrid's mesh-LOD bands one per LOD whose share range is
+// not empty (lod_shares), in LOD order, NONE for the others. The first is never NONE.
+fn tree_keys(i: u32, inst: Instance, sp: GeoSpecies, c: vec3<f32>) -> vec3<u32> {
+    let dw = distance(camera.form_eye.xyz, c);
+    let d = dw / inst.scale;
+    let species = geo_consts.y;
+    if (!lod_bands_on(method, camera.forms, sp)) {
+        return vec3<u32>(method_band(method, d) * species + inst.species, NONE, NONE);
+    }
+    let unit = sp.switch_unit * inst.scale;
+    let shares = lod_shares(method, camera.forms, sp, dw, unit, i);
+    let s = (camera.forms.x + camera.forms.y * unit) / inst.scale;
+    var keys = vec3<u32>(NONE);
+    var n = 0u;
+    for (var k = 0u; k < 3u; k++) {
+        let r = lod_range(k, shares);
+        if (r.x < r.y) {
+            keys[n] = lod_band(k, d, s, sp) * species + inst.species;
+            n += 1u;
+        }
+    }
+    return keys;
 }
 
 // One invocation: segment offsets in draw order and the indirect arguments of every segment
@@ -64,7 +92,11 @@ fn geo_args() {
         let sp = geo_species[seg % species];
         var count = sp.lod_count.x;
         var first = sp.lod_first.x;
-        if (method.mode == 1u) {
+        if (lod_bands_on(method, camera.forms, sp)) {
+            let lod = band_lod(band);
+            count = sp.lod_count[lod];
+            first = sp.lod_first[lod];
+        } else if (method.mode == 1u) {
             let k = band_elements(band, sp.leaves, method.fade);
             count = sp.branch_vertices;
             if (k > 0u) { count = leaf_end[sp.leaf_base + k - 1u]; }
@@ -94,7 +126,16 @@ fn geo_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     // The order bin its triangles are drawn in (geometry_draw.wgsl's draw_vertex), once per
     // tree here rather than per vertex there.
     let inst = instances[i];
-    let centre = to_world(inst, geo_species[inst.species].sphere.xyz);
+    let sp = geo_species[inst.species];
+    let centre = to_world(inst, sp.sphere.xyz);
     let bin = order_bin(to_object_dir(inst, centre - camera.eye.xyz));
-    visible_list[atomicAdd(&cursor[key], 1u)] = i | (bin << VISIBLE_ID_BITS);
+    let entry = i | (bin << VISIBLE_ID_BITS);
+    visible_list[atomicAdd(&cursor[key], 1u)] = entry;
+    // A tree in a crossfade between mesh LODs: its other LODs' segments.
+    if (lod_bands_on(method, camera.forms, sp)) {
+        let k = tree_keys(i, inst, sp, centre);
+        for (var j = 1u; j < 3u; j++) {
+            if (k[j] != NONE) { visible_list[atomicAdd(&cursor[k[j]], 1u)] = entry; }
+        }
+    }
 }

@@ -2,8 +2,8 @@
 // a light view's listed trees, culled by the cascade's box with their forms and levels of
 // detail chosen from the view's eye (camera.form_eye), as depth only into the cascade's layer.
 // Alpha-tested leaves and billboards are kept where the draw keeps them; in the hybrid's
-// transition band each texel belongs to the form that owns it (quads_own), so the two forms
-// never both cast. No march towards the sun: nothing is shaded.
+// transition band each texel belongs to the form that owns it (not_drawn_here), so the two
+// forms never both cast, and in a crossfade between mesh LODs to one of them. No march towards the sun: nothing is shaded.
 
 @vertex
 fn vs_geo_cast(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> GeoOut {
@@ -12,7 +12,7 @@ fn vs_geo_cast(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32)
 
 @fragment
 fn fs_geo_cast(in: GeoOut) {
-    if (quads_own(in.clip.xy, in.form)) { discard; }
+    if (not_drawn_here(in.clip.xy, in.form)) { discard; }
     let m = materials[in.material];
     if (m.layer != NONE && m.alpha_tested != 0u) {
         let t = textureSampleBias(textures, tex_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y),
@@ -23,6 +23,6 @@ fn fs_geo_cast(in: GeoOut) {
 
 @fragment
 fn fs_billboard_cast(in: BillboardOut) {
-    if (quads_own(in.clip.xy, in.form)) { discard; }
+    if (not_drawn_here(in.clip.xy, in.form)) { discard; }
     if (textureSample(billboards, tex_sampler, in.uv, in.layer).a < 0.5) { discard; }
 }

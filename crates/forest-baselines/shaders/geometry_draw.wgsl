@@ -47,9 +47,10 @@ struct GeoOut {
     @location(4) @interpolate(flat) material: u32,
     // rgb: mean leaf colour; a: contrast weight α = √λ (1: untouched).
     @location(5) @interpolate(flat) contrast: vec4<f32>,
-    // The instance and its quad share (see quad_share): in the hybrid's transition band the
-    // geometry keeps the pixels the quads leave.
-    @location(6) @interpolate(flat) form: vec2<u32>,
+    // The instance, its quad share (see quad_share) and its mesh LOD's share range: in the
+    // hybrid's transition band the geometry keeps the pixels the quads leave, and in a
+    // crossfade between mesh LODs each LOD the pixels of its range (lod_range).
+    @location(6) @interpolate(flat) form: vec4<u32>,
     // The surface point (world, metres), for the haze.
     @location(7) world: vec3<f32>,
     // Transmittance towards the sun through the tree's own crown (its opacity volume).
@@ -59,16 +60,27 @@ struct GeoOut {
     @location(9) @interpolate(flat) tree: vec4<f32>,
 }
 
-// The instance and its quad share (0 outside the hybrid's transition band).
-fn geo_form(id: u32, inst: Instance) -> vec2<u32> {
+// The instance, its quad share (0 outside the hybrid's transition band) and the share range
+// of its mesh LOD `lod` under the hybrid's LOD bands (else, or for NONE, [0, WEIGHT_ONE):
+// every pixel).
+fn geo_form(id: u32, inst: Instance, lod: u32) -> vec4<u32> {
     let sp = geo_species[inst.species];
     let d = distance(camera.form_eye.xyz, to_world(inst, sp.sphere.xyz));
-    return vec2<u32>(id, quad_share(camera.forms, d, sp.switch_unit * inst.scale, id));
+    let unit = sp.switch_unit * inst.scale;
+    var range = vec2<u32>(0u, WEIGHT_ONE);
+    if (lod != NONE && lod_bands_on(method, camera.forms, sp)) {
+        range = lod_range(lod, lod_shares(method, camera.forms, sp, d, unit, id));
+    }
+    return vec4<u32>(id, quad_share(camera.forms, d, unit, id), range);
 }
 
-// Whether a pixel of a tree in the transition band belongs to the quads.
-fn quads_own(pixel: vec2<f32>, form: vec2<u32>) -> bool {
-    return form.y > 0u && form_threshold(pixel, form.x) < form.y;
+// Whether a pixel of a tree is not this draw's: the quads own it (the transition band), or
+// another of its mesh LODs does (a crossfade between them).
+fn not_drawn_here(pixel: vec2<f32>, form: vec4<u32>) -> bool {
+    if (form.y > 0u && form_threshold(pixel, form.x) < form.y) { return true; }
+    if (form.z == 0u && form.w == WEIGHT_ONE) { return false; }
+    let t = lod_threshold(pixel, form.x);
+    return t < form.z || t >= form.w;
 }
 
 @vertex
@@ -94,6 +106,7 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
     let id = entry & VISIBLE_ID_MASK;
     let inst = instances[id];
     let v = vertices[draw_vertex(vi, entry >> VISIBLE_ID_BITS)];
+    let lod = vertex_lod(geo_species[inst.species], vi);
     var p = v.pos;
     var contrast = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     if (method.mode == 1u && v.element != NONE) {
@@ -119,7 +132,7 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
     out.sky = vec2<f32>(v.sky_front, v.sky_back);
     out.material = v.material;
     out.contrast = contrast;
-    out.form = geo_form(id, inst);
+    out.form = geo_form(id, inst, lod);
     let sp = geo_species[inst.species];
     out.tree = vec4<f32>(to_world(inst, sp.sphere.xyz), sp.sphere.w * inst.scale);
     out.sun_vis = 1.0;
@@ -133,7 +146,7 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
 @fragment
 fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
     count_enter(in.clip);
-    if (quads_own(in.clip.xy, in.form)) { discard; }
+    if (not_drawn_here(in.clip.xy, in.form)) { discard; }
     let m = materials[in.material];
     var albedo = m.kd.rgb;
     if (m.layer != NONE) {
@@ -164,7 +177,7 @@ struct BillboardOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
     @location(1) @interpolate(flat) layer: u32,
-    @location(2) @interpolate(flat) form: vec2<u32>,
+    @location(2) @interpolate(flat) form: vec4<u32>,
     @location(3) world: vec3<f32>,
     // The billboard's frame (world): image x, image up, towards the viewer.
     @location(4) @interpolate(flat) right: vec3<f32>,
@@ -212,7 +225,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.clip = camera.view_proj * vec4<f32>(out.world, 1.0);
     out.uv = vec2<f32>(0.5 + 0.5 * x, 0.5 - 0.5 * y);
     out.layer = sp.lod_first.w + e;
-    out.form = geo_form(id, inst);
+    out.form = geo_form(id, inst, NONE);
     out.right = right;
     out.up = up;
     out.back = -f;
@@ -228,7 +241,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
 @fragment
 fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     count_enter(in.clip);
-    if (quads_own(in.clip.xy, in.form)) { discard; }
+    if (not_drawn_here(in.clip.xy, in.form)) { discard; }
     let t = textureSample(billboards, tex_sampler, in.uv, in.layer);
     let g = textureSample(billboard_surface, tex_sampler, in.uv, in.layer);
     if (t.a < 0.5) { discard; }

@@ -46,9 +46,11 @@ struct GeoSpecies {
     switch_unit: f32,
     // Optical depth per voxel length of the opacity-volume code 1.0 (0: no self-shadowing).
     opacity_depth: f32,
+    // Where the hybrid draws its near trees in mesh LOD 1 and LOD 2, as fractions of the
+    // switch distance (0: never; forest_baselines::geometry::GeometrySpecies::lod_from).
+    lod1_from: f32,
+    lod2_from: f32,
     pad0: u32,
-    pad1: u32,
-    pad2: u32,
 }
 
 // The method and its parameters (forest_render::geometry::MeshMethod).
@@ -129,6 +131,59 @@ fn band_elements(k: u32, n: u32, width: f32) -> u32 {
 // Distance band of depth sorting: ⌊2·log2 d⌋ for d in [1, 256) m.
 fn distance_band(d: f32) -> u32 {
     return min(u32(max(floor(2.0 * log2(max(d, 1.0))), 0.0)), BANDS - 1u);
+}
+
+// Whether the hybrid draws a species' near trees in its mesh LODs this frame: under full
+// geometry (mode 0) with a switch (forms: neither the quad stream alone nor geometry alone)
+// and a measured start for LOD 1 or 2.
+fn lod_bands_on(m: Method, forms: vec4<f32>, sp: GeoSpecies) -> bool {
+    return m.mode == 0u && (sp.lod1_from > 0.0 || sp.lod2_from > 0.0)
+        && forms.x < 3.0e38 && (forms.x > 0.0 || forms.y > 0.0);
+}
+
+// The shares of a tree's mesh LODs 1 and 2 and coarser (forest_render::forms::lod_shares):
+// LOD k draws the pixels whose lod_threshold lies in [c(k+1), c(k)), c = (WEIGHT_ONE, x, y, 0).
+// (0, 0) outside the hybrid's LOD bands: LOD 0 draws every pixel.
+fn lod_shares(m: Method, forms: vec4<f32>, sp: GeoSpecies, d: f32, unit: f32, id: u32)
+    -> vec2<u32> {
+    if (!lod_bands_on(m, forms, sp)) { return vec2<u32>(0u); }
+    let c2 = lod_share(forms, d, unit, id, sp.lod2_from);
+    let c1 = max(lod_share(forms, d, unit, id, sp.lod1_from), c2);
+    return vec2<u32>(c1, c2);
+}
+
+// The share range [lo, hi) of mesh LOD k (0 to 2) of a tree with lod_shares `c`.
+fn lod_range(k: u32, c: vec2<u32>) -> vec2<u32> {
+    let bounds = array<u32, 4>(WEIGHT_ONE, c.x, c.y, 0u);
+    return vec2<u32>(bounds[k + 1u], bounds[k]);
+}
+
+// The mesh LOD of a species' vertex `vi` (its index in the vertex buffer).
+fn vertex_lod(sp: GeoSpecies, vi: u32) -> u32 {
+    if (vi >= sp.lod_first.z) { return 2u; }
+    return select(0u, 1u, vi >= sp.lod_first.y);
+}
+
+// Under the hybrid's LOD bands, the draw band of mesh LOD `k` of a tree at object-space
+// distance d, with the switch at s (object-space metres): LOD 0 in bands 0 to 7 from the eye
+// to the next LOD's start, LOD 1 in 8 to 11 and LOD 2 in 12 to 15 up to the next start (the
+// switch for LOD 2), each split evenly: nearest first for the depth test, one LOD per band.
+fn lod_band(k: u32, d: f32, s: f32, sp: GeoSpecies) -> u32 {
+    let starts = array<f32, 4>(0.0, sp.lod1_from, sp.lod2_from, 1.0);
+    var end = 1.0;
+    for (var j = 2u; j > k; j--) {
+        if (starts[j] > 0.0) { end = starts[j]; }
+    }
+    let start = starts[k] * s;
+    let n = select(4.0, 8.0, k == 0u);
+    let sub = u32(clamp(floor(n * (d - start) / max(end * s - start, 1e-6)), 0.0, n - 1.0));
+    return select(4u + 4u * k, 0u, k == 0u) + sub;
+}
+
+// The mesh LOD a band of a species under the hybrid's LOD bands draws (lod_band).
+fn band_lod(band: u32) -> u32 {
+    if (band < 8u) { return 0u; }
+    return select(2u, 1u, band < 12u);
 }
 
 // The draw band of a tree at object-space distance d (forest_render::geometry::cpu_band).

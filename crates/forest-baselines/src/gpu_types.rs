@@ -29,8 +29,11 @@ pub struct GpuGeoSpecies {
     /// Optical depth per voxel length of the species' opacity-volume code 255 (0: no
     /// self-shadowing; see [`forest_format::opacity`]).
     pub opacity_depth: f32,
+    /// Where the hybrid's near trees are drawn in mesh LOD 1 and LOD 2, as fractions of the
+    /// switch distance (0: never; [`crate::geometry::GeometrySpecies::lod_from`]).
+    pub lod_from: [f32; 2],
     /// Padding to 16 bytes.
-    pub pad: [u32; 3],
+    pub pad: u32,
 }
 
 /// The mip bias that makes every lookup read a texture's finest level (WGSL clamps biases to

@@ -175,6 +175,7 @@ mod tests {
             epsilon: 2.0,
             cameras: 1,
             tolerance: 0.0,
+            lod_from: [None; 2],
         });
         m
     }

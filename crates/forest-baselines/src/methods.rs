@@ -75,7 +75,8 @@ pub struct MethodStats {
     /// Trees drawn as billboards (discrete LODs).
     pub billboards: u32,
     /// Trees drawn as geometry by the hybrid (near ones and those in the transition band,
-    /// which the quads draw too); 0 for the other methods.
+    /// which the quads draw too; a tree in a crossfade between mesh LODs counts once per
+    /// LOD); 0 for the other methods.
     pub geometry_trees: u32,
     /// Quads per hierarchy level (quad-stream methods; empty for the others).
     pub per_level: Vec<u32>,

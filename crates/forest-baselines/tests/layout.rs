@@ -45,9 +45,9 @@ fn geometry_structs_match_the_host() {
                 ("mean_leaf", offset_of!(GpuGeoSpecies, mean_leaf)),
                 ("switch_unit", offset_of!(GpuGeoSpecies, switch_unit)),
                 ("opacity_depth", offset_of!(GpuGeoSpecies, opacity_depth)),
+                ("lod1_from", offset_of!(GpuGeoSpecies, lod_from)),
+                ("lod2_from", offset_of!(GpuGeoSpecies, lod_from) + 4),
                 ("pad0", offset_of!(GpuGeoSpecies, pad)),
-                ("pad1", offset_of!(GpuGeoSpecies, pad) + 4),
-                ("pad2", offset_of!(GpuGeoSpecies, pad) + 8),
             ],
         ),
         (

@@ -12,7 +12,9 @@
 //! excess falls with distance); it is recorded as the width the finest quads project to
 //! there ([`HybridSwitch::finest_quad_pixels`]), which carries over to any view and tree
 //! size. The LODs' errors say whether they could draw the hybrid's near trees instead of the
-//! full model ([`describe_lods`]; on the bundled species they never come within 1.7× of it).
+//! full model: from where each is as accurate as the full model (within the same tolerance),
+//! up to the switch, the hybrid draws its near trees in it ([`lod_from`],
+//! [`HybridSwitch::lod_from`]; on the bundled species they never come within 1.7× of it).
 
 use anyhow::Result;
 use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
@@ -133,6 +135,45 @@ pub fn crossover(ladder: &[Rung], tolerance: f32) -> (f32, bool) {
     (ladder[ladder.len() - 1].radii, false)
 }
 
+/// Where mesh LOD `k` (1 or 2) becomes as accurate as the full model (its error within
+/// `1 + tolerance` times the model's) and stays so up to the switch at `switch_radii`, in
+/// crown radii: after the last measured rung nearer than the switch where it was not,
+/// linear between that rung and the next; the first rung when it was at every rung nearer
+/// than the switch; `None` when it was not at the last rung before the switch (or when no
+/// rung lies nearer than it), or the crossing lies at or past the switch.
+pub fn lod_crossover(ladder: &[Rung], switch_radii: f32, tolerance: f32, k: usize) -> Option<f32> {
+    let excess = |r: &Rung| r.lods[k - 1] - (1.0 + tolerance) * r.geometry;
+    let near = ladder.iter().filter(|r| r.radii < switch_radii).count();
+    if near == 0 {
+        return None;
+    }
+    let Some(last_bad) = (0..near).rev().find(|&i| excess(&ladder[i]) > 0.0) else {
+        return Some(ladder[0].radii);
+    };
+    let (a, b) = (&ladder[last_bad], ladder.get(last_bad + 1)?);
+    let (ea, eb) = (excess(a), excess(b));
+    if eb > 0.0 {
+        return None;
+    }
+    let at = a.radii + ea / (ea - eb) * (b.radii - a.radii);
+    (at < switch_radii).then_some(at)
+}
+
+/// The hybrid's mesh-LOD starts of a measured ladder ([`HybridSwitch::lod_from`]): each
+/// LOD's [`lod_crossover`] as a fraction of the switch. A LOD 2 that is as accurate from as
+/// near as LOD 1 replaces it (LOD 1 would draw no tree).
+pub fn lod_from(ladder: &[Rung], switch_radii: f32, tolerance: f32) -> [Option<f32>; 2] {
+    let frac = |k| {
+        lod_crossover(ladder, switch_radii, tolerance, k)
+            .map(|r| r / switch_radii)
+            .filter(|f| *f > 0.0 && *f < 1.0)
+    };
+    match [frac(1), frac(2)] {
+        [Some(a), Some(b)] if b <= a => [None, Some(b)],
+        f => f,
+    }
+}
+
 /// The finest quads' projected width (pixels) at `radii` crown radii, for a hierarchy of
 /// `levels` levels at the measurement's view: `2 · focal / (2^(levels−1) · radii)`, the
 /// relation [`auto_radii`] solves for the radii (crown radii × pixels is fixed).
@@ -164,18 +205,37 @@ pub fn accuracy_words(tolerance: f32) -> String {
 pub fn describe(m: &forest_format::AtlasManifest) -> String {
     match &m.hybrid_switch {
         Some(h) => format!(
-            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, stream {})",
+            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, stream {}){}",
             h.finest_quad_pixels,
             h.crown_radii,
             h.viewport[0],
             h.viewport[1],
             h.fov_y_deg,
-            accuracy_words(h.tolerance)
+            accuracy_words(h.tolerance),
+            describe_lod_from(&h.lod_from)
         ),
         None => format!(
             "finest quads {} px (not measured: the default)",
             forest_render::forms::DEFAULT_SWITCH_PIXELS
         ),
+    }
+}
+
+/// The hybrid's mesh-LOD starts in words: empty when the near trees are always the full
+/// model, else where each LOD takes over.
+pub fn describe_lod_from(lod_from: &[Option<f32>; 2]) -> String {
+    let parts: Vec<String> = lod_from
+        .iter()
+        .enumerate()
+        .filter_map(|(k, f)| f.map(|f| format!("mesh LOD {} from {:.2}", k + 1, f)))
+        .collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; near trees in {} of the switch distance",
+            parts.join(", ")
+        )
     }
 }
 
@@ -335,6 +395,7 @@ pub fn measure(
     progress(total, total);
     let ladder: Vec<Rung> = measured.into_iter().flatten().collect();
     let (radii, _) = crossover(&ladder, tolerance);
+    let lod_from = lod_from(&ladder, radii, tolerance);
     let pixels = finest_quad_pixels(manifest.levels, radii)
         .clamp(HybridSwitch::MIN_PIXELS, HybridSwitch::MAX_PIXELS);
     Ok((
@@ -346,6 +407,7 @@ pub fn measure(
             epsilon: EPSILON,
             cameras: CAMERAS,
             tolerance,
+            lod_from,
         },
         ladder,
     ))
@@ -437,6 +499,64 @@ mod tests {
         assert!(text.contains("on 2 measured rungs"), "{text}");
         // No rung nearer than the switch: every rung counts.
         assert!(describe_lods(&[far], 1.0).contains("1.00x / 1.00x"));
+    }
+
+    fn lod_rung(radii: f32, geometry: f32, lods: [f32; 2]) -> Rung {
+        Rung {
+            radii,
+            geometry,
+            quads: 1.0,
+            lods,
+        }
+    }
+
+    #[test]
+    fn mesh_lods_start_where_they_stay_as_accurate_up_to_the_switch() {
+        // LOD 1: twice the model's error at 1, 0.05 over at 2, 0.05 under at 3: as accurate
+        // from 2.5. LOD 2: over at every rung nearer than the switch at 4, under at 4: from
+        // 3.8, between the last rung before the switch and the first past it.
+        let ladder = [
+            lod_rung(1.0, 0.1, [0.2, 0.5]),
+            lod_rung(2.0, 0.1, [0.15, 0.4]),
+            lod_rung(3.0, 0.1, [0.05, 0.3]),
+            lod_rung(4.0, 0.1, [0.05, 0.05]),
+        ];
+        let c = lod_crossover(&ladder, 4.0, 0.0, 1).unwrap();
+        assert!((c - 2.5).abs() < 1e-5, "{c}");
+        let c = lod_crossover(&ladder, 4.0, 0.0, 2).unwrap();
+        assert!((c - 3.8).abs() < 1e-5, "{c}");
+        let f = lod_from(&ladder, 4.0, 0.0);
+        assert!((f[0].unwrap() - 2.5 / 4.0).abs() < 1e-5, "{f:?}");
+        assert!((f[1].unwrap() - 3.8 / 4.0).abs() < 1e-5, "{f:?}");
+        // The crossing at 3.8 lies past a switch at 3.5: never.
+        assert_eq!(lod_crossover(&ladder, 3.5, 0.0, 2), None);
+        // A tolerance of 1.5: LOD 1 is within it everywhere, from the first rung; LOD 2 from
+        // 3.2 (excess 0.05 at 3, −0.2 at 4).
+        let f = lod_from(&ladder, 4.0, 1.5);
+        assert_eq!(f[0], Some(0.25));
+        assert!((f[1].unwrap() - 3.2 / 4.0).abs() < 1e-5, "{f:?}");
+        // A LOD that is worse again at a later rung starts after it; none before the switch,
+        // or no rung nearer than it: never.
+        let bumpy = [
+            lod_rung(1.0, 0.1, [0.05, 0.5]),
+            lod_rung(2.0, 0.1, [0.2, 0.5]),
+            lod_rung(3.0, 0.1, [0.1, 0.5]),
+        ];
+        assert_eq!(lod_crossover(&bumpy, 4.0, 0.0, 1), Some(3.0));
+        assert_eq!(lod_crossover(&bumpy, 2.5, 0.0, 1), None);
+        assert_eq!(lod_from(&bumpy, 2.5, 0.0), [None; 2]);
+        assert_eq!(lod_crossover(&bumpy, 1.0, 0.0, 1), None);
+        // LOD 2 as accurate as near as LOD 1 replaces it.
+        let coarse = [
+            lod_rung(1.0, 0.1, [0.2, 0.2]),
+            lod_rung(2.0, 0.1, [0.1, 0.1]),
+        ];
+        assert_eq!(lod_from(&coarse, 4.0, 0.0), [None, Some(0.5)]);
+        assert_eq!(describe_lod_from(&[None; 2]), "");
+        assert_eq!(
+            describe_lod_from(&[Some(0.25), Some(0.5)]),
+            "; near trees in mesh LOD 1 from 0.25, mesh LOD 2 from 0.50 of the switch distance"
+        );
     }
 
     #[test]

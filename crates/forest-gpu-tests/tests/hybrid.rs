@@ -313,6 +313,98 @@ fn a_tree_in_the_band_is_drawn_by_both_forms_with_weights_summing_to_one() {
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
 }
 
+/// One tree nearer than the hybrid's switch, drawn with mesh-LOD starts `lod_from` for its
+/// species: the image and the frame's counters.
+fn near_tree_in_lods(
+    ctx: &GpuContext,
+    species: u32,
+    lod_from: [f32; 2],
+    cam: &Camera,
+) -> (
+    image::RgbaImage,
+    forest_baselines::methods::MethodStats,
+    [u32; 2],
+) {
+    let forest = common::one_tree(species, 0.4);
+    let mut prepared = common::prepared().clone();
+    prepared.set_lod_from(species as usize, lod_from).unwrap();
+    let mut r = common::forest_renderer(
+        ctx,
+        &common::species(),
+        &prepared,
+        &forest,
+        cam.viewport,
+        Background::Transparent,
+        Atmosphere::CLEAR,
+    );
+    let (d, unit) = tree_distance(&r, cam, 0);
+    // The switch at twice the tree's distance: the tree is geometry alone.
+    let h = Hybrid {
+        near: Near::Metres(2.0 * d),
+        band: 0.5,
+        jitter: 0.0,
+        ..Default::default()
+    };
+    assert_eq!(hybrid::quad_share(h.forms(cam), d, unit, 0), 0);
+    let image = frame(ctx, &mut r, Method::Hybrid(h), cam);
+    let shares = hybrid::lod_shares(h.forms(cam), d, unit, 0, lod_from);
+    (image, r.read_stats(ctx), shares)
+}
+
+#[test]
+fn a_near_tree_in_a_crossfade_between_mesh_lods_is_split_pixel_for_pixel() {
+    let ctx = common::ctx();
+    let cam = common::camera(Vec3::new(2.0, 2.0, 9.0), Vec3::new(0.0, 2.0, 0.0), 2.0);
+    let mut cam = cam;
+    cam.viewport = (160, 120);
+    for species in [0, 1] {
+        // Without starts the full model; starts at a tenth of the switch put the whole tree
+        // (at half of it) in that LOD.
+        let (lod0, full, _) = near_tree_in_lods(&ctx, species, [0.0, 0.0], &cam);
+        let (lod1, one, _) = near_tree_in_lods(&ctx, species, [0.1, 0.0], &cam);
+        let (lod2, two, _) = near_tree_in_lods(&ctx, species, [0.0, 0.1], &cam);
+        let lods = [&lod0, &lod1, &lod2];
+        let tris = common::prepared().figures[species as usize].lod_triangles;
+        for (stats, t) in [(&full, tris[0]), (&one, tris[1]), (&two, tris[2])] {
+            assert_eq!(
+                (stats.geometry_trees, stats.primitives),
+                (1, t),
+                "{stats:?}"
+            );
+        }
+        assert!(
+            lod0 != lod1 && lod1 != lod2,
+            "the LODs draw different images"
+        );
+        // LOD 1 from 0.4 and LOD 2 from 0.45 of the switch (band 0.5): the tree, at 0.5, is
+        // half-way through LOD 1's crossfade and a fifth of the way through LOD 2's.
+        let (mixed, stats, [c1, c2]) = near_tree_in_lods(&ctx, species, [0.4, 0.45], &cam);
+        assert!(
+            (1900..2200).contains(&c1) && (700..1000).contains(&c2),
+            "shares {c1} {c2}"
+        );
+        assert_eq!(stats.geometry_trees, 3, "listed once per LOD: {stats:?}");
+        let expected = image::RgbaImage::from_fn(160, 120, |x, y| {
+            let t = hybrid::lod_threshold(x, y, 0);
+            let k = 2 - usize::from(t >= c2) - usize::from(t >= c1);
+            *lods[k].get_pixel(x, y)
+        });
+        let wrong = mixed
+            .pixels()
+            .zip(expected.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        if wrong != 0 {
+            save(
+                &format!("hybrid-lods-{species}"),
+                &[("mixed", &mixed), ("expected", &expected)],
+            );
+            panic!("{wrong} pixels are not from the LOD their mask gives");
+        }
+    }
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+}
+
 #[test]
 fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera() {
     let ctx = common::ctx();
@@ -329,15 +421,21 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
         epsilon: 2.0,
         cameras: 1,
         tolerance: 0.0,
+        lod_from: [None; 2],
     });
     let atlases: Vec<_> = species.iter().map(|s| s.atlas.clone()).collect();
     let measured = common::prepared_for(&atlases);
     let default = hybrid::switch_unit(&common::atlases()[1].manifest);
     let unit = hybrid::switch_unit(&species[1].atlas.manifest);
     assert!((unit / default - hybrid::DEFAULT_SWITCH_PIXELS / 0.8).abs() < 1e-5);
+    // And with the pine's near trees in mesh LOD 1 from 0.3 and LOD 2 from 0.6 of its
+    // switch: a tree is listed once per LOD its crossfades give pixels.
+    let mut lods = measured.clone();
+    lods.set_lod_from(1, [0.3, 0.6]).unwrap();
     for (near, species, prepared) in [
         (Near::Metres(10.0), common::species(), common::prepared()),
-        (Near::Auto, species, &measured),
+        (Near::Auto, species.clone(), &measured),
+        (Near::Auto, species, &lods),
     ] {
         classification_matches(&ctx, &forest, &species, prepared, near);
     }
@@ -370,7 +468,8 @@ fn classification_matches(
     };
     r.set_method(ctx, Method::Hybrid(h)).unwrap();
     let before = r.uploads();
-    let (mut both, mut frames) = (0, 0);
+    let (mut both, mut frames, mut crossfades) = (0, 0, 0);
+    let lod_from = prepared.lod_from();
     for (name, cam) in common::cameras(forest.extent()) {
         r.render_frame(ctx, &cam, &target).unwrap();
         frames += 1;
@@ -400,7 +499,15 @@ fn classification_matches(
                 .all(|p| p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] >= -radius);
             let share = hybrid::quad_share(forms, d, unit, i as u32);
             if visible && share < WEIGHT_ONE {
-                near += 1;
+                // Once per mesh LOD with pixels: [c(k+1), c(k)) not empty.
+                let sp = r.stream.scene.tables.instances[i].species as usize;
+                let [c1, c2] = hybrid::lod_shares(forms, d, unit, i as u32, lod_from[sp]);
+                let listed = [WEIGHT_ONE, c1, c2, 0]
+                    .windows(2)
+                    .filter(|w| w[1] < w[0])
+                    .count() as u32;
+                near += listed;
+                crossfades += u32::from(listed > 1);
                 both += u32::from(share > 0);
             }
         }
@@ -411,6 +518,12 @@ fn classification_matches(
         );
     }
     assert!(both > 0, "some trees were in the band");
+    if lod_from.iter().flatten().any(|&f| f > 0.0) {
+        assert!(
+            crossfades > 0,
+            "some trees were in a crossfade between mesh LODs"
+        );
+    }
     let (n, bytes) = r.uploads();
     let size = std::mem::size_of::<forest_render::gpu_types::GpuCamera>() as u64;
     assert_eq!(

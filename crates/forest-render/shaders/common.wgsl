@@ -397,6 +397,24 @@ fn form_threshold(pixel: vec2<f32>, instance: u32) -> u32 {
     return dither_threshold(pixel.yx, instance ^ 0x5bd1e995u);
 }
 
+// The hybrid's share of a tree given to its mesh LOD starting at `start` (a fraction of the
+// switch distance; 0: none) and the coarser ones, in units of 1/WEIGHT_ONE
+// (forest_render::forms::lod_share mirrors it): the quad share of a switch `start` times
+// nearer, with the same band and jitter. 0 when there is no such LOD, or no switch.
+fn lod_share(forms: vec4<f32>, d: f32, unit: f32, instance: u32, start: f32) -> u32 {
+    let s = forms.x + forms.y * unit;
+    if (start <= 0.0 || s <= 0.0 || s >= 3.0e38) { return 0u; }
+    return quad_share(vec4<f32>(forms.x * start, forms.y * start, forms.z, forms.w), d, unit,
+                      instance);
+}
+
+// The screen-door threshold that splits a tree in a crossfade between its mesh LODs: the
+// coarser LOD keeps the pixels whose threshold is below its share (lod_share), the finer one
+// the others. Salted apart from form_threshold.
+fn lod_threshold(pixel: vec2<f32>, instance: u32) -> u32 {
+    return dither_threshold(pixel, instance ^ 0x27d4eb2fu);
+}
+
 fn pack_pos(level: u32, x: u32, y: u32, slab: u32) -> u32 {
     return level | (x << 4u) | (y << 16u) | (slab << 28u);
 }

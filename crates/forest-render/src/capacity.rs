@@ -93,24 +93,33 @@ impl Capacity {
 pub struct GeometryCapacity {
     /// Draw segments: distance bands × species (at least 1).
     pub segments: u32,
-    /// Elements of the classification-key and visible-instance lists: every instance (at
-    /// least 1, so that empty forests still bind a buffer).
+    /// Elements of the classification-key list: every instance (at least 1, so that empty
+    /// forests still bind a buffer).
     pub instances: u32,
+    /// Elements of the visible list: every instance, listed up to `listings` times (a tree
+    /// in a crossfade between two or three of the hybrid's mesh LODs is listed once per LOD),
+    /// at least 1.
+    pub listed: u32,
 }
 
 impl GeometryCapacity {
-    /// Sizes for `instances` trees of `species` species drawn in `bands` distance bands.
-    pub fn new(instances: u32, species: u32, bands: u32) -> Self {
-        Self {
+    /// Sizes for `instances` trees of `species` species drawn in `bands` distance bands,
+    /// each listed at most `listings` times (1 to 3). `None` when the visible list's entries
+    /// overflow 32 bits.
+    pub fn new(instances: u32, species: u32, bands: u32, listings: u32) -> Option<Self> {
+        Some(Self {
             segments: (bands * species).max(1),
             instances: instances.max(1),
-        }
+            listed: instances.checked_mul(listings.clamp(1, 3))?.max(1),
+        })
     }
 
-    /// Bytes of the per-frame buffers: keys and visible list (4 bytes per instance), counts
-    /// and cursors (4 bytes per segment), indirect draw arguments (16 bytes per segment).
+    /// Bytes of the per-frame buffers: keys (4 bytes per instance), visible list (4 bytes
+    /// per listing), counts and cursors (4 bytes per segment), indirect draw arguments (16
+    /// bytes per segment).
     pub fn bytes(&self) -> u64 {
-        2 * u64::from(self.instances) * 4 + u64::from(self.segments) * (4 + 4 + 16)
+        (u64::from(self.instances) + u64::from(self.listed)) * 4
+            + u64::from(self.segments) * (4 + 4 + 16)
     }
 }
 
@@ -172,9 +181,15 @@ mod tests {
             (many.items, many.sums),
             (100_000, 2 * 100_000u32.div_ceil(512))
         );
-        let g = GeometryCapacity::new(1000, 2, 12);
-        assert_eq!((g.segments, g.instances), (24, 1000));
+        let g = GeometryCapacity::new(1000, 2, 12, 1).unwrap();
+        assert_eq!((g.segments, g.instances, g.listed), (24, 1000, 1000));
         assert_eq!(g.bytes(), 8000 + 24 * 24);
-        assert_eq!(GeometryCapacity::new(0, 0, 12).segments, 1);
+        let empty = GeometryCapacity::new(0, 0, 12, 3).unwrap();
+        assert_eq!((empty.segments, empty.listed), (1, 1));
+        // Mesh-LOD crossfades list a tree up to three times.
+        let g = GeometryCapacity::new(1000, 2, 12, 3).unwrap();
+        assert_eq!((g.instances, g.listed), (1000, 3000));
+        assert_eq!(g.bytes(), 16000 + 24 * 24);
+        assert!(GeometryCapacity::new(u32::MAX / 2, 1, 16, 3).is_none());
     }
 }

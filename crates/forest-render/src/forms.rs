@@ -93,6 +93,46 @@ pub fn form_threshold(x: u32, y: u32, instance: u32) -> u32 {
     dither_threshold(y, x, instance ^ 0x5bd1_e995)
 }
 
+/// The hybrid's share of a tree given to its mesh LOD that starts at `from` (a fraction of
+/// the switch distance, 0: the species has no such LOD) and the coarser ones, in units of
+/// 1/[`WEIGHT_ONE`] (`lod_share` in `shaders/common.wgsl`): the [`quad_share`] of a switch
+/// `from` times nearer, with the same band and jitter, so LODs crossfade as the forms do.
+/// 0 without such a LOD or without a switch (the quad stream alone, geometry alone).
+pub fn lod_share(forms: [f32; 4], distance: f32, unit: f32, instance: u32, from: f32) -> u32 {
+    let s = forms[0] + forms[1] * unit;
+    if from <= 0.0 || s <= 0.0 || s >= GEOMETRY_ALWAYS {
+        return 0;
+    }
+    quad_share(
+        [forms[0] * from, forms[1] * from, forms[2], forms[3]],
+        distance,
+        unit,
+        instance,
+    )
+}
+
+/// The shares of a tree's mesh LODs 1 and 2 and coarser, `[c1, c2]` with `c1 ≥ c2`, for a
+/// species whose LODs start at `lod_from` (fractions of the switch, 0: none): mesh LOD `k`
+/// (0, 1, 2) draws the pixels whose [`lod_threshold`] lies in `[c(k+1), c(k))`, with
+/// `c0 = WEIGHT_ONE` and `c3 = 0`; a LOD without a start takes no pixels.
+pub fn lod_shares(
+    forms: [f32; 4],
+    distance: f32,
+    unit: f32,
+    instance: u32,
+    lod_from: [f32; 2],
+) -> [u32; 2] {
+    let c2 = lod_share(forms, distance, unit, instance, lod_from[1]);
+    let c1 = lod_share(forms, distance, unit, instance, lod_from[0]).max(c2);
+    [c1, c2]
+}
+
+/// The screen-door threshold that splits a tree in a crossfade between its mesh LODs
+/// (`lod_threshold` in `shaders/common.wgsl`), salted apart from [`form_threshold`].
+pub fn lod_threshold(x: u32, y: u32, instance: u32) -> u32 {
+    dither_threshold(x, y, instance ^ 0x27d4_eb2f)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -122,6 +162,53 @@ mod tests {
             .filter(|&i| quad_share(forms, 12.5, 1.0, i) == WEIGHT_ONE)
             .count();
         assert!((400..600).contains(&quads), "{quads}");
+    }
+
+    #[test]
+    fn mesh_lods_split_the_near_trees_by_fractions_of_the_switch() {
+        // Switch at 20 m, band 0.5, no jitter: LOD 1 from 0.5 (10 to 15 m), LOD 2 from 0.75
+        // (15 to 22.5 m).
+        let forms = [20.0, 0.0, 0.5, 0.0];
+        let from = [0.5, 0.75];
+        let half = WEIGHT_ONE / 2 + 1;
+        assert_eq!(lod_shares(forms, 9.9, 1.0, 3, from), [0, 0]);
+        assert_eq!(lod_shares(forms, 12.5, 1.0, 3, from), [half, 0]);
+        assert_eq!(lod_shares(forms, 15.0, 1.0, 3, from), [WEIGHT_ONE, 0]);
+        assert_eq!(lod_shares(forms, 18.75, 1.0, 3, from), [WEIGHT_ONE, half]);
+        assert_eq!(lod_shares(forms, 22.5, 1.0, 3, from), [WEIGHT_ONE; 2]);
+        // Without LOD 1, LOD 2 takes its pixels straight from LOD 0.
+        assert_eq!(lod_shares(forms, 18.75, 1.0, 3, [0.0, 0.75]), [half; 2]);
+        assert_eq!(lod_shares(forms, 18.75, 1.0, 3, [0.0, 0.0]), [0, 0]);
+        // No switch, no LODs: the quad stream or full geometry alone.
+        for f in [FORMS_QUADS, FORMS_GEOMETRY] {
+            assert_eq!(lod_shares(f, 15.0, 1.0, 3, from), [0, 0]);
+        }
+        // The focal-length switch scales the same way.
+        let auto = [0.0, 2.0, 0.5, 0.0];
+        assert_eq!(
+            lod_shares(auto, 12.5, 10.0, 3, from),
+            lod_shares(forms, 12.5, 1.0, 3, from)
+        );
+        // With band 1 the crossfades overlap: at 17.5 m LOD 1 and coarser have 3/4 (3071.25),
+        // LOD 2 1/6 (682.5).
+        let forms = [20.0, 0.0, 1.0, 0.0];
+        // Every pixel of a tree goes to exactly one LOD, in proportion to the shares.
+        let [c1, c2] = lod_shares(forms, 17.5, 1.0, 9, from);
+        assert_eq!([c1, c2], [3071, 683]);
+        let mut per_lod = [0u32; 3];
+        for y in 0..8 {
+            for x in 0..8 {
+                let t = lod_threshold(x, y, 9);
+                per_lod[2 - usize::from(t >= c2) - usize::from(t >= c1)] += 1;
+            }
+        }
+        let want = |c: u32| c as f32 / WEIGHT_ONE as f32 * 64.0;
+        assert!((per_lod[2] as f32 - want(c2)).abs() <= 1.0, "{per_lod:?}");
+        assert!(
+            (per_lod[1] as f32 - (want(c1) - want(c2))).abs() <= 1.0,
+            "{per_lod:?}"
+        );
+        assert_eq!(per_lod.iter().sum::<u32>(), 64);
     }
 
     #[test]

@@ -102,8 +102,8 @@ pub fn check_limits(
             ": draw fewer trees",
         ),
         (
-            "the geometry methods' visible list, 4 bytes per tree (bytes)",
-            bytes(instances, 4),
+            "the geometry methods' visible list, 4 bytes per tree and listing (bytes)",
+            bytes(instances, 4).saturating_mul(u64::from(prepared.listings())),
             ": draw fewer trees",
         ),
     ];
@@ -185,6 +185,19 @@ impl GpuModels {
         super::renderer::require_indirect_first_instance(ctx)?;
         let device = &ctx.device;
         check_limits(&device.limits(), prepared, forest.instances.len())?;
+        let capacity = GeometryCapacity::new(
+            forest.instances.len() as u32,
+            prepared.geo_species.len() as u32,
+            BANDS,
+            prepared.listings(),
+        )
+        .ok_or_else(|| {
+            RenderError::Parameter(format!(
+                "{} trees listed {} times overflow the geometry methods' visible list",
+                forest.instances.len(),
+                prepared.listings()
+            ))
+        })?;
         let terrain = GpuTerrain::new(device, forest.terrain.as_ref())?;
         let instances = forest_render::scene::gpu_instances(forest);
         let mut bytes = terrain.bytes();
@@ -297,11 +310,7 @@ impl GpuModels {
             billboard_view,
             opacity_view: opacity_texture.create_view(&Default::default()),
             opacity_sampler,
-            capacity: GeometryCapacity::new(
-                instances.len() as u32,
-                geo_species.len() as u32,
-                BANDS,
-            ),
+            capacity,
             species_count: geo_species.len() as u32,
             instance_count: instances.len() as u32,
             band: ReceiverBand::of(

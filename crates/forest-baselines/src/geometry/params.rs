@@ -15,6 +15,10 @@ pub struct GeometrySpecies {
     /// The hybrid's switch unit of its atlas ([`forest_render::forms::switch_unit`]), so that
     /// both forms agree where each tree switches (any value when the hybrid is not used).
     pub switch_unit: f32,
+    /// Where the hybrid draws its near trees in mesh LOD 1 and LOD 2 instead of the full
+    /// model, as fractions of the switch distance in (0, 1); 0: never (the atlas's
+    /// [`forest_format::atlas::HybridSwitch::lod_from`]).
+    pub lod_from: [f32; 2],
 }
 
 impl GeometrySpecies {
@@ -27,6 +31,9 @@ impl GeometrySpecies {
         Self {
             model,
             switch_unit: forest_render::forms::switch_unit(manifest),
+            lod_from: manifest
+                .hybrid_switch
+                .map_or([0.0; 2], |h| h.lod_from.map(|f| f.unwrap_or(0.0))),
         }
     }
 }
@@ -212,7 +219,8 @@ impl MeshMethod {
 /// Counters of the last frame.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GeometryStats {
-    /// Trees that passed the frustum test.
+    /// Trees that passed the frustum test (the hybrid lists a tree in a crossfade between
+    /// mesh LODs once per LOD, and each listing counts).
     pub visible_trees: u32,
     /// Visible trees per draw band.
     pub per_band: Vec<u32>,

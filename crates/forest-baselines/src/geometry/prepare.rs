@@ -9,6 +9,7 @@ use super::cards::{card_quads, cut_cards};
 use super::params::{GeometrySpecies, SpeciesFigures};
 use super::textures::layer_bytes;
 use crate::gpu_types::{GpuGeoMaterial, GpuGeoSpecies};
+use forest_render::context::RenderError;
 
 /// How the geometry methods draw their alpha-tested leaf cards.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -55,6 +56,51 @@ impl PreparedGeometry {
     /// 3 vertices per triangle of every species' LODs (see [`super::check_limits`]).
     pub fn vertex_bytes(&self) -> u64 {
         std::mem::size_of_val(self.vertices.as_slice()) as u64
+    }
+
+    /// Per species, where the hybrid draws its near trees in mesh LOD 1 and LOD 2 (fractions
+    /// of the switch distance, 0: never).
+    pub fn lod_from(&self) -> Vec<[f32; 2]> {
+        self.geo_species.iter().map(|s| s.lod_from).collect()
+    }
+
+    /// Set where the hybrid draws species `species`' near trees in mesh LOD 1 and LOD 2, as
+    /// fractions of the switch distance (0: never), overriding its atlas's measurement
+    /// ([`GeometrySpecies::lod_from`]). Refused, naming the value, outside [0, 1) or with LOD
+    /// 2 starting before LOD 1, or for a species the models do not have.
+    pub fn set_lod_from(&mut self, species: usize, lod_from: [f32; 2]) -> Result<(), RenderError> {
+        let n = self.geo_species.len();
+        let sp = self.geo_species.get_mut(species).ok_or_else(|| {
+            RenderError::Parameter(format!("species {species} of {n} has no model"))
+        })?;
+        if let Some(f) = lod_from.iter().find(|f| !(0.0..1.0).contains(*f)) {
+            return Err(RenderError::Parameter(format!(
+                "a mesh LOD's start {f} must be a fraction of the switch distance in [0, 1)"
+            )));
+        }
+        if lod_from[0] > 0.0 && lod_from[1] > 0.0 && lod_from[1] < lod_from[0] {
+            return Err(RenderError::Parameter(format!(
+                "mesh LOD 2 starts at {} of the switch, before LOD 1 at {}",
+                lod_from[1], lod_from[0]
+            )));
+        }
+        sp.lod_from = lod_from;
+        Ok(())
+    }
+
+    /// How many times the geometry renderer may list one tree per view: 3 when a species'
+    /// near trees crossfade between mesh LODs in the hybrid (a tree in two overlapping
+    /// crossfades is drawn in three LODs), else 1.
+    pub fn listings(&self) -> u32 {
+        if self
+            .geo_species
+            .iter()
+            .any(|s| s.lod_from.iter().any(|&f| f > 0.0))
+        {
+            3
+        } else {
+            1
+        }
     }
 
     /// Layers of the material texture array: every species' textures.
@@ -121,7 +167,8 @@ impl PreparedGeometry {
                 mean_leaf: m.mean_leaf,
                 switch_unit: s.switch_unit,
                 opacity_depth: m.opacity.max_depth,
-                pad: [0; 3],
+                lod_from: s.lod_from,
+                pad: 0,
             });
             let mut start = first as usize;
             for c in counts {

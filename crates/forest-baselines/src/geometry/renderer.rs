@@ -124,8 +124,12 @@ impl Shared {
             U::UNIFORM | U::COPY_DST | U::COPY_SRC,
         );
         let m = &*self.models;
-        let (segments, listed) = (m.capacity.segments as usize, m.capacity.instances as usize);
-        let keys = zeros("segment keys", listed * 4, U::STORAGE);
+        let (segments, instances, listed) = (
+            m.capacity.segments as usize,
+            m.capacity.instances as usize,
+            m.capacity.listed as usize,
+        );
+        let keys = zeros("segment keys", instances * 4, U::STORAGE);
         let counts = zeros("segment counts", segments * 4, U::STORAGE | U::COPY_SRC);
         let cursor = zeros("segment cursors", segments * 4, U::STORAGE);
         let visible = zeros("visible instances", listed * 4, U::STORAGE);

@@ -108,6 +108,18 @@ pub struct HybridSwitch {
     /// times the triangles'. 0 (atlases measured before it was recorded): as accurate.
     #[serde(default)]
     pub tolerance: f32,
+    /// Where the hybrid may draw its near trees in the discrete-LOD baseline's mesh LOD 1 and
+    /// LOD 2 instead of the full model, as fractions of the switch distance in (0, 1): from
+    /// there on, measured at the same rungs, the LOD was as accurate as the full model (within
+    /// `tolerance`). `None`: never (the LOD's error stayed above the full model's up to the
+    /// switch), as in atlases measured before it was recorded. LOD 2 never starts before LOD 1.
+    #[serde(default, skip_serializing_if = "no_lods")]
+    pub lod_from: [Option<f32>; 2],
+}
+
+/// Whether a switch records no mesh-LOD band (such records are written without the field).
+fn no_lods(lod_from: &[Option<f32>; 2]) -> bool {
+    lod_from.iter().all(Option::is_none)
 }
 
 impl HybridSwitch {
@@ -172,6 +184,22 @@ impl HybridSwitch {
             return Err(format!(
                 "tolerance = {t}, outside [0, {}]",
                 Self::MAX_TOLERANCE
+            ));
+        }
+        for (k, f) in self.lod_from.iter().enumerate() {
+            if let Some(f) = *f
+                && !(f > 0.0 && f < 1.0)
+            {
+                return Err(format!(
+                    "lod_from[{k}] = {f}, outside (0, 1) (a fraction of the switch distance)"
+                ));
+            }
+        }
+        if let [Some(a), Some(b)] = self.lod_from
+            && b < a
+        {
+            return Err(format!(
+                "lod_from = [{a}, {b}]: mesh LOD 2 starts before LOD 1"
             ));
         }
         Ok(())

@@ -200,6 +200,7 @@ fn the_loader_names_what_is_wrong() {
         epsilon: 2.0,
         cameras: 6,
         tolerance: 0.25,
+        lod_from: [Some(0.5), Some(0.75)],
     });
     measured.save(&path).unwrap();
     assert_eq!(Atlas::load(&path).unwrap(), measured);
@@ -227,6 +228,41 @@ fn the_loader_names_what_is_wrong() {
     std::fs::write(&manifest, text.replace(",\n    \"tolerance\": 0.25", "")).unwrap();
     let older = Atlas::load(&path).unwrap();
     assert_eq!(older.manifest.hybrid_switch.map(|h| h.tolerance), Some(0.0));
+    // Mesh-LOD bands outside (0, 1), or LOD 2 before LOD 1, are named; a record without
+    // them (none measured, or an older atlas) reads as none.
+    let with_lods = |from: serde_json::Value| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["hybrid_switch"]["lod_from"] = from;
+        std::fs::write(&manifest, v.to_string()).unwrap();
+    };
+    for (from, cause) in [
+        (serde_json::json!([0.5, 1.5]), "lod_from[1] = 1.5"),
+        (serde_json::json!([0.0, null]), "lod_from[0] = 0"),
+        (serde_json::json!([0.5, 0.25]), "LOD 2 starts before LOD 1"),
+    ] {
+        with_lods(from);
+        assert!(err(&path).contains(cause), "{}", err(&path));
+    }
+    let lods = |path: &std::path::Path| {
+        Atlas::load(path)
+            .unwrap()
+            .manifest
+            .hybrid_switch
+            .map(|h| h.lod_from)
+    };
+    with_lods(serde_json::json!([null, 0.25]));
+    assert_eq!(lods(&path), Some([None, Some(0.25)]));
+    let mut none = measured.clone();
+    if let Some(h) = none.manifest.hybrid_switch.as_mut() {
+        h.lod_from = [None; 2];
+    }
+    none.save(&path).unwrap();
+    assert!(
+        !std::fs::read_to_string(&manifest)
+            .unwrap()
+            .contains("lod_from")
+    );
+    assert_eq!(lods(&path), Some([None; 2]));
     assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
 }
 
