@@ -86,3 +86,51 @@ pub enum RenderError {
     #[error(transparent)]
     Format(#[from] forest_format::FormatError),
 }
+
+/// The one check behind every [`RenderError::DeviceLimit`]: `Err` naming `what` (with its
+/// unit), what it needs and the limit, followed by `hint` (empty, or starting with ": "), when
+/// `needed` exceeds `limit`.
+pub fn within_limit(
+    what: impl FnOnce() -> String,
+    needed: u64,
+    limit: u64,
+    hint: &'static str,
+) -> Result<(), RenderError> {
+    if needed > limit {
+        return Err(RenderError::DeviceLimit {
+            what: what(),
+            needed,
+            limit,
+            hint,
+        });
+    }
+    Ok(())
+}
+
+/// The largest storage buffer a device of `limits` can bind: its storage-binding limit, or
+/// its largest buffer where that is smaller (bytes).
+pub fn storage_limit(limits: &wgpu::Limits) -> u64 {
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_limit_refuses_only_what_exceeds_it_and_names_it() {
+        assert!(within_limit(|| unreachable!(), 10, 10, "").is_ok());
+        let e = within_limit(|| "the thing (bytes)".into(), 11, 10, ": use less")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "the thing (bytes) needs 11, the device allows 10: use less");
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: 100,
+            max_buffer_size: 50,
+            ..Default::default()
+        };
+        assert_eq!(storage_limit(&limits), 50);
+    }
+}

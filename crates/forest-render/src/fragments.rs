@@ -102,18 +102,12 @@ impl FragmentCounter {
             )));
         }
         let bytes = u64::from(width) * u64::from(height) * (COUNT_STRIDE * 4) as u64;
-        let limit = device
-            .limits()
-            .max_storage_buffer_binding_size
-            .min(device.limits().max_buffer_size);
-        if bytes > limit {
-            return Err(RenderError::DeviceLimit {
-                what: format!("fragment counts of a {width}×{height} target (bytes)"),
-                needed: bytes,
-                limit,
-                hint: ": count at a smaller size",
-            });
-        }
+        crate::error::within_limit(
+            || format!("fragment counts of a {width}×{height} target (bytes)"),
+            bytes,
+            crate::error::storage_limit(&device.limits()),
+            ": count at a smaller size",
+        )?;
         use wgpu::BufferUsages as U;
         let counts = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fragment counts"),

@@ -29,16 +29,12 @@ pub fn opacity_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 pub fn check_volumes(limits: &wgpu::Limits, species: usize) -> Result<(), RenderError> {
     let r = VOLUME_RESOLUTION;
     let depth = u64::from(r) * species.max(1) as u64;
-    let limit = limits.max_texture_dimension_3d;
-    if depth > u64::from(limit) {
-        return Err(RenderError::DeviceLimit {
-            what: format!("the opacity volumes ({species} species × {r} slices)"),
-            needed: depth,
-            limit: limit.into(),
-            hint: ": split the forest into scenes of fewer species",
-        });
-    }
-    Ok(())
+    crate::error::within_limit(
+        || format!("the opacity volumes ({species} species × {r} slices)"),
+        depth,
+        limits.max_texture_dimension_3d.into(),
+        ": split the forest into scenes of fewer species",
+    )
 }
 
 /// Upload `volumes` (every one [`VOLUME_RESOLUTION`] a side; one empty volume when there are

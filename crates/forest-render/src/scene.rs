@@ -329,14 +329,12 @@ fn u32_texture(
     let texels = bytes.len() / texel_bytes;
     let height = texels.div_ceil(width as usize).max(1) as u32;
     let max = ctx.device.limits().max_texture_dimension_2d;
-    if height > max {
-        return Err(RenderError::DeviceLimit {
-            what: format!("the {label} texture (rows)"),
-            needed: height.into(),
-            limit: max.into(),
-            hint: "",
-        });
-    }
+    crate::error::within_limit(
+        || format!("the {label} texture (rows)"),
+        height.into(),
+        max.into(),
+        "",
+    )?;
     let mut padded = bytes.to_vec();
     padded.resize(width as usize * height as usize * texel_bytes, 0);
     Ok(ctx.device.create_texture_with_data(
@@ -449,14 +447,12 @@ impl GpuScene {
         let tables = SceneTables::new(species, forest)?;
         let terrain = crate::terrain::GpuTerrain::new(&ctx.device, forest.terrain.as_ref())?;
         let limits = ctx.device.limits();
-        if tables.layers > limits.max_texture_array_layers {
-            return Err(RenderError::DeviceLimit {
-                what: "the colour atlas (texture array layers)".into(),
-                needed: tables.layers.into(),
-                limit: limits.max_texture_array_layers.into(),
-                hint: "",
-            });
-        }
+        crate::error::within_limit(
+            || "the colour atlas (texture array layers)".into(),
+            tables.layers.into(),
+            limits.max_texture_array_layers.into(),
+            "",
+        )?;
         let bc7 = ctx.use_bc7(colour_format) && tables.resolution >= 4;
         let res = tables.resolution.max(1);
         // Progress counts the albedo and the surface layers.

@@ -233,19 +233,23 @@ impl ShadowTargets {
     ) -> Result<Self, RenderError> {
         opts.validate().map_err(RenderError::Parameter)?;
         let limits = device.limits();
-        if opts.resolution > limits.max_texture_dimension_2d
-            || opts.cascades > limits.max_texture_array_layers
-        {
-            return Err(RenderError::DeviceLimit {
-                what: format!(
+        crate::error::within_limit(
+            || {
+                format!(
                     "{} shadow cascades of {}² texels (texels on a side)",
                     opts.cascades, opts.resolution
-                ),
-                needed: u64::from(opts.resolution),
-                limit: u64::from(limits.max_texture_dimension_2d),
-                hint: ": lower the shadow resolution",
-            });
-        }
+                )
+            },
+            opts.resolution.into(),
+            limits.max_texture_dimension_2d.into(),
+            ": lower the shadow resolution",
+        )?;
+        crate::error::within_limit(
+            || "the shadow cascades (texture array layers)".into(),
+            opts.cascades.into(),
+            limits.max_texture_array_layers.into(),
+            ": use fewer cascades",
+        )?;
         let texture = depth_array(device, opts.resolution, opts.cascades);
         let layers = (0..opts.cascades)
             .map(|k| {

@@ -436,16 +436,14 @@ impl QuadStream {
         capacity: &Capacity,
         readback: &[(&wgpu::Buffer, u64)],
     ) -> Result<Sized, RenderError> {
-        let limit = device.limits().max_storage_buffer_binding_size;
+        let limit = crate::error::storage_limit(&device.limits());
         let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
-        if quad_bytes > limit {
-            return Err(RenderError::DeviceLimit {
-                what: format!("a stream of {} quads (bytes per buffer)", capacity.quads),
-                needed: quad_bytes,
-                limit,
-                hint: ": lower the viewport or raise the minimum epsilon",
-            });
-        }
+        crate::error::within_limit(
+            || format!("a stream of {} quads (bytes per buffer)", capacity.quads),
+            quad_bytes,
+            limit,
+            ": lower the viewport or raise the minimum epsilon",
+        )?;
         let t = &scene.tables;
         use wgpu::BufferUsages as U;
         let consts = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

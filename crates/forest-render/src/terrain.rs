@@ -63,15 +63,12 @@ impl GpuTerrain {
         let zero = [0.0f32];
         let heights: &[f32] = terrain.map_or(&zero, |t| &t.heights);
         let bytes = std::mem::size_of_val(heights) as u64;
-        let limit = device.limits().max_storage_buffer_binding_size;
-        if bytes > limit {
-            return Err(RenderError::DeviceLimit {
-                what: "the terrain's heights (bytes)".into(),
-                needed: bytes,
-                limit,
-                hint: ": load the height field at a coarser spacing (fewer pixels)",
-            });
-        }
+        crate::error::within_limit(
+            || "the terrain's heights (bytes)".into(),
+            bytes,
+            crate::error::storage_limit(&device.limits()),
+            ": load the height field at a coarser spacing (fewer pixels)",
+        )?;
         let heights = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("terrain heights"),
             contents: bytemuck::cast_slice(heights),

@@ -6,6 +6,7 @@ use forest_format::forest::Forest;
 use forest_format::model::{BANDS, BILLBOARD_RESOLUTION};
 use forest_render::capacity::GeometryCapacity;
 use forest_render::context::{GpuContext, RenderError};
+use forest_render::error::{storage_limit, within_limit};
 use forest_render::shadow::ReceiverBand;
 use forest_render::terrain::GpuTerrain;
 use wgpu::util::DeviceExt;
@@ -107,18 +108,9 @@ pub fn check_limits(
             ": draw fewer trees",
         ),
     ];
-    let limit = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
+    let limit = storage_limit(limits);
     for (what, needed, hint) in storage {
-        if needed > limit {
-            return Err(RenderError::DeviceLimit {
-                what: what.into(),
-                needed,
-                limit,
-                hint,
-            });
-        }
+        within_limit(|| what.into(), needed, limit, hint)?;
     }
     let layers = [
         (
@@ -137,16 +129,9 @@ pub fn check_limits(
             ": draw fewer species",
         ),
     ];
+    let limit = u64::from(limits.max_texture_array_layers);
     for (what, needed, hint) in layers {
-        let limit = u64::from(limits.max_texture_array_layers);
-        if needed as u64 > limit {
-            return Err(RenderError::DeviceLimit {
-                what: what.into(),
-                needed: needed as u64,
-                limit,
-                hint,
-            });
-        }
+        within_limit(|| what.into(), needed as u64, limit, hint)?;
     }
     forest_render::opacity::check_volumes(limits, prepared.opacity.len())
 }
