@@ -712,6 +712,9 @@ fn a_forest_on_hills_or_a_height_field_stands_on_it_and_bad_height_fields_are_na
         .unwrap()
         .expect("the bake stores the model")
         .footprint_radius();
+    // The bake records the same foot in the manifest, which scene reads instead of the model.
+    let manifest = forest_format::Atlas::load_manifest(&d.join("bush.atlas")).unwrap();
+    assert_eq!(manifest.source.foot, Some(foot));
     assert!(
         foot > 0.0 && text.contains(&format!("bush: foot {foot:.3} m")),
         "{foot}: {text}"

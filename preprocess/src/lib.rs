@@ -244,6 +244,9 @@ pub fn bake_mesh(
                 .fold(f32::NEG_INFINITY, f32::max),
         )
         .filter(|t| t.is_finite()),
+        foot: Some(forest_format::model::footprint_radius(
+            mesh.tris.iter().flat_map(|t| t.p).map(|p| p.to_array()),
+        )),
     };
     let manifest = manifest_for(*params, source, sphere, layer_roots, nodes_per_level);
     let layers = Layers {

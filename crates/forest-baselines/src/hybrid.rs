@@ -159,6 +159,7 @@ mod tests {
                 degenerate_triangles: 0,
                 materials: Vec::new(),
                 top: None,
+                foot: None,
             },
             forest_format::slab::Sphere {
                 center: Vec3::ZERO,

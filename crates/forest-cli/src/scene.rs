@@ -314,19 +314,27 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     Ok(())
 }
 
-/// Each species' foot ([`forest_format::model::footprint_radius`] of the model its atlas
-/// stores), so that trees on a slope are planted on the ground's lowest point under their
-/// trunk; and a line per species saying what was found. An atlas without a readable model
-/// gives 0 (its trees stand on the ground at their axis, as before feet were measured) and
+/// Each species' foot ([`forest_format::model::footprint_radius`] of its model, recorded in
+/// its atlas's manifest at bake, else computed from the model the atlas stores), so that
+/// trees on a slope are planted on the ground's lowest point under their trunk; and a line
+/// per species saying what was found. An older atlas without a readable model gives 0 (its trees stand on the ground at their axis, as before feet were measured) and
 /// says why: the forest needs no model, only the geometry methods do.
 fn footprints(atlases: &[PathBuf]) -> (Vec<f32>, Vec<String>) {
     let mut radii = Vec::new();
     let mut lines = Vec::new();
     for a in atlases {
         let name = species_name(a);
-        let (r, line) = match forest_format::model::PreparedModel::load(a) {
-            Ok(Some(m)) => {
-                let r = m.footprint_radius();
+        // Recorded at bake; atlases baked before it was recorded compute it from their model.
+        let recorded = forest_format::Atlas::load_manifest(a)
+            .ok()
+            .and_then(|m| m.source.foot);
+        let found = match recorded {
+            Some(r) => Ok(Some(r)),
+            None => forest_format::model::PreparedModel::load(a)
+                .map(|m| m.map(|m| m.footprint_radius())),
+        };
+        let (r, line) = match found {
+            Ok(Some(r)) => {
                 let line = format!(
                     "  {name}: foot {r:.3} m from its axis at scale 1; on slopes lowered to the \
                      lowest ground under it"

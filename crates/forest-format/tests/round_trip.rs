@@ -97,6 +97,7 @@ fn atlas_round_trip(params: BakeParams, pixels: &[(u8, [u8; 3])], nodes: Vec<Qua
             degenerate_triangles: 0,
             materials: vec![],
             top: Some(6.5),
+            foot: Some(0.25),
         },
         Sphere {
             center: Vec3::new(0.5, 2.0, -1.0),

@@ -125,7 +125,10 @@ mod tests {
         let e = within_limit(|| "the thing (bytes)".into(), 11, 10, ": use less")
             .unwrap_err()
             .to_string();
-        assert_eq!(e, "the thing (bytes) needs 11, the device allows 10: use less");
+        assert_eq!(
+            e,
+            "the thing (bytes) needs 11, the device allows 10: use less"
+        );
         let limits = wgpu::Limits {
             max_storage_buffer_binding_size: 100,
             max_buffer_size: 50,

@@ -30,6 +30,12 @@ pub struct SourceInfo {
     /// falls back to the top of the bounding sphere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub top: Option<f32>,
+    /// How far the model's foot reaches from its axis (metres at scale 1,
+    /// [`crate::model::footprint_radius`] of its vertices): `forest scene` lowers a tree on a
+    /// slope to the lowest ground under it. Absent in atlases baked before it was recorded:
+    /// it is then computed from the atlas's stored model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub foot: Option<f32>,
 }
 
 /// The manifest of an atlas (`manifest.json`).
@@ -352,6 +358,13 @@ impl AtlasManifest {
         }
         if let Some(h) = &self.hybrid_switch {
             h.check().or_else(|e| bad(format!("hybrid_switch.{e}")))?;
+        }
+        if let Some(f) = self.source.foot
+            && !(f.is_finite() && f >= 0.0)
+        {
+            return bad(format!(
+                "source.foot = {f}, expected a finite radius of 0 or more"
+            ));
         }
         Ok(())
     }

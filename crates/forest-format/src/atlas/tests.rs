@@ -57,6 +57,7 @@ fn synthetic(colour: ColourEncoding) -> (Atlas, Layers) {
             degenerate_triangles: 0,
             materials: vec!["leaf".into()],
             top: Some(6.5),
+            foot: Some(0.25),
         },
         Sphere {
             center: glam::Vec3::Y,
@@ -243,6 +244,14 @@ fn the_loader_names_what_is_wrong() {
         with_lods(from);
         assert!(err(&path).contains(cause), "{}", err(&path));
     }
+    // A foot that is not a finite radius is named; one absent (older atlases) reads as none.
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["source"]["foot"] = serde_json::json!(-1.0);
+    std::fs::write(&manifest, v.to_string()).unwrap();
+    assert!(err(&path).contains("source.foot = -1"), "{}", err(&path));
+    v["source"].as_object_mut().unwrap().remove("foot");
+    std::fs::write(&manifest, v.to_string()).unwrap();
+    assert_eq!(Atlas::load(&path).unwrap().manifest.source.foot, None);
     let lods = |path: &std::path::Path| {
         Atlas::load(path)
             .unwrap()
