@@ -27,13 +27,18 @@ pub(super) const CUT_LEVELS: u32 = 7;
 
 /// The quadrilateral each texture layer of `model` cuts its cards to (`None`: cards on it stay
 /// whole): for the layers of alpha-tested materials, [`enclosing_quad`] of [`passable_hull`]
-/// over the layer's mip chain as uploaded ([`super::textures::mip_chain`]).
-pub(super) fn card_quads(model: &PreparedModel) -> Vec<Option<[Vec2; 4]>> {
+/// over the layer's mip chain as uploaded, `chains[i]` ([`super::textures::mip_chain`] of
+/// layer `i`).
+pub(super) fn card_quads(
+    model: &PreparedModel,
+    chains: &[super::textures::MipChain],
+) -> Vec<Option<[Vec2; 4]>> {
     model
         .layers
         .iter()
+        .zip(chains)
         .enumerate()
-        .map(|(i, img)| {
+        .map(|(i, (img, (chain, _)))| {
             let tested = model
                 .materials
                 .iter()
@@ -41,11 +46,10 @@ pub(super) fn card_quads(model: &PreparedModel) -> Vec<Option<[Vec2; 4]>> {
             if !tested || img.width() != img.height() || img.width() == 0 {
                 return None;
             }
-            let (chain, _) = super::textures::mip_chain(img);
             // Simplifying outward can carry a corner past the card's edge; the card's square
             // clips it back (the clipped hull still holds every passing texel inside it).
             let square = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
-            passable_hull(&chain, img.width(), CUT_LEVELS, HULL_VERTICES)
+            passable_hull(chain, img.width(), CUT_LEVELS, HULL_VERTICES)
                 .and_then(|h| enclosing_quad(&clip_convex(&h, &square)))
         })
         .collect()

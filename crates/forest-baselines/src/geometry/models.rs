@@ -13,7 +13,7 @@ use wgpu::util::DeviceExt;
 
 use super::params::SpeciesFigures;
 use super::prepare::PreparedGeometry;
-use super::textures::{MATERIAL_TEXTURE_SIZE, layered_texture};
+use super::textures::{MATERIAL_TEXTURE_SIZE, layered_texture, upload_layers};
 
 /// Every species' prepared model (vertices, materials and their textures, billboards, leaf
 /// tables, opacity volumes) and the forest's instances and terrain on one device. Read-only
@@ -151,7 +151,7 @@ impl GpuModels {
             vertices,
             geo_species,
             materials,
-            layers,
+            layer_mips,
             billboard_layers,
             billboard_surface,
             leaf_end,
@@ -238,11 +238,11 @@ impl GpuModels {
             bytemuck::cast_slice(&[instances.len() as u32, geo_species.len() as u32, 0, 0]),
             U::UNIFORM,
         );
-        let (material_view, material_bytes) = layered_texture(
+        let (material_view, material_bytes) = upload_layers(
             ctx,
             "material textures",
             MATERIAL_TEXTURE_SIZE,
-            layers,
+            layer_mips,
             false,
         );
         let (billboard_view, billboard_bytes) = layered_texture(

@@ -7,7 +7,7 @@ use forest_format::opacity::{OpacityVolume, VOLUME_RESOLUTION};
 
 use super::cards::{card_quads, cut_cards};
 use super::params::{GeometrySpecies, SpeciesFigures};
-use super::textures::layer_bytes;
+use super::textures::{MipChain, layer_bytes, mip_chain};
 use crate::gpu_types::{GpuGeoMaterial, GpuGeoSpecies};
 use forest_render::context::RenderError;
 
@@ -31,7 +31,9 @@ pub struct PreparedGeometry {
     pub(super) vertices: Vec<RefVertex>,
     pub(super) geo_species: Vec<GpuGeoSpecies>,
     pub(super) materials: Vec<GpuGeoMaterial>,
-    pub(super) layers: Vec<image::RgbaImage>,
+    /// Every species' material layers as their mip chains, computed once here (they cut the
+    /// leaf cards and are uploaded as they are).
+    pub(super) layer_mips: Vec<MipChain>,
     pub(super) billboard_layers: Vec<image::RgbaImage>,
     pub(super) billboard_surface: Vec<image::RgbaImage>,
     pub(super) leaf_end: Vec<u32>,
@@ -105,7 +107,7 @@ impl PreparedGeometry {
 
     /// Layers of the material texture array: every species' textures.
     pub fn material_layers(&self) -> usize {
-        self.layers.len()
+        self.layer_mips.len()
     }
 
     /// As [`PreparedGeometry::new`], with the leaf cards cut or whole.
@@ -113,7 +115,7 @@ impl PreparedGeometry {
         let mut vertices: Vec<RefVertex> = Vec::new();
         let mut geo_species = Vec::new();
         let mut materials = Vec::new();
-        let mut layers: Vec<image::RgbaImage> = Vec::new();
+        let mut layer_mips: Vec<MipChain> = Vec::new();
         let mut billboard_layers: Vec<image::RgbaImage> = Vec::new();
         let mut billboard_surface: Vec<image::RgbaImage> = Vec::new();
         let mut leaf_end: Vec<u32> = Vec::new();
@@ -124,17 +126,18 @@ impl PreparedGeometry {
         for s in species {
             let mut cards_cut = 0;
             let cut;
+            let chains: Vec<MipChain> = s.model.layers.iter().map(mip_chain).collect();
             let m = match cards {
                 Cards::Whole => &*s.model,
                 Cards::Cut => {
-                    let (model, n) = cut_cards(&s.model, &card_quads(&s.model));
+                    let (model, n) = cut_cards(&s.model, &card_quads(&s.model, &chains));
                     cards_cut = n as u32;
                     cut = model;
                     &cut
                 }
             };
             let material_base = materials.len() as u32;
-            let layer_base = layers.len() as u32;
+            let layer_base = layer_mips.len() as u32;
             let (billboards_base, vertices_base, leaves_base) =
                 (billboard_layers.len(), vertices.len(), leaf_end.len());
             materials.extend(m.materials.iter().map(|mat| GpuGeoMaterial {
@@ -147,7 +150,7 @@ impl PreparedGeometry {
                 alpha_tested: u32::from(mat.alpha_tested),
                 pad: [0; 2],
             }));
-            layers.extend(m.layers.iter().cloned());
+            layer_mips.extend(chains);
             let first = vertices.len() as u32;
             let counts = m.lod_vertices;
             geo_species.push(GpuGeoSpecies {
@@ -199,7 +202,10 @@ impl PreparedGeometry {
                     + std::mem::size_of_val(&leaf_centre[leaves_base..]))
                     as u64
                     + u64::from(VOLUME_RESOLUTION).pow(3)
-                    + layer_bytes(&layers[layer_base as usize..])
+                    + layer_mips[layer_base as usize..]
+                        .iter()
+                        .map(|c| c.0.len() as u64)
+                        .sum::<u64>()
                     + 2 * layer_bytes(&billboard_layers[billboards_base..])
                     // Its triangles' presorted draw orders, one u32 per bin.
                     + (vertices.len() - vertices_base) as u64 / 3
@@ -213,7 +219,7 @@ impl PreparedGeometry {
             vertices,
             geo_species,
             materials,
-            layers,
+            layer_mips,
             billboard_layers,
             billboard_surface,
             leaf_end,

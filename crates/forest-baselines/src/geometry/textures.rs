@@ -11,6 +11,10 @@ pub(super) fn layer_bytes(layers: &[image::RgbaImage]) -> u64 {
     layers.iter().map(|l| l.as_raw().len() as u64 * 4 / 3).sum()
 }
 
+/// A layer's mip chain as uploaded: every level's RGBA8 bytes, level 0 first, concatenated,
+/// and the number of levels ([`mip_chain`], [`box_mip_chain`]).
+pub(super) type MipChain = (Vec<u8>, u32);
+
 /// Every mip level of linear data down to 1×1, each the box filter of the one above (bytes and
 /// level count, as [`mip_chain`]).
 pub(super) fn box_mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
@@ -159,10 +163,9 @@ fn preserve_coverage(m: &mut image::RgbaImage, target: f64) {
 /// The smallest alpha byte that passes the geometry shaders' 0.5 alpha test.
 pub(super) const ALPHA_TEST_BYTE: u8 = 128;
 
-/// An sRGB RGBA8 2D-array texture with mips from square layers of side `size`.
-/// An array of `layers` with their mip chains: sRGB colour with coverage-preserving mips
-/// ([`mip_chain`]), or with `linear` plain box-filtered linear data (the billboards' surface
-/// attributes, whose blank texels were dilated).
+/// An array of square layers of side `size` with their mip chains: sRGB colour with
+/// coverage-preserving mips ([`mip_chain`]), or with `linear` plain box-filtered linear data
+/// (the billboards' surface attributes, whose blank texels were dilated).
 pub(super) fn layered_texture(
     ctx: &GpuContext,
     label: &str,
@@ -170,27 +173,37 @@ pub(super) fn layered_texture(
     layers: &[image::RgbaImage],
     linear: bool,
 ) -> (wgpu::TextureView, u64) {
-    let white = [image::RgbaImage::from_pixel(
-        size,
-        size,
-        image::Rgba([255; 4]),
-    )];
-    let layers = if layers.is_empty() {
+    let chain = if linear { box_mip_chain } else { mip_chain };
+    let chains: Vec<MipChain> = layers.iter().map(chain).collect();
+    upload_layers(ctx, label, size, &chains, linear)
+}
+
+/// [`layered_texture`] from the layers' mip chains, computed once beforehand (the material
+/// layers', which also cut the leaf cards). No layers upload one white layer.
+pub(super) fn upload_layers(
+    ctx: &GpuContext,
+    label: &str,
+    size: u32,
+    chains: &[MipChain],
+    linear: bool,
+) -> (wgpu::TextureView, u64) {
+    let white;
+    let chains = if chains.is_empty() {
+        let img = image::RgbaImage::from_pixel(size, size, image::Rgba([255; 4]));
+        white = [if linear {
+            box_mip_chain(&img)
+        } else {
+            mip_chain(&img)
+        }];
         &white[..]
     } else {
-        layers
+        chains
     };
-    let mut data = Vec::new();
-    let mut mips = 1;
-    for img in layers {
-        let (d, m) = if linear {
-            box_mip_chain(img)
-        } else {
-            mip_chain(img)
-        };
-        data.extend(d);
-        mips = m;
+    let mut data = Vec::with_capacity(chains.iter().map(|c| c.0.len()).sum());
+    for (d, _) in chains {
+        data.extend_from_slice(d);
     }
+    let mips = chains[0].1;
     let texture = ctx.device.create_texture_with_data(
         &ctx.queue,
         &wgpu::TextureDescriptor {
@@ -198,7 +211,7 @@ pub(super) fn layered_texture(
             size: wgpu::Extent3d {
                 width: size,
                 height: size,
-                depth_or_array_layers: layers.len() as u32,
+                depth_or_array_layers: chains.len() as u32,
             },
             mip_level_count: mips,
             sample_count: 1,
