@@ -3,7 +3,8 @@
 // detail chosen from the view's eye (camera.form_eye), as depth only into the cascade's layer.
 // Alpha-tested leaves and billboards are kept where the draw keeps them; in the hybrid's
 // transition band each texel belongs to the form that owns it (not_drawn_here), so the two
-// forms never both cast, and in a crossfade between mesh LODs to one of them. No march towards the sun: nothing is shaded.
+// forms never both cast, and in a crossfade between mesh LODs to one of them. No march
+// towards the sun: nothing is shaded.
 
 @vertex
 fn vs_geo_cast(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> GeoOut {

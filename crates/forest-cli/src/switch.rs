@@ -137,10 +137,11 @@ pub fn crossover(ladder: &[Rung], tolerance: f32) -> (f32, bool) {
 
 /// Where mesh LOD `k` (1 or 2) becomes as accurate as the full model (its error within
 /// `1 + tolerance` times the model's) and stays so up to the switch at `switch_radii`, in
-/// crown radii: after the last measured rung nearer than the switch where it was not,
-/// linear between that rung and the next; the first rung when it was at every rung nearer
-/// than the switch; `None` when it was not at the last rung before the switch (or when no
-/// rung lies nearer than it), or the crossing lies at or past the switch.
+/// crown radii, over a `ladder` of increasing distance: after the last measured rung nearer
+/// than the switch where it was not, linear between that rung and the next (which may lie
+/// past the switch); the first rung when it was at every rung nearer than the switch. `None`
+/// when no rung lies nearer than the switch, when the rung after the last failing one fails
+/// too or is missing, or when the crossing lies at or past the switch.
 pub fn lod_crossover(ladder: &[Rung], switch_radii: f32, tolerance: f32, k: usize) -> Option<f32> {
     let excess = |r: &Rung| r.lods[k - 1] - (1.0 + tolerance) * r.geometry;
     let near = ladder.iter().filter(|r| r.radii < switch_radii).count();
