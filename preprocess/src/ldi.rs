@@ -5,8 +5,9 @@
 //! the run-time light needs, averaged into that slab's pixel: premultiplied albedo =
 //! Σ albedo / spp, alpha = hits / spp, depth = mean sphere depth of the hits, and the surface
 //! attributes (normal facing the ray, sky visibility from [`crate::sky`], translucency) as
-//! coverage-weighted means stored premultiplied. No light is traced. Per sample the hits are opaque (alpha-tested), so front-to-back compositing within
-//! a slab reduces to taking its first hit; partial coverage comes from the samples.
+//! coverage-weighted means stored premultiplied. No light is traced. Per sample the hits are opaque
+//! (alpha-tested), so front-to-back compositing within a slab reduces to taking its first hit;
+//! partial coverage comes from the samples.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -337,11 +337,11 @@ pub fn reference_vertices(mesh: &Mesh, sky: &[sky::TriangleSky]) -> Vec<RefVerte
 /// (`forest bake --json` reports both; 1.1–1.5× the measured peak on the bundled models at
 /// 128–1024 px, 1.37× on the 280k-triangle oak-dense; without the hybrid-switch measurement,
 /// which `forest bake` adds its own estimate for): 52 B per layer pixel (the tracer's tiles
-/// and the assembled slab images, RGBA8 + f32 depth each, the atlas's mosaics, decoded copies and codec buffers), the
-/// quad-tree moments of the layers built at once (`threads` of them, 72 B per finest quad and
-/// a third more for the coarser levels), about 10 B per byte of OBJ text for the mesh and its
-/// BVH and 2 B more for one direction's piece footprints and tile bins (21 B per piece), and
-/// 16 MiB for the program itself.
+/// and the assembled slab images, RGBA8 + f32 depth each, the atlas's mosaics, decoded copies and
+/// codec buffers), the quad-tree moments of the layers built at once (`threads` of them, 72 B per
+/// finest quad and a third more for the coarser levels), about 10 B per byte of OBJ text for the
+/// mesh and its BVH and 2 B more for one direction's piece footprints and tile bins (21 B per
+/// piece), and 16 MiB for the program itself.
 pub fn peak_bytes_estimate(
     params: &forest_format::BakeParams,
     model_bytes: u64,

@@ -1,8 +1,9 @@
 // Types and level-of-detail functions of the geometry-based methods (full geometry,
 // stochastic simplification, discrete LODs + billboards), shared by geometry.wgsl (cull) and
-// geometry_draw.wgsl. Host mirrors: forest_format::model::RefVertex, forest_render::gpu_types::Geo*,
-// and the pure functions of forest_bake::lod (lambda, area_scale, fade, lambda_band,
-// band_lambda, band_elements), which the tests check against this code's results.
+// geometry_draw.wgsl. Host mirrors: forest_format::model::RefVertex,
+// forest_render::gpu_types::Geo*, and the pure functions of forest_bake::lod (lambda, area_scale,
+// fade, lambda_band, band_lambda, band_elements), which the tests check against this code's
+// results.
 
 struct GeoVertex {
     pos: vec3<f32>,

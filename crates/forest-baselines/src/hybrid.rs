@@ -22,12 +22,12 @@ use forest_render::context::RenderError;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Near {
     /// Per species, where its quad stream becomes as accurate as its own triangles (within
-    /// the tolerance the bake measured it at, [`forest_format::atlas::HybridSwitch::tolerance`]): the
-    /// distance at which the species' finest quads project to the size its atlas records
+    /// the tolerance the bake measured it at, [`forest_format::atlas::HybridSwitch::tolerance`]):
+    /// the distance at which the species' finest quads project to the size its atlas records
     /// ([`forest_format::atlas::HybridSwitch`], measured by `forest bake` against a 4×4
-    /// supersampled reference), else to [`forest_render::forms::DEFAULT_SWITCH_PIXELS`]. It follows the tree's size,
-    /// the viewport and the field of view ([`forest_render::forms::switch_unit`]); ε does not
-    /// move it: a coarser ε makes the near trees' quads coarser still, not better (an
+    /// supersampled reference), else to [`forest_render::forms::DEFAULT_SWITCH_PIXELS`]. It follows
+    /// the tree's size, the viewport and the field of view ([`forest_render::forms::switch_unit`]);
+    /// ε does not move it: a coarser ε makes the near trees' quads coarser still, not better (an
     /// ε-scaled switch left the hybrid at ε 8–32 less accurate than the discrete LODs at the
     /// same time). Measured on the five bundled species (400×300, 60°, ε 2) the crossover lies
     /// between 2.1 (pine) and 6 (oak, ash: the ladder's end) crown radii, 1.3 to 3.5 with a
@@ -177,6 +177,7 @@ mod tests {
             cameras: 1,
             tolerance: 0.0,
             lod_from: [None; 2],
+            never_reached: false,
         });
         m
     }

@@ -1,7 +1,8 @@
 //! Every method behind one switch: the quad stream, static impostors (the stream without
 //! refinement), the geometry-based methods (full geometry, stochastic simplification,
-//! discrete LODs + billboards), and the hybrid (near trees as geometry, the rest as quads). Switching is a uniform write or an iteration count: nothing is
-//! rebuilt, so a viewer or a benchmark can compare methods frame by frame.
+//! discrete LODs + billboards), and the hybrid (near trees as geometry, the rest as quads).
+//! Switching is a uniform write or an iteration count: nothing is rebuilt, so a viewer or a
+//! benchmark can compare methods frame by frame.
 
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};

@@ -9,7 +9,8 @@ use forest_format::{Atlas, BakeParams, ColourEncoding};
 /// Arguments of `forest bake`.
 #[derive(Args, Debug)]
 pub struct BakeArgs {
-    /// The tree model: an OBJ file with its MTL and textures beside it, or glTF 2.0 (`.gltf`, `.glb`).
+    /// The tree model: an OBJ file with its MTL and textures beside it, or glTF 2.0 (`.gltf`,
+    /// `.glb`).
     pub model: PathBuf,
     /// Output atlas folder (conventionally NAME.atlas); an existing atlas there is replaced.
     #[arg(short, long)]
@@ -386,24 +387,29 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             mb(m.gpu_bytes())
         );
         if let Some(h) = &m.hybrid_switch {
-            let d = &crate::switch::DISTANCES;
-            let (first, last) = (d[0], d[d.len() - 1]);
-            let (_, inside) = crate::switch::crossover(&ladder, h.tolerance);
+            use crate::switch::{Crossing, DISTANCES, accuracy_words, crossover};
+            let (first, last) = (DISTANCES[0], DISTANCES[DISTANCES.len() - 1]);
+            let words = accuracy_words(h.tolerance);
+            let r = h.crown_radii;
+            let place = match crossover(&ladder, h.tolerance).1 {
+                Crossing::Between => format!("is {words} from {r:.2} crown radii"),
+                Crossing::Nearest => {
+                    format!("is {words} already at {r:.2} crown radii, the nearest measured")
+                }
+                Crossing::Never => {
+                    let ratio = ladder
+                        .last()
+                        .map_or(f32::NAN, |g| g.quads / g.geometry.max(f32::MIN_POSITIVE));
+                    format!(
+                        "was never {words} from {first} to {last} crown radii ({ratio:.2}x the \
+                         triangles' error at {last}): switched at the farthest, {r:.2}"
+                    )
+                }
+            };
             println!(
-                "  hybrid switch: the quad stream (ε {}) is {} from {:.2} crown radii{} \
-                 (finest quads {:.2} px at {}x{}, {}°)",
-                h.epsilon,
-                crate::switch::accuracy_words(h.tolerance),
-                h.crown_radii,
-                if inside {
-                    String::new()
-                } else {
-                    format!(", the end of the measured {first}-{last}")
-                },
-                h.finest_quad_pixels,
-                h.viewport[0],
-                h.viewport[1],
-                h.fov_y_deg
+                "  hybrid switch: the quad stream (ε {}) {place} (finest quads {:.2} px at \
+                 {}x{}, {}°)",
+                h.epsilon, h.finest_quad_pixels, h.viewport[0], h.viewport[1], h.fov_y_deg
             );
         }
         if !ladder.is_empty() {

@@ -215,7 +215,9 @@ pub struct MethodArgs {
     /// (model.bin), or --models.
     #[arg(long, default_value = "quads", value_parser = METHODS)]
     pub method: String,
-    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order (geometry-based methods), instead of those stored in the atlases. Each must be the file its atlas was baked from (the same bytes, or else the same bounding sphere within 1 %)
+    /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order
+    /// (geometry-based methods), instead of those stored in the atlases. Each must be the file its
+    /// atlas was baked from (the same bytes, or else the same bounding sphere within 1 %)
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<PathBuf>,
     /// Draw --models that are not the files their atlases were baked from (each is named on stderr)

@@ -317,8 +317,9 @@ pub fn run(args: &SceneArgs) -> Result<()> {
 /// Each species' foot ([`forest_format::model::footprint_radius`] of its model, recorded in
 /// its atlas's manifest at bake, else computed from the model the atlas stores), so that
 /// trees on a slope are planted on the ground's lowest point under their trunk; and a line
-/// per species saying what was found. An older atlas without a readable model gives 0 (its trees stand on the ground at their axis, as before feet were measured) and
-/// says why: the forest needs no model, only the geometry methods do.
+/// per species saying what was found. An older atlas without a readable model gives 0 (its trees
+/// stand on the ground at their axis, as before feet were measured) and says why: the forest needs
+/// no model, only the geometry methods do.
 fn footprints(atlases: &[PathBuf]) -> (Vec<f32>, Vec<String>) {
     let mut radii = Vec::new();
     let mut lines = Vec::new();

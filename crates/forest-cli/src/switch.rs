@@ -113,26 +113,40 @@ pub fn first_crossing(
     Ok((lo < n).then_some(lo))
 }
 
+/// Where a ladder's crossover lies ([`crossover`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    /// Between two measured rungs.
+    Between,
+    /// At the nearest rung: the stream was already within the tolerance there.
+    Nearest,
+    /// Nowhere: the stream stayed outside the tolerance at every rung; the switch is put at
+    /// the farthest ([`HybridSwitch::never_reached`]). Also an empty ladder (distance 0).
+    Never,
+}
+
 /// The crossover of a ladder (crown radii): where `quads − (1 + tolerance) · geometry` first
 /// reaches zero, linear between the rungs around it; the first rung when the stream is
-/// already within the tolerance there, the last when it never is. The flag tells whether it
-/// lies inside the ladder.
-pub fn crossover(ladder: &[Rung], tolerance: f32) -> (f32, bool) {
+/// already within the tolerance there, the last when it never is, which [`Crossing`] tells.
+pub fn crossover(ladder: &[Rung], tolerance: f32) -> (f32, Crossing) {
     let Some(first) = ladder.first() else {
-        return (0.0, false);
+        return (0.0, Crossing::Never);
     };
     let diff = |r: &Rung| r.excess(tolerance);
     if diff(first) <= 0.0 {
-        return (first.radii, false);
+        return (first.radii, Crossing::Nearest);
     }
     for w in ladder.windows(2) {
         let (a, b) = (diff(&w[0]), diff(&w[1]));
         if b <= 0.0 {
             let t = a / (a - b);
-            return (w[0].radii + t * (w[1].radii - w[0].radii), true);
+            return (
+                w[0].radii + t * (w[1].radii - w[0].radii),
+                Crossing::Between,
+            );
         }
     }
-    (ladder[ladder.len() - 1].radii, false)
+    (ladder[ladder.len() - 1].radii, Crossing::Never)
 }
 
 /// Where mesh LOD `k` (1 or 2) becomes as accurate as the full model (its error within
@@ -202,24 +216,38 @@ pub fn accuracy_words(tolerance: f32) -> String {
 }
 
 /// The hybrid's automatic switch of an atlas in words: the finest quads' width there and,
-/// where the bake measured it, the crossover in crown radii at the measurement's view.
+/// where the bake measured it, the crossover in crown radii at the measurement's view, or
+/// that the stream never reached the accuracy asked and the switch is the farthest distance
+/// measured.
 pub fn describe(m: &forest_format::AtlasManifest) -> String {
     match &m.hybrid_switch {
-        Some(h) => format!(
-            "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, stream {}){}",
-            h.finest_quad_pixels,
-            h.crown_radii,
-            h.viewport[0],
-            h.viewport[1],
-            h.fov_y_deg,
-            accuracy_words(h.tolerance),
-            describe_lod_from(&h.lod_from)
-        ),
+        Some(h) => describe_switch(h),
         None => format!(
             "finest quads {} px (not measured: the default)",
             forest_render::forms::DEFAULT_SWITCH_PIXELS
         ),
     }
+}
+
+/// A measured switch in words (see [`describe`]).
+pub fn describe_switch(h: &HybridSwitch) -> String {
+    format!(
+        "finest quads {:.2} px ({:.2} crown radii at {}x{}, {}°, {}){}",
+        h.finest_quad_pixels,
+        h.crown_radii,
+        h.viewport[0],
+        h.viewport[1],
+        h.fov_y_deg,
+        if h.never_reached {
+            format!(
+                "the farthest measured: the stream was never {}",
+                accuracy_words(h.tolerance)
+            )
+        } else {
+            format!("stream {}", accuracy_words(h.tolerance))
+        },
+        describe_lod_from(&h.lod_from)
+    )
 }
 
 /// The hybrid's mesh-LOD starts in words: empty when the near trees are always the full
@@ -276,9 +304,9 @@ pub fn peak_bytes_estimate(model_bytes: u64) -> u64 {
 }
 
 /// Measure the switch of the prepared model `model` of the species baked into `species` at
-/// `tolerance` (see [`HybridSwitch::tolerance`]); `progress(done, total)` counts the views. Each rung also measures the discrete-LOD baseline's mesh LODs 1 and 2
-/// ([`Rung::lods`]), which says whether they could draw the hybrid's near trees. Returns the
-/// record and the ladder it came from.
+/// `tolerance` (see [`HybridSwitch::tolerance`]); `progress(done, total)` counts the views. Each
+/// rung also measures the discrete-LOD baseline's mesh LODs 1 and 2 ([`Rung::lods`]), which says
+/// whether they could draw the hybrid's near trees. Returns the record and the ladder it came from.
 pub fn measure(
     ctx: &GpuContext,
     species: SpeciesData,
@@ -395,7 +423,7 @@ pub fn measure(
     }
     progress(total, total);
     let ladder: Vec<Rung> = measured.into_iter().flatten().collect();
-    let (radii, _) = crossover(&ladder, tolerance);
+    let (radii, crossing) = crossover(&ladder, tolerance);
     let lod_from = lod_from(&ladder, radii, tolerance);
     let pixels = finest_quad_pixels(manifest.levels, radii)
         .clamp(HybridSwitch::MIN_PIXELS, HybridSwitch::MAX_PIXELS);
@@ -409,6 +437,7 @@ pub fn measure(
             cameras: CAMERAS,
             tolerance,
             lod_from,
+            never_reached: crossing == Crossing::Never,
         },
         ladder,
     ))
@@ -422,6 +451,33 @@ mod tests {
     fn a_strict_switch_reads_as_accurate_and_a_tolerance_as_its_share() {
         assert_eq!(accuracy_words(0.0), "as accurate as the triangles");
         assert_eq!(accuracy_words(0.25), "within 25 % of the triangles' error");
+    }
+
+    #[test]
+    fn a_switch_the_stream_never_reached_says_so() {
+        let mut h = HybridSwitch {
+            finest_quad_pixels: 0.68,
+            crown_radii: 6.0,
+            viewport: [400, 300],
+            fov_y_deg: 60.0,
+            epsilon: 2.0,
+            cameras: 6,
+            tolerance: 0.0,
+            lod_from: [None; 2],
+            never_reached: false,
+        };
+        let reached = describe_switch(&h);
+        assert!(reached.contains("6.00 crown radii"), "{reached}");
+        assert!(
+            reached.contains("stream as accurate as the triangles"),
+            "{reached}"
+        );
+        h.never_reached = true;
+        let text = describe_switch(&h);
+        assert!(
+            text.contains("the farthest measured: the stream was never as accurate"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -462,29 +518,29 @@ mod tests {
             rung(3.0, 0.03, 0.02),
             rung(4.0, 0.01, 0.02),
         ];
-        let (k, inside) = crossover(&ladder, 0.0);
+        let (k, crossing) = crossover(&ladder, 0.0);
         assert!((k - (2.0 + 2.0 / 3.0)).abs() < 1e-5, "{k}");
-        assert!(inside);
+        assert_eq!(crossing, Crossing::Between);
         // Allowed 50 % more error than the triangles: the excess falls from 0.20 − 0.15 = 0.05
         // at 1 to 0.07 − 0.075 = −0.005 at 2.
-        let (k, inside) = crossover(&ladder, 0.5);
+        let (k, crossing) = crossover(&ladder, 0.5);
         assert!((k - (1.0 + 0.05 / 0.055)).abs() < 1e-5, "{k}");
-        assert!(inside);
-        // Better from the first rung, or never: the ladder's ends, flagged.
+        assert_eq!(crossing, Crossing::Between);
+        // Better from the first rung, or never: the ladder's ends, told apart.
         assert_eq!(
             crossover(&[rung(1.0, 0.2, 0.1), rung(2.0, 0.1, 0.2)], 0.0),
-            (1.0, false)
+            (1.0, Crossing::Nearest)
         );
         assert_eq!(
             crossover(&[rung(1.0, 0.1, 0.2), rung(2.0, 0.1, 0.2)], 0.0),
-            (2.0, false)
+            (2.0, Crossing::Never)
         );
         // Twice the triangles' error is within a tolerance of 1 from the first rung.
         assert_eq!(
             crossover(&[rung(1.0, 0.1, 0.2), rung(2.0, 0.1, 0.2)], 1.0),
-            (1.0, false)
+            (1.0, Crossing::Nearest)
         );
-        assert_eq!(crossover(&[], 0.0), (0.0, false));
+        assert_eq!(crossover(&[], 0.0), (0.0, Crossing::Never));
     }
 
     #[test]

@@ -1,8 +1,8 @@
 //! The hybrid method: at a switch distance of 0 it is the quad stream (at the hybrid's aspect
 //! sharpening) and at infinity the full geometry, byte for byte; a tree in the transition
-//! band is drawn by both forms through complementary masks (every pixel from exactly one of them); the GPU's classification equals
-//! the CPU mirror; a frame writes only the camera; empty, single-tree and 1M-tree forests
-//! render without validation errors.
+//! band is drawn by both forms through complementary masks (every pixel from exactly one of them);
+//! the GPU's classification equals the CPU mirror; a frame writes only the camera; empty,
+//! single-tree and 1M-tree forests render without validation errors.
 
 mod common;
 
@@ -422,6 +422,7 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
         cameras: 1,
         tolerance: 0.0,
         lod_from: [None; 2],
+        never_reached: false,
     });
     let atlases: Vec<_> = species.iter().map(|s| s.atlas.clone()).collect();
     let measured = common::prepared_for(&atlases);
@@ -431,6 +432,19 @@ fn gpu_classification_equals_the_cpu_mirror_and_a_frame_writes_only_the_camera()
     // And with the pine's near trees in mesh LOD 1 from 0.3 and LOD 2 from 0.6 of its
     // switch: a tree is listed once per LOD its crossfades give pixels.
     let mut lods = measured.clone();
+    // Starts the manifest would refuse are refused by the same rule, naming the value; 0 is
+    // "never".
+    for (bad, cause) in [
+        ([0.6, 0.3], "LOD 2 starts before LOD 1"),
+        ([1.0, 0.0], "lod_from[0] = 1"),
+        ([0.0, -0.5], "lod_from[1] = -0.5"),
+    ] {
+        let e = lods.set_lod_from(1, bad).unwrap_err().to_string();
+        assert!(e.contains(cause) && e.contains("species 1"), "{e}");
+    }
+    assert!(lods.set_lod_from(9, [0.3, 0.6]).is_err());
+    lods.set_lod_from(1, [0.0, 0.6]).unwrap();
+    assert_eq!(lods.lod_from()[1], [0.0, 0.6]);
     lods.set_lod_from(1, [0.3, 0.6]).unwrap();
     for (near, species, prepared) in [
         (Near::Metres(10.0), common::species(), common::prepared()),

@@ -1,12 +1,12 @@
 // The light views' casting pass (appended to the draw module): a light-view stream's quads as
 // depth only into one cascade's layer of the shadow map: far trees' composited quads
-// (vs_cast_composite, fs_cast_composite), then the plain ones (vs_cast, fs_cast). Each quad lies on its plane, as in the draw. A fragment is kept where the
-// slab image's coverage exceeds an ordered-dither threshold (a screen door: a texel of
-// coverage a casts in a share a of the map's texels, which the receivers' filter averages
-// back into a shadow of strength a), and a tree's aspects combine as the draw combines them:
-// split by its dither, or "over" each other (see fs_cast). A fixed
-// threshold of ½ was measured to drop a sparse crown's top: the test pine's shadow fell 1.1 m
-// short of its silhouette's. No opacity march: nothing is shaded.
+// (vs_cast_composite, fs_cast_composite), then the plain ones (vs_cast, fs_cast). Each quad lies on
+// its plane, as in the draw. A fragment is kept where the slab image's coverage exceeds an
+// ordered-dither threshold (a screen door: a texel of coverage a casts in a share a of the map's
+// texels, which the receivers' filter averages back into a shadow of strength a), and a tree's
+// aspects combine as the draw combines them: split by its dither, or "over" each other (see
+// fs_cast). A fixed threshold of ½ was measured to drop a sparse crown's top: the test pine's
+// shadow fell 1.1 m short of its silhouette's. No opacity march: nothing is shaded.
 
 struct CastOut {
     @builtin(position) clip: vec4<f32>,

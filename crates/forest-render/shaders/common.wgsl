@@ -16,9 +16,9 @@ struct Camera {
     // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
     planes: array<vec4<f32>, 6>,
     // Which form draws each tree (the hybrid method, see quad_share): x metres + y focal
-    // pixels × the tree's switch unit = the switch distance; z: the transition band's width as a fraction of it;
-    // w: the per-instance jitter of the band's start, a fraction of the switch distance.
-    // (0, 0, ·, ·): every tree is drawn as quads; x ≥ 3e38: every tree as geometry.
+    // pixels × the tree's switch unit = the switch distance; z: the transition band's width as a
+    // fraction of it; w: the per-instance jitter of the band's start, a fraction of the switch
+    // distance. (0, 0, ·, ·): every tree is drawn as quads; x ≥ 3e38: every tree as geometry.
     forms: vec4<f32>,
     // The light (forest_format::shading::Lighting), world space, linear RGB. xyz: unit
     // direction towards the sun; w: exposure.

@@ -201,11 +201,11 @@ fn largest(q: vec3<u32>) -> u32 {
 }
 
 // Level-0 quads of one tree, in drawing order: slabs back to front (a far tree's slabs as one
-// composited quad, unless FLAG_FAR_SLABS); within a slab the present aspects, each with its share [lo, hi) of the blend, cumulative over the aspects of non-zero
-// weight (present or blank), which the draw pass turns into a dither interval or an "over"
-// alpha (hi − lo) / hi. Puts them from `out` on (skipping indices below `skip`; plain quads
-// after the `front` kept composited ones) when `emit` (`last`: see put_quad); returns the
-// count, a composited quad counted as TREE_COMPOSITE.
+// composited quad, unless FLAG_FAR_SLABS); within a slab the present aspects, each with its share
+// [lo, hi) of the blend, cumulative over the aspects of non-zero weight (present or blank), which
+// the draw pass turns into a dither interval or an "over" alpha (hi − lo) / hi. Puts them from
+// `out` on (skipping indices below `skip`; plain quads after the `front` kept composited ones) when
+// `emit` (`last`: see put_quad); returns the count, a composited quad counted as TREE_COMPOSITE.
 // One composited quad in a tree's packed count (plain quads count 1).
 const TREE_COMPOSITE: u32 = 65536u;
 

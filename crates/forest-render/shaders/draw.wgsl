@@ -1,17 +1,17 @@
-// Pass 3, draw: the environment (environment.wgsl), then every quad of the final stream becomes 4 vertices (a triangle strip, one
-// instance per quad, drawn indirectly): its image-space rectangle at its 4 corner depths in
-// the sampling frame of its direction and slab (object space), then the instance transform.
-// Each vertex marches the tree's opacity volume towards the sun (opacity_march, from the
-// corner's Gauss point, at the mip level that suits the quad's size: quad_march): the crown's
-// self-shadowing under the frame's sun; a composited quad, which spans a whole far
+// Pass 3, draw: the environment (environment.wgsl), then every quad of the final stream becomes 4
+// vertices (a triangle strip, one instance per quad, drawn indirectly): its image-space rectangle
+// at its 4 corner depths in the sampling frame of its direction and slab (object space), then the
+// instance transform. Each vertex marches the tree's opacity volume towards the sun (opacity_march,
+// from the corner's Gauss point, at the mip level that suits the quad's size: quad_march): the
+// crown's self-shadowing under the frame's sun; a composited quad, which spans a whole far
 // tree, marches per fragment from where its coverage lies, through the volume's coarse mip
 // level in fewer steps (sun_transmittance_coarse).
 // Textured from the colour array (premultiplied albedo, sRGB-decoded by the format) and the
 // surface array (premultiplied normal code, sky visibility, translucency), lit by the frame's
-// light in world space (shade_light in common.wgsl), and blended colour = src + dst·(1 − src.a). A tree's 1–3 aspects combine by an ordered dither (each
-// pixel shows the aspect whose share [lo, hi) of the blend holds the pixel's threshold, so
-// coverage is the weighted mean of the aspects' coverages) or, without FLAG_DITHER, "over"
-// each other with alpha (hi − lo) / hi.
+// light in world space (shade_light in common.wgsl), and blended colour = src + dst·(1 − src.a). A
+// tree's 1–3 aspects combine by an ordered dither (each pixel shows the aspect whose share [lo, hi)
+// of the blend holds the pixel's threshold, so coverage is the weighted mean of the aspects'
+// coverages) or, without FLAG_DITHER, "over" each other with alpha (hi − lo) / hi.
 //
 // Finest-level quads magnified past CRACK_PIXELS reach a little past their rectangles (see
 // crack_margin), so that neighbours at different depths overlap rather than crack apart.

@@ -31,16 +31,17 @@ pub fn instance_hash(instance: u32) -> f32 {
     (h >> 8) as f32 / 16_777_216.0
 }
 
-/// Where a model's atlas records no measured switch ([`forest_format::atlas::HybridSwitch`]), the hybrid switches
-/// where the model's finest quads project this many pixels (2.7 crown radii at 400×300, 60°
-/// and 8 levels).
+/// Where a model's atlas records no measured switch ([`forest_format::atlas::HybridSwitch`]), the
+/// hybrid switches where the model's finest quads project this many pixels (2.7 crown radii at
+/// 400×300, 60° and 8 levels).
 pub const DEFAULT_SWITCH_PIXELS: f32 = 1.5;
 
 /// A species' switch unit (metres per pixel of focal length, at tree scale 1): the width of
 /// its finest quads, `2R / 2^(levels−1)`, over the pixels they project to where the hybrid
-/// switches to them (the atlas's measured [`forest_format::atlas::HybridSwitch::finest_quad_pixels`], else
-/// [`DEFAULT_SWITCH_PIXELS`]). A tree of scale `k` seen with focal length `f` pixels switches
-/// at `f · k · unit` metres from its crown's centre.
+/// switches to them (the atlas's measured
+/// [`forest_format::atlas::HybridSwitch::finest_quad_pixels`], else [`DEFAULT_SWITCH_PIXELS`]). A
+/// tree of scale `k` seen with focal length `f` pixels switches at `f · k · unit` metres from its
+/// crown's centre.
 pub fn switch_unit(m: &AtlasManifest) -> f32 {
     let finest = 2.0 * m.bounding_sphere.radius / (1u64 << (m.levels.clamp(1, 32) - 1)) as f32;
     let pixels = m

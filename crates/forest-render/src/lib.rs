@@ -4,8 +4,8 @@
 //! SpeciesData::load (atlases) + Forest ─► GpuScene (uploaded once) ─► QuadStream
 //! per frame: set_camera (the one upload) ─► encode: cull ─► refine × (l − 1) ─► draw
 //! ```
-//! [`reference`](mod@reference) computes passes 1 and 2 on the CPU over the same tables; tests require the
-//! GPU's stream to equal it quad for quad. The rival methods (full geometry, stochastic
+//! [`reference`](mod@reference) computes passes 1 and 2 on the CPU over the same tables; tests
+//! require the GPU's stream to equal it quad for quad. The rival methods (full geometry, stochastic
 //! simplification, discrete LODs + billboards, the hybrid) live in the `forest-baselines`
 //! crate, which builds on this one.
 //!

@@ -658,7 +658,8 @@ mod tests {
 
     /// Sharpening: weights (0.7, 0.25, 0.05) quantise to (2867, 1024, 205), whose sum's excess
     /// the largest gives back; less 410 each, (2457, 614, 0), scaled to 4095 in integers
-    /// (3276, 818, 0), and the remainder to the largest. A sharpening past a third is refused; the value rides in flag bits 8–19.
+    /// (3276, 818, 0), and the remainder to the largest. A sharpening past a third is refused; the
+    /// value rides in flag bits 8–19.
     #[test]
     fn sharpening_fades_the_faint_aspect_out_exactly() {
         let flags = |sharpen| {

@@ -69,23 +69,17 @@ impl PreparedGeometry {
     /// Set where the hybrid draws species `species`' near trees in mesh LOD 1 and LOD 2, as
     /// fractions of the switch distance (0: never), overriding its atlas's measurement
     /// ([`GeometrySpecies::lod_from`]). Refused, naming the value, outside [0, 1) or with LOD
-    /// 2 starting before LOD 1, or for a species the models do not have.
+    /// 2 starting before LOD 1 (the manifest's rule, [`forest_format::atlas::check_lod_from`]),
+    /// or for a species the models do not have.
     pub fn set_lod_from(&mut self, species: usize, lod_from: [f32; 2]) -> Result<(), RenderError> {
         let n = self.geo_species.len();
         let sp = self.geo_species.get_mut(species).ok_or_else(|| {
             RenderError::Parameter(format!("species {species} of {n} has no model"))
         })?;
-        if let Some(f) = lod_from.iter().find(|f| !(0.0..1.0).contains(*f)) {
-            return Err(RenderError::Parameter(format!(
-                "a mesh LOD's start {f} must be a fraction of the switch distance in [0, 1)"
-            )));
-        }
-        if lod_from[0] > 0.0 && lod_from[1] > 0.0 && lod_from[1] < lod_from[0] {
-            return Err(RenderError::Parameter(format!(
-                "mesh LOD 2 starts at {} of the switch, before LOD 1 at {}",
-                lod_from[1], lod_from[0]
-            )));
-        }
+        // 0 is "never" here, an absent start in the manifest's record.
+        let starts = lod_from.map(|f| (f != 0.0).then_some(f));
+        forest_format::atlas::check_lod_from(&starts)
+            .map_err(|e| RenderError::Parameter(format!("species {species}: {e}")))?;
         sp.lod_from = lod_from;
         Ok(())
     }

@@ -464,8 +464,8 @@ impl GeometryRenderer {
     }
 
     /// Which trees the renderer draws from the next camera write on (the camera's `forms`, see
-    /// [`forest_render::forms`]); [`forest_render::forms::FORMS_GEOMETRY`], every tree, unless the hybrid
-    /// method set it.
+    /// [`forest_render::forms`]); [`forest_render::forms::FORMS_GEOMETRY`], every tree, unless the
+    /// hybrid method set it.
     pub fn set_forms(&mut self, forms: [f32; 4]) {
         self.forms = forms;
     }

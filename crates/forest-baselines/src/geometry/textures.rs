@@ -6,9 +6,19 @@ use wgpu::util::DeviceExt;
 
 pub use forest_format::model::MATERIAL_TEXTURE_SIZE;
 
-/// Bytes of RGBA8 layers with their mip chains (a third more than level 0).
+/// Bytes of square RGBA8 layers with their mip chains down to 1×1, as [`mip_chain`] and
+/// [`box_mip_chain`] build them, from the layers' sizes alone.
 pub(super) fn layer_bytes(layers: &[image::RgbaImage]) -> u64 {
-    layers.iter().map(|l| l.as_raw().len() as u64 * 4 / 3).sum()
+    layers
+        .iter()
+        .map(|l| {
+            let levels = l.width().max(l.height()).max(1).ilog2() + 1;
+            (0..levels)
+                .map(|k| u64::from((l.width() >> k).max(1)) * u64::from((l.height() >> k).max(1)))
+                .sum::<u64>()
+                * 4
+        })
+        .sum()
 }
 
 /// A layer's mip chain as uploaded: every level's RGBA8 bytes, level 0 first, concatenated,
@@ -251,6 +261,18 @@ mod tests {
         let last = &data[data.len() - 4..];
         assert!((186..=190).contains(&last[0]), "{last:?}");
         assert_eq!(last[3], 255);
+    }
+
+    #[test]
+    fn layer_bytes_are_the_chains_bytes() {
+        for side in [1, 2, 5, 64] {
+            let img = image::RgbaImage::from_pixel(side, side, image::Rgba([9, 8, 7, 200]));
+            let layers = [img.clone(), img.clone()];
+            let chains = 2 * mip_chain(&img).0.len() as u64;
+            assert_eq!(layer_bytes(&layers), chains, "side {side}");
+            assert_eq!(layer_bytes(&layers), 2 * box_mip_chain(&img).0.len() as u64);
+        }
+        assert_eq!(layer_bytes(&[]), 0);
     }
 
     #[test]

@@ -360,8 +360,9 @@ impl Viewer {
     }
 
     /// The stream overflowed: when the window is larger or ε smaller than its buffers were
-    /// sized for, resize the stream's buffers (the scene and the geometry renderer are kept). If that fails (the
-    /// device's limits), the HUD says so and the overflow counter stays the only effect.
+    /// sized for, resize the stream's buffers (the scene and the geometry renderer are kept). If
+    /// that fails (the device's limits), the HUD says so and the overflow counter stays the only
+    /// effect.
     fn grow_stream(&mut self, viewport: (u32, u32)) -> Result<()> {
         let ((w, h), eps) = self.sized;
         let wish = (

@@ -121,6 +121,36 @@ pub struct HybridSwitch {
     /// switch), as in atlases measured before it was recorded. LOD 2 never starts before LOD 1.
     #[serde(default, skip_serializing_if = "no_lods")]
     pub lod_from: [Option<f32>; 2],
+    /// The stream's error stayed above `(1 + tolerance)` times the triangles' at every
+    /// distance measured: `crown_radii` is the farthest one, where the measurement stopped,
+    /// not a crossover, and the hybrid switches there. Written only when true; false in
+    /// atlases measured before it was recorded.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub never_reached: bool,
+}
+
+/// The rule for where the hybrid's near trees take mesh LOD 1 and LOD 2
+/// ([`HybridSwitch::lod_from`]), for the manifest and for hosts that set it
+/// (`PreparedGeometry::set_lod_from`): each start, where present, a fraction of the switch
+/// distance in (0, 1), and LOD 2 not before LOD 1. The error names the value.
+pub fn check_lod_from(lod_from: &[Option<f32>; 2]) -> Result<(), String> {
+    for (k, f) in lod_from.iter().enumerate() {
+        if let Some(f) = *f
+            && !(f > 0.0 && f < 1.0)
+        {
+            return Err(format!(
+                "lod_from[{k}] = {f}, outside (0, 1) (a fraction of the switch distance)"
+            ));
+        }
+    }
+    if let [Some(a), Some(b)] = *lod_from
+        && b < a
+    {
+        return Err(format!(
+            "lod_from = [{a}, {b}]: mesh LOD 2 starts before LOD 1"
+        ));
+    }
+    Ok(())
 }
 
 /// Whether a switch records no mesh-LOD band (such records are written without the field).
@@ -192,22 +222,7 @@ impl HybridSwitch {
                 Self::MAX_TOLERANCE
             ));
         }
-        for (k, f) in self.lod_from.iter().enumerate() {
-            if let Some(f) = *f
-                && !(f > 0.0 && f < 1.0)
-            {
-                return Err(format!(
-                    "lod_from[{k}] = {f}, outside (0, 1) (a fraction of the switch distance)"
-                ));
-            }
-        }
-        if let [Some(a), Some(b)] = self.lod_from
-            && b < a
-        {
-            return Err(format!(
-                "lod_from = [{a}, {b}]: mesh LOD 2 starts before LOD 1"
-            ));
-        }
+        check_lod_from(&self.lod_from)?;
         Ok(())
     }
 }

@@ -3,8 +3,9 @@
 //! - `manifest.json`: format name and version, every bake parameter, the bounding sphere, the
 //!   sampling directions with their frames and triangulation, per-level node counts;
 //! - `colour.jpg` (or `colour.png` when baked lossless): every slab image's premultiplied,
-//!   sRGB-encoded albedo (no light: light is applied at run time), tiled into one mosaic (layer `L = direction·slabs + slab` at column
-//!   `L mod mosaic_columns`, row `L div mosaic_columns`);
+//!   sRGB-encoded albedo (no light: light is applied at run time), tiled into one mosaic
+//!   (layer `L = direction·slabs + slab` at column `L mod mosaic_columns`, row
+//!   `L div mosaic_columns`);
 //! - `alpha.png`: the coverage (alpha) mosaic, 8-bit, lossless;
 //! - `surface.png`: what the run-time light needs besides the albedo, as RGBA8, linear and
 //!   premultiplied by coverage like the colour: the octahedral code of the normal facing the
@@ -156,9 +157,9 @@ impl Atlas {
         )
     }
 
-    /// Decode the surface mosaic (stored at `resolution /` [`SURFACE_SCALE`]) into layers at the slab resolution (RGBA8, premultiplied: each channel is
-    /// clamped to the pixel's coverage from the alpha mosaic, `alpha`'s layers as
-    /// [`Self::decode_layers`] returns them).
+    /// Decode the surface mosaic (stored at `resolution /` [`SURFACE_SCALE`]) into layers at the
+    /// slab resolution (RGBA8, premultiplied: each channel is clamped to the pixel's coverage from
+    /// the alpha mosaic, `alpha`'s layers as [`Self::decode_layers`] returns them).
     pub fn decode_surface(&self, path: &Path, alpha: &Layers) -> Result<Layers, FormatError> {
         let p = &self.manifest.params;
         let file = path.join(SURFACE_FILE);

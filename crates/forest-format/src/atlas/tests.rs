@@ -202,6 +202,7 @@ fn the_loader_names_what_is_wrong() {
         cameras: 6,
         tolerance: 0.25,
         lod_from: [Some(0.5), Some(0.75)],
+        never_reached: true,
     });
     measured.save(&path).unwrap();
     assert_eq!(Atlas::load(&path).unwrap(), measured);
@@ -272,6 +273,22 @@ fn the_loader_names_what_is_wrong() {
             .contains("lod_from")
     );
     assert_eq!(lods(&path), Some([None; 2]));
+    // A switch the stream reached is written without `never_reached`, which reads as false.
+    assert!(
+        std::fs::read_to_string(&manifest)
+            .unwrap()
+            .contains("\"never_reached\": true")
+    );
+    if let Some(h) = none.manifest.hybrid_switch.as_mut() {
+        h.never_reached = false;
+    }
+    none.save(&path).unwrap();
+    assert!(
+        !std::fs::read_to_string(&manifest)
+            .unwrap()
+            .contains("never_reached")
+    );
+    assert_eq!(Atlas::load(&path).unwrap(), none);
     assert!(err(&dir.path().join("none.atlas")).contains("no such atlas"));
 }
 

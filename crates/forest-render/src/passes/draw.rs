@@ -1,5 +1,5 @@
-//! Pass 3, draw (`shaders/draw.wgsl`): the environment (sky and ground), then the final stream as an indirect,
-//! instanced triangle strip per quad, blended back to front.
+//! Pass 3, draw (`shaders/draw.wgsl`): the environment (sky and ground), then the final stream as
+//! an indirect, instanced triangle strip per quad, blended back to front.
 
 use super::{args, draw_source};
 
