@@ -30,7 +30,7 @@ pub enum Near {
     /// ε does not move it: a coarser ε makes the near trees' quads coarser still, not better (an
     /// ε-scaled switch left the hybrid at ε 8–32 less accurate than the discrete LODs at the
     /// same time). Measured on the five bundled species (400×300, 60°, ε 2) the crossover lies
-    /// between 2.1 (pine) and 6 (oak, ash: the ladder's end) crown radii, 1.3 to 3.5 with a
+    /// between 2.5 (pine) and 6 (oak, ash, bush: the ladder's end) crown radii, 1.3 to 3.5 with a
     /// 25 % tolerance: a single switch for every species
     /// draws some trees in their less accurate form.
     Auto,

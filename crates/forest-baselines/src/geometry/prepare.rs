@@ -79,7 +79,7 @@ impl PreparedGeometry {
         // 0 is "never" here, an absent start in the manifest's record.
         let starts = lod_from.map(|f| (f != 0.0).then_some(f));
         forest_format::atlas::check_lod_from(&starts)
-            .map_err(|e| RenderError::Parameter(format!("species {species}: {e}")))?;
+            .map_err(|e| RenderError::Parameter(format!("species {species}: {e}; 0: never")))?;
         sp.lod_from = lod_from;
         Ok(())
     }
