@@ -75,8 +75,8 @@ pub(super) fn passable_hull(
 ) -> Option<Polygon> {
     let mut points = Vec::new();
     let mut offset = 0usize;
-    for level in 0..levels {
-        let s = (side >> level).max(1) as usize;
+    for (s, _) in super::textures::mip_sizes(side, side).take(levels as usize) {
+        let s = s as usize;
         let bytes = s * s * 4;
         let Some(data) = chain.get(offset..offset + bytes) else {
             break;

@@ -6,18 +6,20 @@ use wgpu::util::DeviceExt;
 
 pub use forest_format::model::MATERIAL_TEXTURE_SIZE;
 
+/// The sizes (width, height) of a full mip chain's levels down to 1×1, level 0 first, as
+/// [`mip_chain`] builds them (and [`box_mip_chain`] for square images).
+pub(super) fn mip_sizes(width: u32, height: u32) -> impl Iterator<Item = (u32, u32)> {
+    let levels = width.max(height).max(1).ilog2() + 1;
+    (0..levels).map(move |k| ((width >> k).max(1), (height >> k).max(1)))
+}
+
 /// Bytes of square RGBA8 layers with their mip chains down to 1×1, as [`mip_chain`] and
 /// [`box_mip_chain`] build them, from the layers' sizes alone.
 pub(super) fn layer_bytes(layers: &[image::RgbaImage]) -> u64 {
     layers
         .iter()
-        .map(|l| {
-            let levels = l.width().max(l.height()).max(1).ilog2() + 1;
-            (0..levels)
-                .map(|k| u64::from((l.width() >> k).max(1)) * u64::from((l.height() >> k).max(1)))
-                .sum::<u64>()
-                * 4
-        })
+        .flat_map(|l| mip_sizes(l.width(), l.height()))
+        .map(|(w, h)| u64::from(w) * u64::from(h) * 4)
         .sum()
 }
 
@@ -110,15 +112,12 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
             ])
         })
     };
-    let mips = img.width().max(img.height()).ilog2() + 1;
     let mut level0 = dilated.clone();
     preserve_coverage(&mut level0, target);
     data.extend_from_slice(level0.as_raw());
-    for level in 1..mips {
-        let (w, h) = (
-            (img.width() >> level).max(1),
-            (img.height() >> level).max(1),
-        );
+    let mut mips = 1;
+    for (w, h) in mip_sizes(img.width(), img.height()).skip(1) {
+        mips += 1;
         use image::imageops::{FilterType, resize};
         plain = resize(&plain, w, h, FilterType::Triangle);
         passing = resize(&passing, w, h, FilterType::Triangle);
