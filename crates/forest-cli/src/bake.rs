@@ -263,7 +263,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
 
     // Where the hybrid should switch this model to the quad stream, measured before the atlas
     // is written so that it is written once, whole.
-    let mut ladder = Vec::new();
+    let mut measured = None;
     let mut switch_note = None;
     if !args.no_hybrid_switch {
         match crate::gpu_context() {
@@ -277,12 +277,12 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 let species =
                     forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
                 let model = model.clone().expect("prepared when the switch is measured");
-                let (switch, rungs) =
+                let m =
                     crate::switch::measure(&ctx, species, model, args.switch_tolerance, &progress)
                         .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
                 bar.finish_and_clear();
-                out.atlas.manifest.hybrid_switch = Some(switch);
-                ladder = rungs;
+                out.atlas.manifest.hybrid_switch = Some(m.switch);
+                measured = Some(m);
             }
             Err(e) => {
                 switch_note = Some(format!(
@@ -294,6 +294,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         }
     }
 
+    let ladder: &[crate::switch::Rung] = measured.as_ref().map_or(&[], |m| &m.ladder);
     let model_file = model.filter(|_| !args.no_model).map(|m| m.encode());
     let disk = out
         .atlas
@@ -386,35 +387,15 @@ pub fn run(args: &BakeArgs) -> Result<()> {
             file_summary(&files),
             mb(m.gpu_bytes())
         );
-        if let Some(h) = &m.hybrid_switch {
-            use crate::switch::{Crossing, DISTANCES, accuracy_words, crossover};
-            let (first, last) = (DISTANCES[0], DISTANCES[DISTANCES.len() - 1]);
-            let words = accuracy_words(h.tolerance);
-            let r = h.crown_radii;
-            let place = match crossover(&ladder, h.tolerance).1 {
-                Crossing::Between => format!("is {words} from {r:.2} crown radii"),
-                Crossing::Nearest => {
-                    format!("is {words} already at {r:.2} crown radii, the nearest measured")
-                }
-                Crossing::Never => {
-                    let ratio = ladder
-                        .last()
-                        .map_or(f32::NAN, |g| g.quads / g.geometry.max(f32::MIN_POSITIVE));
-                    format!(
-                        "was never {words} from {first} to {last} crown radii ({ratio:.2}x the \
-                         triangles' error at {last}): switched at the farthest, {r:.2}"
-                    )
-                }
-            };
+        if let Some(measured) = &measured {
             println!(
-                "  hybrid switch: the quad stream (ε {}) {place} (finest quads {:.2} px at \
-                 {}x{}, {}°)",
-                h.epsilon, h.finest_quad_pixels, h.viewport[0], h.viewport[1], h.fov_y_deg
+                "  hybrid switch: {}",
+                crate::switch::describe_measured(measured)
             );
         }
         if !ladder.is_empty() {
             let radii = m.hybrid_switch.map_or(f32::INFINITY, |h| h.crown_radii);
-            println!("  {}", crate::switch::describe_lods(&ladder, radii));
+            println!("  {}", crate::switch::describe_lods(ladder, radii));
         }
         if let Some(p) = &args.contact_sheet {
             println!("  contact sheet {}", p.display());

@@ -250,6 +250,53 @@ pub fn describe_switch(h: &HybridSwitch) -> String {
     )
 }
 
+/// What [`measure`] found: the record the manifest keeps, where on the ladder its crossover
+/// lies, and the rungs it measured (increasing distance; the rest were not needed).
+pub struct Measured {
+    /// The switch as the manifest records it.
+    pub switch: HybridSwitch,
+    /// Where [`crossover`] put it.
+    pub crossing: Crossing,
+    /// The measured rungs.
+    pub ladder: Vec<Rung>,
+}
+
+/// A fresh measurement in words, for `forest bake`: [`describe_switch`]'s facts with the
+/// ladder's own, which the manifest does not keep (whether the crossover lay between rungs
+/// or at the nearest, and the stream's error ratio at the farthest rung when it never
+/// reached the accuracy asked).
+pub fn describe_measured(m: &Measured) -> String {
+    let h = &m.switch;
+    let (first, last) = (DISTANCES[0], DISTANCES[DISTANCES.len() - 1]);
+    let words = accuracy_words(h.tolerance);
+    let r = h.crown_radii;
+    let place = match m.crossing {
+        Crossing::Between => format!("is {words} from {r:.2} crown radii"),
+        Crossing::Nearest => {
+            format!("is {words} already at {r:.2} crown radii, the nearest measured")
+        }
+        Crossing::Never => {
+            let ratio = m
+                .ladder
+                .last()
+                .map_or(f32::NAN, |g| g.quads / g.geometry.max(f32::MIN_POSITIVE));
+            format!(
+                "was never {words} from {first} to {last} crown radii ({ratio:.2}x the \
+                 triangles' error at {last}): switched at the farthest, {r:.2}"
+            )
+        }
+    };
+    format!(
+        "the quad stream (ε {}) {place} (finest quads {:.2} px at {}x{}, {}°){}",
+        h.epsilon,
+        h.finest_quad_pixels,
+        h.viewport[0],
+        h.viewport[1],
+        h.fov_y_deg,
+        describe_lod_from(&h.lod_from)
+    )
+}
+
 /// The hybrid's mesh-LOD starts in words: empty when the near trees are always the full
 /// model, else where each LOD takes over.
 pub fn describe_lod_from(lod_from: &[Option<f32>; 2]) -> String {
@@ -306,14 +353,14 @@ pub fn peak_bytes_estimate(model_bytes: u64) -> u64 {
 /// Measure the switch of the prepared model `model` of the species baked into `species` at
 /// `tolerance` (see [`HybridSwitch::tolerance`]); `progress(done, total)` counts the views. Each
 /// rung also measures the discrete-LOD baseline's mesh LODs 1 and 2 ([`Rung::lods`]), which says
-/// whether they could draw the hybrid's near trees. Returns the record and the ladder it came from.
+/// whether they could draw the hybrid's near trees.
 pub fn measure(
     ctx: &GpuContext,
     species: SpeciesData,
     model: std::sync::Arc<PreparedModel>,
     tolerance: f32,
     progress: &dyn Fn(u64, u64),
-) -> Result<(HybridSwitch, Vec<Rung>)> {
+) -> Result<Measured> {
     let manifest = species.atlas.manifest.clone();
     let sphere = manifest.bounding_sphere;
     let forest = Forest::new(
@@ -427,8 +474,8 @@ pub fn measure(
     let lod_from = lod_from(&ladder, radii, tolerance);
     let pixels = finest_quad_pixels(manifest.levels, radii)
         .clamp(HybridSwitch::MIN_PIXELS, HybridSwitch::MAX_PIXELS);
-    Ok((
-        HybridSwitch {
+    Ok(Measured {
+        switch: HybridSwitch {
             finest_quad_pixels: pixels,
             crown_radii: radii,
             viewport: [VIEWPORT.0, VIEWPORT.1],
@@ -439,8 +486,9 @@ pub fn measure(
             lod_from,
             never_reached: crossing == Crossing::Never,
         },
+        crossing,
         ladder,
-    ))
+    })
 }
 
 #[cfg(test)]
@@ -453,19 +501,24 @@ mod tests {
         assert_eq!(accuracy_words(0.25), "within 25 % of the triangles' error");
     }
 
-    #[test]
-    fn a_switch_the_stream_never_reached_says_so() {
-        let mut h = HybridSwitch {
-            finest_quad_pixels: 0.68,
-            crown_radii: 6.0,
-            viewport: [400, 300],
-            fov_y_deg: 60.0,
-            epsilon: 2.0,
-            cameras: 6,
+    /// A strict switch at `radii` crown radii measured at the bake's view.
+    fn strict_switch(radii: f32, never_reached: bool) -> HybridSwitch {
+        HybridSwitch {
+            finest_quad_pixels: finest_quad_pixels(8, radii),
+            crown_radii: radii,
+            viewport: [VIEWPORT.0, VIEWPORT.1],
+            fov_y_deg: FOV_Y_DEG,
+            epsilon: EPSILON,
+            cameras: CAMERAS,
             tolerance: 0.0,
             lod_from: [None; 2],
-            never_reached: false,
-        };
+            never_reached,
+        }
+    }
+
+    #[test]
+    fn a_switch_the_stream_never_reached_says_so() {
+        let mut h = strict_switch(6.0, false);
         let reached = describe_switch(&h);
         assert!(reached.contains("6.00 crown radii"), "{reached}");
         assert!(
@@ -478,6 +531,43 @@ mod tests {
             text.contains("the farthest measured: the stream was never as accurate"),
             "{text}"
         );
+    }
+
+    #[test]
+    fn a_fresh_measurement_says_where_its_crossover_lay() {
+        let rung = |radii, geometry, quads| Rung {
+            radii,
+            geometry,
+            quads,
+            lods: [1.0; 2],
+        };
+        let switch_at = |ladder: Vec<Rung>| {
+            let (radii, crossing) = crossover(&ladder, 0.0);
+            describe_measured(&Measured {
+                switch: strict_switch(radii, crossing == Crossing::Never),
+                crossing,
+                ladder,
+            })
+        };
+        // quads − geometry: 0.02 at 2, −0.02 at 3: crossing halfway.
+        let between = switch_at(vec![rung(2.0, 0.1, 0.12), rung(3.0, 0.1, 0.08)]);
+        assert!(
+            between.contains("is as accurate as the triangles from 2.50 crown radii"),
+            "{between}"
+        );
+        let nearest = switch_at(vec![rung(1.25, 0.1, 0.09)]);
+        assert!(
+            nearest.contains("already at 1.25 crown radii, the nearest"),
+            "{nearest}"
+        );
+        // Still 1.5× the triangles' error at the last rung measured.
+        let never = switch_at(vec![rung(5.0, 0.1, 0.2), rung(6.0, 0.1, 0.15)]);
+        assert!(never.contains("was never as accurate"), "{never}");
+        assert!(
+            never.contains("(1.50x the triangles' error at 6)"),
+            "{never}"
+        );
+        assert!(never.contains("switched at the farthest, 6.00"), "{never}");
     }
 
     #[test]
