@@ -294,7 +294,6 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         }
     }
 
-    let ladder: &[crate::switch::Rung] = measured.as_ref().map_or(&[], |m| &m.ladder);
     let model_file = model.filter(|_| !args.no_model).map(|m| m.encode());
     let disk = out
         .atlas
@@ -337,8 +336,9 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         "bounding_radius": m.bounding_sphere.radius,
         "hybrid_switch": m.hybrid_switch,
         "files": files.iter().copied().collect::<std::collections::BTreeMap<_, _>>(),
-        "hybrid_switch_ladder": ladder
+        "hybrid_switch_ladder": measured
             .iter()
+            .flat_map(|m| &m.ladder)
             .map(|r| serde_json::json!({
                 "crown_radii": r.radii,
                 "flip_geometry": r.geometry,
@@ -392,10 +392,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 "  hybrid switch: {}",
                 crate::switch::describe_measured(measured)
             );
-        }
-        if !ladder.is_empty() {
-            let radii = m.hybrid_switch.map_or(f32::INFINITY, |h| h.crown_radii);
-            println!("  {}", crate::switch::describe_lods(ladder, radii));
+            println!(
+                "  {}",
+                crate::switch::describe_lods(&measured.ladder, measured.switch.crown_radii)
+            );
         }
         if let Some(p) = &args.contact_sheet {
             println!("  contact sheet {}", p.display());

@@ -115,9 +115,7 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
     let mut level0 = dilated.clone();
     preserve_coverage(&mut level0, target);
     data.extend_from_slice(level0.as_raw());
-    let mut mips = 1;
     for (w, h) in mip_sizes(img.width(), img.height()).skip(1) {
-        mips += 1;
         use image::imageops::{FilterType, resize};
         plain = resize(&plain, w, h, FilterType::Triangle);
         passing = resize(&passing, w, h, FilterType::Triangle);
@@ -125,7 +123,7 @@ pub(super) fn mip_chain(img: &image::RgbaImage) -> (Vec<u8>, u32) {
         preserve_coverage(&mut m, target);
         data.extend_from_slice(m.as_raw());
     }
-    (data, mips)
+    (data, mip_sizes(img.width(), img.height()).count() as u32)
 }
 
 /// Scale `m`'s alpha so that a share of at least `target` of its bilinearly filtered area
