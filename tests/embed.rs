@@ -6,7 +6,7 @@ use std::path::Path;
 
 mod cli;
 
-#[path = "../crates/forest-render/examples/embed/main.rs"]
+#[path = "../crates/forest-baselines/examples/embed/main.rs"]
 #[allow(dead_code)]
 mod embed;
 

@@ -405,6 +405,16 @@ impl ForestRenderer {
         }
     }
 
+    /// A new largest viewport: the quad stream's per-view buffers are rebuilt for it (see
+    /// `QuadStream::resize`); the geometry's buffers do not depend on the viewport.
+    pub fn resize(
+        &mut self,
+        device: &wgpu::Device,
+        viewport: (u32, u32),
+    ) -> Result<(), RenderError> {
+        self.stream.resize(device, viewport)
+    }
+
     /// Receive a host's sun shadows in both forms (see `QuadStream::receive_host_shadows`);
     /// `None` stops.
     pub fn receive_host_shadows(

@@ -10,6 +10,7 @@ use forest_baselines::geometry::{
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
+use forest_format::views::{self, Clearances, TreeShape};
 use forest_render::fragments::{FragmentCounter, FragmentCounts, FragmentSummary};
 use forest_render::gpu_types::WEIGHT_ONE;
 use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOptions};
@@ -18,10 +19,10 @@ use forest_render::scene::SpeciesData;
 use forest_render::shadow::ShadowOptions;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 /// Arguments of `forest render`.
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
     /// Forest file (binary .forest or .json).
     pub forest: PathBuf,
@@ -29,8 +30,9 @@ pub struct RenderArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Named views: inside (eye height inside the forest), hill (on the highest ground among
-    /// the trees, looking down over the lowest), birds-eye (above it). Repeatable.
-    #[arg(long = "view", value_parser = ["inside", "hill", "birds-eye"])]
+    /// the trees, looking down over the lowest), birds-eye (above it); each keeps 3 m from
+    /// every tree's trunk and crown. Repeatable.
+    #[arg(long = "view", value_parser = views::NAMES)]
     pub views: Vec<String>,
     /// Eye position x,y,z in metres (with --target, instead of --view).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, requires = "target")]
@@ -212,9 +214,11 @@ pub struct MethodArgs {
     /// texture read at its finest level, for --supersample 4); stochastic simplification;
     /// discrete LODs + billboards; hybrid (trees nearer than --near as full geometry, the
     /// rest as the quad stream). The last five draw the models the bake stored in the atlases
-    /// (model.bin), or --models.
-    #[arg(long, default_value = "quads", value_parser = METHODS)]
-    pub method: String,
+    /// (model.bin), or --models. Default: hybrid, the most accurate for its time (the quad
+    /// stream alone is poor within a few crown radii of the eye); quads where an atlas holds
+    /// no model, said on stderr.
+    #[arg(long, value_parser = METHODS)]
+    pub method: Option<String>,
     /// Models (OBJ, or glTF 2.0 `.gltf`/`.glb`) of the forest's species, in its species order
     /// (geometry-based methods), instead of those stored in the atlases. Each must be the file its
     /// atlas was baked from (the same bytes, or else the same bounding sphere within 1 %)
@@ -322,7 +326,42 @@ fn parse_near(s: &str) -> Result<Near, String> {
     }
 }
 
+/// The method drawn when `--method` is not given: the hybrid.
+pub const DEFAULT_METHOD: &str = "hybrid";
+
 impl MethodArgs {
+    /// The method's name: `--method`, else [`DEFAULT_METHOD`] (see [`Self::settle`]).
+    pub fn name(&self) -> &str {
+        self.method.as_deref().unwrap_or(DEFAULT_METHOD)
+    }
+
+    /// Settle the method the user left to the program: the hybrid where `--models` are
+    /// given or every atlas of `forest` (read from `forest_file`) holds a model, else the
+    /// quad stream, with a line on stderr naming the atlas without one. A method given by
+    /// name is kept (and fails later with the cause if it cannot be drawn).
+    pub fn settle(&mut self, forest_file: &Path, forest: &Forest) {
+        if self.method.is_some() {
+            return;
+        }
+        let dir = forest_file.parent().unwrap_or(Path::new("."));
+        let missing = forest
+            .species
+            .iter()
+            .find(|s| !dir.join(s).join(forest_format::model::MODEL_FILE).is_file());
+        self.method = Some(match missing {
+            Some(s) if self.models.is_empty() => {
+                eprintln!(
+                    "note: drawing the quad stream, not the hybrid: {} holds no model ({}); \
+                     bake it without --no-model, give --models, or choose a --method",
+                    dir.join(s).display(),
+                    forest_format::model::MODEL_FILE
+                );
+                "quads".into()
+            }
+            _ => DEFAULT_METHOD.into(),
+        });
+    }
+
     /// The quad stream's run-time options.
     pub fn stream_options(&self) -> StreamOptions {
         StreamOptions {
@@ -384,7 +423,7 @@ impl MethodArgs {
     /// The method `--method` names, with `mesh` (from [`Self::checked_method`]) for the
     /// geometry-based ones and the hybrid's near trees.
     pub fn chosen(&self, mesh: Option<MeshMethod>) -> Result<Method> {
-        Ok(match (self.method.as_str(), mesh) {
+        Ok(match (self.name(), mesh) {
             ("hybrid", Some(near_form)) => {
                 let h = Hybrid {
                     near: self.near,
@@ -405,11 +444,11 @@ impl MethodArgs {
     /// The geometry method chosen (None for the quad-stream methods), requiring one model per
     /// species for it when --models is given (else the atlases' stored models are drawn).
     pub fn checked_method(&self, species: usize) -> Result<Option<MeshMethod>> {
-        let m = self.method(&self.method)?;
+        let m = self.method(self.name())?;
         if m.is_some() && !self.models.is_empty() && self.models.len() != species {
             bail!(
                 "--method {} needs --models with one model per species ({} given, the forest has {species})",
-                self.method,
+                self.name(),
                 self.models.len()
             );
         }
@@ -488,133 +527,15 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
     Ok((forest, species))
 }
 
-/// The named views of a forest, standing on its ground: eye height in a clump near the centre
-/// ("inside"), on the highest ground among the trees looking over the lowest ("hill"), and
-/// high above ("birds-eye").
-pub fn named_view(name: &str, forest: &Forest) -> (Vec3, Vec3) {
-    match name {
-        "inside" => inside_view(forest),
-        "hill" => hill_view(forest),
-        _ => {
-            // The trees' extent (the terrain may reach much farther), above the highest ground.
-            let r = forest
-                .instances
-                .iter()
-                .map(|i| Vec3::from_array(i.position).with_y(0.0).length())
-                .fold(10.0, f32::max);
-            let (_, top) = forest
-                .terrain
-                .as_ref()
-                .map_or((0.0, 0.0), |t| t.height_range());
-            (
-                Vec3::new(0.0, top + r * 0.35, r * 0.55),
-                Vec3::new(0.0, 0.0, -r * 0.1),
-            )
-        }
-    }
-}
-
-/// Inside the forest: near the tree with the most neighbours within 15 m among the 500
-/// nearest the centre (a clump, not a clearing's edge), at the first spot 6.7, 10, 14 or 20 m from
-/// it (south-south-east first, then round) with no tree's base within 6 m, 1.7 m above the
-/// ground, looking along the heading (of eight) that sees the most trees within 80 m, at a
-/// point 3 m above the ground 60 m away.
-fn inside_view(forest: &Forest) -> (Vec3, Vec3) {
-    let ground = |x: f32, z: f32, up: f32| Vec3::new(x, forest.ground_height(x, z) + up, z);
-    let mut near: Vec<Vec3> = forest
-        .instances
+/// The named view `name` of a forest ([`forest_format::views::named`]: clear of every tree's
+/// bounding sphere, as its species' atlases record them).
+pub fn named_view(name: &str, forest: &Forest, species: &[SpeciesData]) -> Result<(Vec3, Vec3)> {
+    let shapes: Vec<TreeShape> = species
         .iter()
-        .map(|i| Vec3::from_array(i.position))
+        .map(|s| TreeShape::of(&s.atlas.manifest))
         .collect();
-    near.sort_by(|a, b| a.with_y(0.0).length().total_cmp(&b.with_y(0.0).length()));
-    near.truncate(500);
-    let flat = |a: Vec3, b: Vec3| (a - b).with_y(0.0).length();
-    let Some(&c) = near
-        .iter()
-        .enumerate()
-        .max_by_key(|&(k, &p)| {
-            let n = near.iter().filter(|&&q| flat(p, q) < 15.0).count();
-            // The most neighbours; the nearest the centre among equals.
-            (n, std::cmp::Reverse(k))
-        })
-        .map(|(_, p)| p)
-    else {
-        return (ground(3.0, 6.0, 1.7), ground(-40.0, -60.0, 3.0));
-    };
-    let clear = |x: f32, z: f32| {
-        forest
-            .instances
-            .iter()
-            .all(|i| Vec3::new(i.position[0] - x, 0.0, i.position[2] - z).length() >= 6.0)
-    };
-    let first = Vec3::new(3.0, 0.0, 6.0);
-    let spot = [1.0f32, 1.5, 2.1, 3.0]
-        .iter()
-        .flat_map(|&r| {
-            (0..8).map(move |k| {
-                Quat::from_rotation_y(k as f32 * std::f32::consts::FRAC_PI_4) * first * r
-            })
-        })
-        .find(|o| clear(c.x + o.x, c.z + o.z))
-        .unwrap_or(first);
-    let eye = ground(c.x + spot.x, c.z + spot.z, 1.7);
-    let seen = |h: f32| {
-        let d = Vec3::new(h.sin(), 0.0, -h.cos());
-        near.iter()
-            .filter(|&&q| {
-                let v = (q - eye).with_y(0.0);
-                let l = v.length();
-                l > 1.0 && l < 80.0 && v.dot(d) > l * 0.8
-            })
-            .count()
-    };
-    // Headings from north-west round through north; the first of the most trees wins.
-    let mut heading = -std::f32::consts::FRAC_PI_4;
-    let mut best = seen(heading);
-    for k in 1..8 {
-        let h = -std::f32::consts::FRAC_PI_4 + k as f32 * std::f32::consts::FRAC_PI_4;
-        let n = seen(h);
-        if n > best {
-            (heading, best) = (h, n);
-        }
-    }
-    let d = Vec3::new(heading.sin(), 0.0, -heading.cos()) * 60.0;
-    (eye, ground(eye.x + d.x, eye.z + d.z, 3.0))
-}
-
-/// On a lookout 30 m above the highest ground within the trees' square (above the canopy of
-/// the trees around), looking at the lowest ground 50 to 600 m away; on flat ground, 40 m up
-/// at the southern edge looking across.
-fn hill_view(forest: &Forest) -> (Vec3, Vec3) {
-    let half = forest
-        .instances
-        .iter()
-        .map(|i| i.position[0].abs().max(i.position[2].abs()))
-        .fold(10.0f32, f32::max);
-    let Some(t) = &forest.terrain else {
-        return (Vec3::new(0.0, 40.0, half), Vec3::new(0.0, 0.0, -half * 0.2));
-    };
-    let at = |k: usize| {
-        let (i, j) = (k % t.size[0] as usize, k / t.size[0] as usize);
-        Vec3::new(
-            t.origin[0] + i as f32 * t.spacing,
-            t.heights[k],
-            t.origin[1] + j as f32 * t.spacing,
-        )
-    };
-    let within = |p: Vec3, c: Vec3, r: f32| {
-        p.x.abs() <= half && p.z.abs() <= half && (p - c).with_y(0.0).length() <= r
-    };
-    let all = || (0..t.heights.len()).map(at);
-    let top = all()
-        .filter(|p| within(*p, Vec3::ZERO, f32::INFINITY))
-        .max_by(|a, b| a.y.total_cmp(&b.y))
-        .unwrap_or(Vec3::ZERO);
-    let low = all()
-        .filter(|p| within(*p, top, 600.0) && (*p - top).with_y(0.0).length() > 50.0)
-        .min_by(|a, b| a.y.total_cmp(&b.y))
-        .unwrap_or(Vec3::new(0.0, 0.0, -half));
-    (top + Vec3::Y * 30.0, low)
+    forest_format::views::named(name, forest, &Clearances::new(forest, &shapes))
+        .ok_or_else(|| anyhow::anyhow!("no view named {name:?}: give one of {:?}", views::NAMES))
 }
 
 /// Run `forest render`.
@@ -622,8 +543,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.light.lighting()?;
     let mut views: Vec<(String, Vec3, Vec3)> = Vec::new();
     let (forest, species) = load_scene(&args.forest)?;
+    let mut settled = args.clone();
+    settled.m.settle(&args.forest, &forest);
+    let args = &settled;
     for v in &args.views {
-        let (e, t) = named_view(v, &forest);
+        let (e, t) = named_view(v, &forest, &species)?;
         views.push((v.clone(), e, t));
     }
     if let (Some(e), Some(t)) = (args.eye, args.target) {
@@ -884,7 +808,7 @@ fn stream_for(
     let opts = RendererOptions {
         min_epsilon: args.epsilon.min(8.0),
         viewport: rendered_viewport(args),
-        refine: args.m.method != "impostor",
+        refine: args.m.name() != "impostor",
         ..target_options(args)
     };
     let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
@@ -1153,7 +1077,7 @@ fn render_geometry(
         Ok(ViewReport {
             counted,
             json: serde_json::json!({
-                "method": args.m.method,
+                "method": args.m.name(),
                 "visible_trees": stats.visible_trees, "triangles": stats.triangles,
                 "billboards": stats.billboards, "per_band": stats.per_band,
                 "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
@@ -1161,7 +1085,7 @@ fn render_geometry(
             }),
             line: format!(
                 "{} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms",
-                args.m.method,
+                args.m.name(),
                 args.supersample,
                 stats.visible_trees,
                 stats.triangles,

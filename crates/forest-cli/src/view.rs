@@ -172,6 +172,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     }
     crate::guard::not_in_atlas(frames, "frames folder")?;
     let (forest, species) = load_scene(&forest_file)?;
+    args_models.settle(&forest_file, &forest);
     let dir = forest_file.parent().unwrap_or(Path::new("."));
     inputs.extend(forest.species.iter().map(|s| dir.join(s)));
     let frame_file = |i: usize| frames.join(format!("frame-{i:05}.png"));
@@ -247,6 +248,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 /// The window: walk through the forest with every method at hand.
 fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Lighting) -> Result<()> {
     let (forest, species) = load_scene(forest_file)?;
+    let mut m = m.clone();
+    m.settle(forest_file, &forest);
+    let m = &m;
     let mesh_method = m.checked_method(forest.species.len())?;
     // The models: --models, else those stored in the atlases (the geometry methods are
     // offered when every atlas holds one).
@@ -273,7 +277,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
     let extent = forest.extent();
     let terrain = forest.terrain.clone();
     // Start inside the forest, standing on its ground.
-    let start_view = Some(crate::render::named_view("inside", &forest));
+    let start_view = Some(crate::render::named_view("inside", &forest, &species)?);
     let forest = Rc::new(forest);
     let f = forest.clone();
     // The stream's run-time options from the command line (--blend, --far-span, --sharpen…).

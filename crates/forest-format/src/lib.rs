@@ -11,6 +11,7 @@
 //! - [`forest`], [`generate`], [`terrain`]: forest files, the clumped-forest generator and the
 //!   height field the trees stand on;
 //! - [`camera_path`]: recorded camera paths for the viewer;
+//! - [`views`]: the named views of a forest and the rule that keeps them clear of every tree;
 //! - [`model`]: a species' prepared model for the geometry-based methods and the hybrid.
 //! - [`cutout`]: convex polygons in texture space that trim alpha-tested cards.
 //!
@@ -58,6 +59,7 @@ pub mod slab;
 pub mod species;
 pub mod terrain;
 pub mod trim;
+pub mod views;
 
 pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding, PlaneFit};
 pub use error::FormatError;

@@ -10,7 +10,7 @@
 //! crate, which builds on this one.
 //!
 //! One frame of a forest, headless (`no_run`: it needs a GPU adapter, lavapipe will do, and a
-//! forest with its atlases; `examples/embed` draws into a host's own pass instead):
+//! forest with its atlases; `forest-baselines`' `examples/embed` draws into a host's own pass):
 //!
 //! ```no_run
 //! use forest_format::forest::Forest;

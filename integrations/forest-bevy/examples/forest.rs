@@ -1,5 +1,8 @@
 //! The demo forest inside a Bevy app: a terrain mesh under it, a sun that moves, a fly
-//! camera, a PBR sphere among the trees and a method switch.
+//! camera, a PBR sphere among the trees and a method switch. The forest is drawn by the
+//! hybrid (`ForestCamera::default()`), and the camera starts where the viewer and `forest
+//! render --view inside` start: standing on the ground, clear of every tree
+//! (`forest_format::views::start`).
 //!
 //! ```sh
 //! bash scripts/demo.sh   # once, from the repository root: bakes and writes out/forest-100k.forest
@@ -10,16 +13,17 @@
 //! raise and lower it; M switches method; [ ] halve and double ε. The title bar shows the
 //! method, ε, quads, triangles and frame time (or why the method cannot draw). With
 //! `SCREENSHOT=PATH.png` in the environment it saves a frame once the forest is drawn, and
-//! exits.
+//! exits (0) as soon as the file is written.
 
 use std::path::PathBuf;
 
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use bevy::render::view::screenshot::{Screenshot, save_to_disk};
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
 use forest_bevy::{
     ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats, terrain_mesh,
 };
+use forest_format::views::{self, Clearances, TreeShape};
 
 /// The sun's azimuth and elevation, degrees.
 #[derive(Resource)]
@@ -32,6 +36,10 @@ struct Pending(Handle<ForestAsset>);
 /// Where to save a screenshot before exiting, the frames that drew the forest, all frames.
 #[derive(Resource)]
 struct Shot(PathBuf, u32, u32);
+
+/// Set by the screenshot's observer once its file is written.
+#[derive(Resource, Default)]
+struct Saved(bool);
 
 fn main() -> AppExit {
     let forest = std::env::args_os().nth(1).map_or_else(
@@ -56,6 +64,7 @@ fn main() -> AppExit {
     let mut app = App::new();
     if let Some(path) = std::env::var_os("SCREENSHOT") {
         app.insert_resource(Shot(path.into(), 0, 0))
+            .init_resource::<Saved>()
             .add_systems(Update, screenshot);
     }
     let fog = Color::srgb(0.62, 0.72, 0.84);
@@ -90,6 +99,7 @@ fn main() -> AppExit {
                     },
                     ..default()
                 },
+                // Placed where the forest has loaded (see `terrain`).
                 Transform::from_xyz(0.0, 4.0, 0.0).looking_to(Vec3::new(1.0, -0.05, 0.3), Vec3::Y),
             ));
             commands.spawn(DirectionalLight {
@@ -103,44 +113,59 @@ fn main() -> AppExit {
     .run()
 }
 
-/// Once the forest has drawn for a few frames: a screenshot, then exit (with an error if
-/// nothing was drawn in 600 frames).
+/// Once the forest has drawn for a few frames: a screenshot, then exit as soon as its file
+/// is written (with an error if nothing was drawn in 600 frames).
 fn screenshot(
     mut commands: Commands,
     mut shot: ResMut<Shot>,
+    saved: Res<Saved>,
     stats: Res<ForestStats>,
     mut exit: MessageWriter<AppExit>,
 ) {
     shot.2 += 1;
+    if saved.0 {
+        exit.write(AppExit::Success);
+        return;
+    }
     if stats.views.values().any(|s| s.quads > 0 || s.triangles > 0) {
         shot.1 += 1;
         if shot.1 == 4 {
+            // `save_to_disk` writes the file before the next observer runs.
             commands
                 .spawn(Screenshot::primary_window())
-                .observe(save_to_disk(shot.0.clone()));
+                .observe(save_to_disk(shot.0.clone()))
+                .observe(|_: On<ScreenshotCaptured>, mut saved: ResMut<Saved>| saved.0 = true);
         }
     }
-    if shot.1 > 4 && shot.0.exists() {
-        exit.write(AppExit::Success);
-    } else if shot.2 == 600 {
+    if shot.2 == 600 {
         eprintln!("forest: no forest drawn in 600 frames, no screenshot");
         exit.write(AppExit::error());
     }
 }
 
-/// Once the forest has loaded: a terrain mesh under it (its height field, or flat ground) and
-/// a PBR sphere on the ground in front of the camera.
+/// Once the forest has loaded: the camera at the forest's start view, a terrain mesh under it
+/// (its height field, or flat ground) and a PBR sphere on the ground in front of the camera.
 fn terrain(
     mut commands: Commands,
     pending: Option<Res<Pending>>,
     forests: Res<Assets<ForestAsset>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut cams: Query<&mut Transform, With<Camera3d>>,
 ) {
     let Some(forest) = pending.and_then(|p| forests.get(&p.0)) else {
         return;
     };
     let f = &forest.forest;
+    let shapes: Vec<TreeShape> = forest
+        .species
+        .iter()
+        .map(|s| TreeShape::of(&s.atlas.manifest))
+        .collect();
+    let (eye, target) = views::start(f, &Clearances::new(f, &shapes));
+    for mut t in &mut cams {
+        *t = Transform::from_translation(eye).looking_at(target, Vec3::Y);
+    }
     let ground = terrain_mesh(f, f.extent().clamp(1.0, 3000.0), 256).expect("a valid grid");
     commands.spawn((
         Mesh3d(meshes.add(ground)),
@@ -152,7 +177,8 @@ fn terrain(
         // 2 cm down, so that the trunks' bases do not fight it.
         Transform::from_xyz(0.0, -0.02, 0.0),
     ));
-    let at = Vec3::new(12.0, 0.0, 4.0);
+    // 8 m ahead of the camera, on the ground.
+    let at = eye + (target - eye).with_y(0.0).normalize_or(Vec3::X) * 8.0;
     commands.spawn((
         Mesh3d(meshes.add(Sphere::new(1.0))),
         MeshMaterial3d(materials.add(StandardMaterial {

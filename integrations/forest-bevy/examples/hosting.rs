@@ -6,8 +6,9 @@
 //! ```sh
 //! cargo run --release --ignore-rust-version --example hosting -- FOREST [--size WxH] [--frames N] [--no-depth] [--method quads|hybrid|lods]
 //! ```
-//! `--no-depth` draws without `ForestCamera::write_depth`. `--method` draws the quad stream
-//! (default), the hybrid or the discrete LODs (these two from the models the atlases hold).
+//! `--no-depth` draws without `ForestCamera::write_depth`. `--method` draws the hybrid
+//! (default), the quad stream or the discrete LODs (the hybrid and the LODs from the models
+//! the atlases hold).
 //! Bevy's camera draws one sample per pixel, as `forest-render`'s frame does.
 
 use std::path::PathBuf;
@@ -50,8 +51,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let epsilon = 4.0;
     let write_depth = !args.iter().any(|a| a == "--no-depth");
     let method = match value("--method").map(String::as_str) {
-        None | Some("quads") => ForestMethod::QuadStream,
-        Some("hybrid") => ForestMethod::Hybrid,
+        Some("quads") => ForestMethod::QuadStream,
+        None | Some("hybrid") => ForestMethod::Hybrid,
         Some("lods") => ForestMethod::DiscreteLods,
         Some(m) => return Err(format!("--method {m}: quads, hybrid or lods").into()),
     };
@@ -65,20 +66,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .parent()
         .unwrap_or(std::path::Path::new("."))
         .canonicalize()?;
-    // The example's opening view, and one from 60 m above.
-    let ground = forest.ground_height(0.0, 0.0);
-    let views = [
-        (
-            "inside",
-            Vec3::new(0.0, ground + 4.0, 0.0),
-            Vec3::new(30.0, ground + 2.5, 9.0),
-        ),
-        (
-            "above",
-            Vec3::new(-60.0, ground + 60.0, -60.0),
-            Vec3::new(0.0, ground, 0.0),
-        ),
-    ];
     // forest-render alone.
     let ctx = GpuContext::headless()?;
     let species = forest
@@ -86,6 +73,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|s| forest_render::SpeciesData::load(&folder.join(s)))
         .collect::<Result<Vec<_>, _>>()?;
+    // The viewer's opening view (clear of every tree), and one from 60 m above.
+    let shapes: Vec<_> = species
+        .iter()
+        .map(|s| forest_format::views::TreeShape::of(&s.atlas.manifest))
+        .collect();
+    let (eye, target) = forest_format::views::start(
+        &forest,
+        &forest_format::views::Clearances::new(&forest, &shapes),
+    );
+    let ground = forest.ground_height(0.0, 0.0);
+    let views = [
+        ("inside", eye, target),
+        (
+            "above",
+            Vec3::new(-60.0, ground + 60.0, -60.0),
+            Vec3::new(0.0, ground, 0.0),
+        ),
+    ];
     let scene = std::sync::Arc::new(GpuScene::new(&ctx, &species, &forest)?);
     let target = forest_render::target::Target::new(&ctx, w, h);
     let opts = RendererOptions {

@@ -28,27 +28,30 @@ pub struct ForestCamera {
 }
 
 impl Default for ForestCamera {
-    /// The quad stream at ε = 4 pixels, writing depth.
+    /// The hybrid ([`ForestMethod::default`]) at ε = 4 pixels, writing depth.
     fn default() -> Self {
         Self {
-            method: ForestMethod::QuadStream,
+            method: ForestMethod::default(),
             epsilon: 4.0,
             write_depth: true,
         }
     }
 }
 
-/// A rendering method available inside Bevy.
+/// A rendering method available inside Bevy. The default is the hybrid: the most accurate
+/// for its time, where the quad stream alone is poor within a few crown radii of the eye.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum ForestMethod {
-    /// The dynamic quad stream: cull, refine by ε, draw (Liu, Hua & Bao 2010).
-    #[default]
+    /// The dynamic quad stream: cull, refine by ε, draw (Liu, Hua & Bao 2010), the paper's
+    /// method.
     QuadStream,
     /// Static impostors: each tree's level-0 slab images, never refined.
     Impostors,
     /// The trees next to the camera as their full models, the rest as the quad stream, each
     /// species switching where its bake measured the quads as accurate as its triangles.
-    /// Needs every species' prepared model (`model.bin`, which `forest bake` stores).
+    /// Needs every species' prepared model (`model.bin`, which `forest bake` stores; without
+    /// them the view draws nothing and [`crate::ForestStats`] says why).
+    #[default]
     Hybrid,
     /// Discrete LODs (the full model, two simplified meshes, billboards) by distance. Needs
     /// the prepared models.

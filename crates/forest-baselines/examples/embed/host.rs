@@ -1,21 +1,25 @@
 //! The host side of the embedding example: a renderer with its own sky and ground that draws a
-//! forest through `forest-render`'s public API, into targets it owns and clears itself. It uses
-//! reverse-Z with an infinite far plane, as many engines do.
+//! forest through the public API of `forest-render` and `forest-baselines`, into targets it
+//! owns and clears itself. It uses reverse-Z with an infinite far plane, as many engines do.
 //!
-//! Per frame: the host writes its own uniform, `QuadStream::prepare` writes the forest's camera
-//! (its one upload), `encode_compute` records cull and refine, and the host's own render pass
-//! draws the ground and then `render`s the trees into it.
+//! The forest is drawn by the hybrid (near trees as their models, the rest as the quad stream)
+//! where every atlas holds a model, else by the quad stream. Per frame: the host writes its own
+//! uniform, `ForestRenderer::prepare` writes the forest's cameras (its one upload per form),
+//! `encode_compute` records the culls and the refinement, and the host's own render pass draws
+//! the ground and then `render`s the trees into it.
 //!
 //! With its sun's shadows on, the host owns a reverse-Z shadow map (one cascade around the
-//! view, fitted with the library's `fit_cascades`): a second stream casts the forest into it
+//! view, fitted with the library's `fit_cascades`): a quad stream casts the forest into it
 //! (`prepare_light`, `encode_compute`, `render_depth` in the host's depth-only pass), the
 //! host's ground reads it, and the forest's trees receive it (`receive_host_shadows`,
 //! `set_host_cascades`).
 
 use std::sync::Arc;
 
+use forest_baselines::{ForestRenderer, GeometryRenderer, Hybrid, Method, PreparedGeometry};
+use forest_format::forest::Forest;
 use forest_render::options::{GROUND_MOSS, RendererOptions, SKY, ground_colour};
-use forest_render::{FrameParams, GpuScene, QuadStream, RenderError};
+use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RenderError};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
@@ -109,7 +113,7 @@ pub struct Host {
     depth: wgpu::TextureView,
     sun: Option<Sun>,
     /// The forest of this view.
-    pub forest: QuadStream,
+    pub forest: ForestRenderer,
 }
 
 /// A reverse-Z perspective with an infinite far plane (60° vertical field of view, 0.1 m near).
@@ -150,12 +154,17 @@ fn depth_view(device: &wgpu::Device, size: (u32, u32)) -> wgpu::TextureView {
 }
 
 impl Host {
-    /// The host's pipelines and a forest stream over `scene` for `format` targets of `size`,
-    /// refined down to `min_epsilon` pixels at most (both size the stream); with `shadows`,
-    /// the host's sun shadow map, which the forest casts into and receives.
+    /// The host's pipelines and the forest's renderer over `scene` for `format` targets of
+    /// `size`, refined down to `min_epsilon` pixels at most (both size the stream): the hybrid
+    /// over `models` (the species' prepared models, in `forest`'s species order), or the quad
+    /// stream without them; with `shadows`, the host's sun shadow map, which the forest casts
+    /// into and receives.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
-        device: &wgpu::Device,
+        ctx: &GpuContext,
         scene: Arc<GpuScene>,
+        forest: &Forest,
+        models: Option<&PreparedGeometry>,
         format: wgpu::TextureFormat,
         size: (u32, u32),
         min_epsilon: f32,
@@ -177,7 +186,16 @@ impl Host {
             .shade(GROUND_MOSS, Vec3::Y, 1.0, 1.0, 0.0)
             .extend(0.0)
             .to_array();
-        let mut forest = QuadStream::new(device, scene.clone(), &opts)?;
+        let device = &ctx.device;
+        let stream = QuadStream::new(device, scene.clone(), &opts)?;
+        let geometry = models
+            .map(|m| GeometryRenderer::with_targets(ctx, m, forest, &opts))
+            .transpose()?;
+        let hybrid = geometry.is_some();
+        let mut forest = ForestRenderer::new(stream, geometry);
+        if hybrid {
+            forest.set_method(ctx, Method::Hybrid(Hybrid::default()))?;
+        }
         let map = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("host shadow map"),
             size: wgpu::Extent3d {
@@ -204,8 +222,9 @@ impl Host {
                 distance: 120.0,
                 ..Default::default()
             };
-            // The caster draws into the host's map: its depth format and convention.
-            let caster = QuadStream::new(
+            // The caster draws into the host's map: its depth format and convention; its
+            // quads are thinned as the view's are.
+            let mut caster = QuadStream::new(
                 device,
                 scene,
                 &RendererOptions {
@@ -217,6 +236,7 @@ impl Host {
                     ..Default::default()
                 },
             )?;
+            caster.set_sharpen_override(forest.method().quad_sharpen())?;
             Some(Sun {
                 layer: map.create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(wgpu::TextureViewDimension::D2),

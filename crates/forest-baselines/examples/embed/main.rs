@@ -1,9 +1,11 @@
 //! Embedding the forest in a host's own wgpu renderer: a plain winit + wgpu program that draws
-//! its sky and ground and then the trees through `forest-render`'s public API (see `host.rs`).
+//! its sky and ground and then the trees through the public API of `forest-render` and
+//! `forest-baselines` (see `host.rs`): the hybrid where the atlases hold their models, else
+//! the quad stream.
 //!
 //! ```sh
-//! cargo run --release -p forest-render --example embed -- out/demo.forest
-//! cargo run --release -p forest-render --example embed -- out/demo.forest --headless shot.png
+//! cargo run --release -p forest-baselines --example embed -- out/forest-100k.forest
+//! cargo run --release -p forest-baselines --example embed -- out/forest-100k.forest --headless shot.png
 //! ```
 //! Options: `--eye X,Y,Z`, `--target X,Y,Z`, `--size WxH`, `--epsilon PX`. The window slowly
 //! circles the eye around the target; Escape quits.
@@ -13,7 +15,9 @@ mod host;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use forest_baselines::{GeometrySpecies, PreparedGeometry};
 use forest_format::forest::Forest;
+use forest_format::model::PreparedModel;
 use forest_render::target::Target;
 use forest_render::{GpuContext, GpuScene, SpeciesData};
 use glam::Vec3;
@@ -24,8 +28,15 @@ use winit::window::{Window, WindowId};
 
 type Error = Box<dyn std::error::Error>;
 
-/// A forest and its species' atlases (named relative to the forest's folder), on the GPU.
-fn load(ctx: &GpuContext, path: &Path) -> Result<Arc<GpuScene>, Error> {
+/// What the host draws: the forest, its species' atlases on the GPU (named relative to the
+/// forest's folder) and, where every atlas holds one, their models for the hybrid.
+struct Loaded {
+    forest: Forest,
+    scene: Arc<GpuScene>,
+    models: Option<PreparedGeometry>,
+}
+
+fn load(ctx: &GpuContext, path: &Path) -> Result<Loaded, Error> {
     let forest = Forest::load(path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let species = forest
@@ -33,7 +44,23 @@ fn load(ctx: &GpuContext, path: &Path) -> Result<Arc<GpuScene>, Error> {
         .iter()
         .map(|s| SpeciesData::load(&dir.join(s)))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(Arc::new(GpuScene::new(ctx, &species, &forest)?))
+    let mut models = Vec::new();
+    for (name, s) in forest.species.iter().zip(&species) {
+        match PreparedModel::load(&dir.join(name))? {
+            Some(m) => models.push(GeometrySpecies::new(m.into(), &s.atlas.manifest)),
+            None => {
+                eprintln!("embed: {name} holds no model: drawing the quad stream alone");
+                break;
+            }
+        }
+    }
+    let models = (models.len() == species.len()).then(|| PreparedGeometry::new(&models));
+    let scene = Arc::new(GpuScene::new(ctx, &species, &forest)?);
+    Ok(Loaded {
+        forest,
+        scene,
+        models,
+    })
 }
 
 /// Render one frame offscreen into a target the host clears itself, and read it back.
@@ -58,9 +85,18 @@ pub fn headless_with(
     shadows: bool,
 ) -> Result<image::RgbaImage, Error> {
     let ctx = GpuContext::headless()?;
-    let scene = load(&ctx, forest)?;
+    let l = load(&ctx, forest)?;
     let out = Target::new(&ctx, size.0, size.1);
-    let mut host = host::Host::new(&ctx.device, scene, out.format, size, epsilon, shadows)?;
+    let mut host = host::Host::new(
+        &ctx,
+        l.scene,
+        &l.forest,
+        l.models.as_ref(),
+        out.format,
+        size,
+        epsilon,
+        shadows,
+    )?;
     let frame = host::frame(eye, target, size, epsilon);
     host.draw(&ctx.device, &ctx.queue, &out.colour_view, &frame)?;
     let img = out.read(&ctx);
@@ -107,10 +143,12 @@ impl App {
             .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
             .ok_or("the window's surface is not supported by the adapter")?;
         surface.configure(&ctx.device, &config);
-        let scene = load(&ctx, &self.forest)?;
+        let l = load(&ctx, &self.forest)?;
         let host = host::Host::new(
-            &ctx.device,
-            scene,
+            &ctx,
+            l.scene,
+            &l.forest,
+            l.models.as_ref(),
             config.format,
             (config.width, config.height),
             self.epsilon,
