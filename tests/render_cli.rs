@@ -114,6 +114,35 @@ fn bake_scene_render_end_to_end() {
     let stored = image::open(d.join("hybrid.png")).unwrap().to_rgba8();
     let from_obj = image::open(d.join("hybrid-obj.png")).unwrap().to_rgba8();
     assert_eq!(stored, from_obj, "the stored models are the OBJs prepared");
+    // Without --method: the hybrid at its defaults, the same image as asked for by name.
+    let small = p("small.json");
+    let view = |out: &str, method: &[&str]| {
+        let mut a = vec![
+            "render",
+            &small,
+            "-o",
+            out,
+            "--eye",
+            "0,1.5,6",
+            "--target",
+            "0,1,0",
+            "--size",
+            "64x48",
+            "--json",
+        ];
+        a.extend(method);
+        forest(&a)
+    };
+    let text = ok(&view(&p("default.png"), &[]));
+    ok(&view(&p("named.png"), &["--method", "hybrid"]));
+    let v: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    assert_eq!(v["method"], "hybrid", "{v}");
+    let default = image::open(d.join("default.png")).unwrap().to_rgba8();
+    let named = image::open(d.join("named.png")).unwrap().to_rgba8();
+    assert_eq!(default, named, "no --method draws the hybrid");
+    ok(&view(&p("quads.png"), &["--method", "quads"]));
+    let quads = image::open(d.join("quads.png")).unwrap().to_rgba8();
+    assert_ne!(default, quads, "the near trees are drawn as their models");
     // Without model.bin (an atlas baked with --no-model), the message says what to do.
     let bare = d.join("bare");
     std::fs::create_dir_all(bare.join("bush.atlas")).unwrap();
@@ -148,6 +177,25 @@ fn bake_scene_render_end_to_end() {
         "{e}"
     );
     assert!(!bare.join("x.png").exists());
+    // Left to choose, render draws the quad stream there, and says why.
+    let out = forest(&[
+        "render",
+        &bare.join("bare.json").display().to_string(),
+        "-o",
+        &bare.join("x.png").display().to_string(),
+        "--view",
+        "birds-eye",
+        "--json",
+    ]);
+    let text = ok(&out);
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("quad stream") && note.contains("bush.atlas") && note.contains("model.bin"),
+        "{note}"
+    );
+    let v: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    assert!(v["quads"].as_u64().unwrap() > 0, "{v}");
+    assert!(bare.join("x.png").is_file());
     // Exact fragment counts and the overdraw view, for a quad method and a geometry one.
     for method in ["quads", "lods"] {
         let out = p(&format!("overdraw-{method}.png"));
