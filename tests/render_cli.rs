@@ -118,17 +118,8 @@ fn bake_scene_render_end_to_end() {
     let small = p("small.json");
     let view = |out: &str, method: &[&str]| {
         let mut a = vec![
-            "render",
-            &small,
-            "-o",
-            out,
-            "--eye",
-            "0,1.5,6",
-            "--target",
-            "0,1,0",
-            "--size",
-            "64x48",
-            "--json",
+            "render", &small, "-o", out, "--eye", "0,1.5,6", "--target", "0,1,0", "--size",
+            "64x48", "--json",
         ];
         a.extend(method);
         forest(&a)
