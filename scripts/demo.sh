@@ -26,14 +26,14 @@ for s in oak ash aspen pine bush; do
 done
 $forest scene --trees 100000 --area-per-tree 60 --species "$(IFS=,; echo "${species[*]}")" --seed 1 \
   --terrain hills -o out/forest-100k.forest
-# The hybrid: the trees within a few crown radii as full geometry (the models the bake stored
+# The default method, the hybrid: the trees within a few crown radii as full geometry (the models the bake stored
 # in the atlases), the rest as the quad stream, both casting the sun's shadows.
 $forest render out/forest-100k.forest -o out/render/forest.png --view inside --view hill --view birds-eye \
-  --size 800x600 --method hybrid --shadows on
+  --size 800x600 --shadows on
 # The same forest at two times of day: a low morning sun and noon.
 for t in 7.5 12; do
   $forest render out/forest-100k.forest -o "out/render/forest-$t.png" --view hill --time "$t" \
-    --size 800x600 --method hybrid --shadows on
+    --size 800x600 --shadows on
 done
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png,"

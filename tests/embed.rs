@@ -74,8 +74,15 @@ fn the_example_matches_forest_render() {
     eprintln!("FLIP {flip:.5}; {trees} tree pixels");
     // With the host's sun shadow map, which the forest casts into and receives: the host's
     // ground and the trees darken where shadowed, and nothing brightens.
-    let shadowed =
-        embed::headless_with(&d.join("f.forest"), eye, target, (160, 120), 2.0, true).unwrap();
+    let shadowed = embed::headless_with(
+        &d.join("f.forest"),
+        Some(eye),
+        Some(target),
+        (160, 120),
+        2.0,
+        true,
+    )
+    .unwrap();
     let lum = |p: &image::Rgba<u8>| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
     let darker = shadowed
         .pixels()

@@ -7,8 +7,9 @@
 //! cargo run --release -p forest-baselines --example embed -- out/forest-100k.forest
 //! cargo run --release -p forest-baselines --example embed -- out/forest-100k.forest --headless shot.png
 //! ```
-//! Options: `--eye X,Y,Z`, `--target X,Y,Z`, `--size WxH`, `--epsilon PX`. The window slowly
-//! circles the eye around the target; Escape quits.
+//! Options: `--eye X,Y,Z`, `--target X,Y,Z` (default: the forest's `inside` view,
+//! `forest_format::views::start`, standing clear of every tree), `--size WxH`, `--epsilon PX`.
+//! The window slowly turns the view around the eye; Escape quits.
 
 mod host;
 
@@ -18,6 +19,7 @@ use std::sync::Arc;
 use forest_baselines::{GeometrySpecies, PreparedGeometry};
 use forest_format::forest::Forest;
 use forest_format::model::PreparedModel;
+use forest_format::views::{self, Clearances, TreeShape};
 use forest_render::target::Target;
 use forest_render::{GpuContext, GpuScene, SpeciesData};
 use glam::Vec3;
@@ -34,6 +36,13 @@ struct Loaded {
     forest: Forest,
     scene: Arc<GpuScene>,
     models: Option<PreparedGeometry>,
+    /// The forest's start view (eye, target): on its ground, clear of every tree.
+    start: (Vec3, Vec3),
+}
+
+/// The eye and target to draw from: those given, the start view's for the rest.
+fn view(l: &Loaded, eye: Option<Vec3>, target: Option<Vec3>) -> (Vec3, Vec3) {
+    (eye.unwrap_or(l.start.0), target.unwrap_or(l.start.1))
 }
 
 fn load(ctx: &GpuContext, path: &Path) -> Result<Loaded, Error> {
@@ -56,10 +65,16 @@ fn load(ctx: &GpuContext, path: &Path) -> Result<Loaded, Error> {
     }
     let models = (models.len() == species.len()).then(|| PreparedGeometry::new(&models));
     let scene = Arc::new(GpuScene::new(ctx, &species, &forest)?);
+    let shapes: Vec<TreeShape> = species
+        .iter()
+        .map(|s| TreeShape::of(&s.atlas.manifest))
+        .collect();
+    let start = views::start(&forest, &Clearances::new(&forest, &shapes));
     Ok(Loaded {
         forest,
         scene,
         models,
+        start,
     })
 }
 
@@ -71,21 +86,22 @@ pub fn headless(
     size: (u32, u32),
     epsilon: f32,
 ) -> Result<image::RgbaImage, Error> {
-    headless_with(forest, eye, target, size, epsilon, false)
+    headless_with(forest, Some(eye), Some(target), size, epsilon, false)
 }
 
 /// [`headless`], with the host's sun shadow map (the forest casting into it and receiving it)
-/// when `shadows`.
+/// when `shadows`, and the start view's eye or target where one is not given.
 pub fn headless_with(
     forest: &Path,
-    eye: Vec3,
-    target: Vec3,
+    eye: Option<Vec3>,
+    target: Option<Vec3>,
     size: (u32, u32),
     epsilon: f32,
     shadows: bool,
 ) -> Result<image::RgbaImage, Error> {
     let ctx = GpuContext::headless()?;
     let l = load(&ctx, forest)?;
+    let (eye, target) = view(&l, eye, target);
     let out = Target::new(&ctx, size.0, size.1);
     let mut host = host::Host::new(
         &ctx,
@@ -106,8 +122,8 @@ pub fn headless_with(
 
 struct App {
     forest: PathBuf,
-    eye: Vec3,
-    target: Vec3,
+    eye: Option<Vec3>,
+    target: Option<Vec3>,
     size: (u32, u32),
     epsilon: f32,
     shadows: bool,
@@ -144,6 +160,10 @@ impl App {
             .ok_or("the window's surface is not supported by the adapter")?;
         surface.configure(&ctx.device, &config);
         let l = load(&ctx, &self.forest)?;
+        (self.eye, self.target) = {
+            let (eye, target) = view(&l, self.eye, self.target);
+            (Some(eye), Some(target))
+        };
         let host = host::Host::new(
             &ctx,
             l.scene,
@@ -171,15 +191,12 @@ impl App {
             }
         };
         let view = texture.texture.create_view(&Default::default());
+        let (Some(eye), Some(target)) = (self.eye, self.target) else {
+            return Ok(());
+        };
         let angle = self.start.elapsed().as_secs_f32() * 0.1;
-        let offset = self.eye - self.target;
-        let eye = self.target + glam::Quat::from_rotation_y(angle) * offset;
-        let frame = host::frame(
-            eye,
-            self.target,
-            (config.width, config.height),
-            self.epsilon,
-        );
+        let target = eye + glam::Quat::from_rotation_y(angle) * (target - eye);
+        let frame = host::frame(eye, target, (config.width, config.height), self.epsilon);
         host.draw(&ctx.device, &ctx.queue, &view, &frame)?;
         window.pre_present_notify();
         ctx.queue.present(texture);
@@ -243,13 +260,13 @@ fn vec3(s: &str) -> Result<Vec3, Error> {
 fn run() -> Result<(), Error> {
     let mut args = std::env::args().skip(1);
     let mut forest = None;
-    let (mut eye, mut target) = (Vec3::new(0.0, 30.0, 60.0), Vec3::ZERO);
+    let (mut eye, mut target) = (None, None);
     let (mut size, mut epsilon, mut headless_out, mut shadows) = ((960, 540), 4.0, None, false);
     while let Some(a) = args.next() {
         let mut value = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
-            "--eye" => eye = vec3(&value()?)?,
-            "--target" => target = vec3(&value()?)?,
+            "--eye" => eye = Some(vec3(&value()?)?),
+            "--target" => target = Some(vec3(&value()?)?),
             "--epsilon" => epsilon = value()?.parse()?,
             "--headless" => headless_out = Some(PathBuf::from(value()?)),
             // The host's sun shadow map, which the forest casts into and receives.
