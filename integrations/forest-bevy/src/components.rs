@@ -49,8 +49,9 @@ pub enum ForestMethod {
     Impostors,
     /// The trees next to the camera as their full models, the rest as the quad stream, each
     /// species switching where its bake measured the quads as accurate as its triangles.
-    /// Needs every species' prepared model (`model.bin`, which `forest bake` stores; without
-    /// them the view draws nothing and [`crate::ForestStats`] says why).
+    /// Draws every species' prepared model (`model.bin`, which `forest bake` stores); over
+    /// atlases without them the view draws the quad stream, and its
+    /// [`crate::ForestViewStats::note`] says why.
     #[default]
     Hybrid,
     /// Discrete LODs (the full model, two simplified meshes, billboards) by distance. Needs

@@ -25,6 +25,9 @@ pub struct ForestViewStats {
     /// Why the forest is not drawn into this view, if it is not (bad camera, a forest that
     /// did not reach the GPU).
     pub error: Option<String>,
+    /// Why the view draws another method than its camera asks, if it does: the hybrid over
+    /// atlases baked without their models draws the quad stream.
+    pub note: Option<String>,
 }
 
 /// The frame statistics of every (camera, forest) pair drawn, keyed by the main world's

@@ -8,7 +8,7 @@ use bevy::asset::AssetLoadFailedEvent;
 use bevy::prelude::*;
 use bevy::render::view::Msaa;
 use common::*;
-use forest_bevy::{ForestAsset, ForestMethod, ForestStats};
+use forest_bevy::{ForestAsset, ForestCamera, ForestMethod, ForestStats};
 
 /// Pixels that differ from the clear colour by more than 8 levels in a channel.
 fn covered(img: &image::RgbaImage) -> Vec<bool> {
@@ -160,6 +160,69 @@ fn the_model_methods_match_forest_render() {
         let flip = compare_view(&name, &reference, &bevy, 0.02);
         println!("{name}: FLIP {flip:.4}, coverage {coverage:.2}, {stats:?}");
     }
+}
+
+/// The hybrid, the default, over an atlas baked without its model draws the quad stream
+/// (within FLIP 0.02 of `forest-render`'s quad stream from that camera) and says why in the
+/// view's statistics, with no error; asked for by name, the discrete LODs report the missing
+/// model as the error.
+#[test]
+fn the_hybrid_without_models_draws_the_quad_stream() {
+    let bare = out_dir().join("bare-assets");
+    let _ = std::fs::remove_dir_all(&bare);
+    std::fs::create_dir_all(bare.join("bush.atlas")).unwrap();
+    for entry in std::fs::read_dir(assets().join("bush.atlas")).unwrap() {
+        let entry = entry.unwrap();
+        if entry.file_name() != forest_format::model::MODEL_FILE {
+            std::fs::copy(
+                entry.path(),
+                bare.join("bush.atlas").join(entry.file_name()),
+            )
+            .unwrap();
+        }
+    }
+    std::fs::copy(assets().join("small.forest"), bare.join("small.forest")).unwrap();
+    let mut app = app(&bare);
+    let forest = spawn_forest(&mut app, Transform::IDENTITY);
+    let hybrid = View {
+        method: ForestCamera::default().method,
+        ..View::at(EYE, AT)
+    };
+    assert_eq!(hybrid.method, ForestMethod::Hybrid);
+    let lods = View {
+        method: ForestMethod::DiscreteLods,
+        ..View::at(EYE, AT)
+    };
+    let (camera, image) = spawn_camera(&mut app, hybrid);
+    let (lods_camera, _) = spawn_camera(&mut app, lods);
+    settle(&mut app, camera, forest);
+    settle_on(&mut app, lods_camera, forest, |s| s.error.is_some());
+    let stats = |camera| {
+        app.world()
+            .resource::<ForestStats>()
+            .get(camera, forest)
+            .cloned()
+            .expect("statistics")
+    };
+    let (drawn, refused) = (stats(camera), stats(lods_camera));
+    assert!(drawn.error.is_none(), "{drawn:?}");
+    assert!(
+        drawn.geometry_trees == 0 && drawn.triangles == 0,
+        "{drawn:?}"
+    );
+    let note = drawn.note.expect("a note saying the quad stream is drawn");
+    assert!(
+        note.contains("quad stream") && note.contains("bush.atlas"),
+        "{note}"
+    );
+    let error = refused.error.expect("the missing model as the LODs' error");
+    assert!(
+        error.contains("bush.atlas") && refused.note.is_none(),
+        "{error}"
+    );
+    let bevy = read(&mut app, &image);
+    let reference = reference(EYE, AT, hybrid.epsilon, expected_light(sun_dir()), 1);
+    assert_flip("hybrid-without-models", &reference, &bevy, 0.02);
 }
 
 /// Two cameras looking from opposite sides: each image is its own view (within FLIP 0.02

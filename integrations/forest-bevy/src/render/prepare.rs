@@ -19,6 +19,7 @@ use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptio
 
 use super::extract::Extracted;
 use crate::assets::ForestAsset;
+use crate::components::ForestMethod;
 use crate::light;
 use crate::shadows;
 use crate::stats::{ForestViewStats, SharedStats};
@@ -53,6 +54,8 @@ pub(super) struct Caster {
 /// view has drawn a model method, those models on the GPU, shared by every view.
 struct Models {
     forest: Arc<Forest>,
+    /// Whether some atlas holds no prepared model (the asset was loaded without them).
+    absent: bool,
     prepared: Result<Arc<PreparedGeometry>, String>,
     gpu: Option<Arc<GpuModels>>,
 }
@@ -93,6 +96,8 @@ pub struct ForestRenderState {
     pub(super) casts: HashMap<Entity, Vec<(Entity, CasterId)>>,
     /// Cameras warned about (once each).
     warned: HashSet<Entity>,
+    /// (camera, forest) pairs warned that the hybrid falls back to the quad stream.
+    warned_fallback: HashSet<(Entity, Entity)>,
 }
 
 impl ForestRenderState {
@@ -160,6 +165,7 @@ pub fn prepare_forests(
             id,
             Models {
                 forest: asset.forest.clone(),
+                absent: asset.geometry.is_err(),
                 prepared: asset.geometry.clone(),
                 gpu: None,
             },
@@ -239,7 +245,26 @@ pub fn prepare_forests(
                 write_depth: cam.settings.write_depth,
                 ..Default::default()
             };
-            let method = cam.settings.method;
+            let mut method = cam.settings.method;
+            // The hybrid (the default) over atlases baked without their models draws the quad
+            // stream, as `forest render` does, and says so; the other model methods report
+            // the missing models as an error.
+            let mut note = None;
+            if method == ForestMethod::Hybrid
+                && let Some(Err(why)) = state
+                    .models
+                    .get(&forest.asset)
+                    .filter(|m| m.absent)
+                    .map(|m| m.prepared.as_ref())
+            {
+                let why = format!("drawing the quad stream, not the hybrid: {why}");
+                if state.warned_fallback.insert(key_pair) {
+                    warn!("forest-bevy: camera {main}: {why}");
+                }
+                note = Some(why);
+                method = ForestMethod::QuadStream;
+            }
+            record.note = note.clone();
             let models = if method.needs_models() {
                 let Some(models) = state.models.get_mut(&forest.asset) else {
                     continue;
@@ -333,6 +358,7 @@ pub fn prepare_forests(
                     cast_quads: 0,
                     gpu_ms: s.times.map(|t| t.total_ms()),
                     error: None,
+                    note: note.clone(),
                 };
                 if let Err(e) = v.renderer.fit(&ctx.device, &s) {
                     fresh.error = Some(e.to_string());
