@@ -153,31 +153,22 @@ fn bake_scene_render_end_to_end() {
         "-o",
         &bare.join("bare.json").display().to_string(),
     ]));
-    let e = err(&forest(&[
-        "render",
-        &bare.join("bare.json").display().to_string(),
-        "-o",
-        &bare.join("x.png").display().to_string(),
-        "--view",
-        "birds-eye",
-        "--method",
-        "lods",
-    ]));
+    // `forest render` of the bare forest's bird's-eye view into x.png, with `extra`.
+    let render_bare = |extra: &[&str]| {
+        let (forest_file, png) = (bare.join("bare.json"), bare.join("x.png"));
+        let (forest_file, png) = (forest_file.display().to_string(), png.display().to_string());
+        let mut a = vec!["render", &forest_file, "-o", &png, "--view", "birds-eye"];
+        a.extend(extra);
+        forest(&a)
+    };
+    let e = err(&render_bare(&["--method", "lods"]));
     assert!(
         e.contains("bush.atlas") && e.contains("model.bin") && e.contains("--models"),
         "{e}"
     );
     assert!(!bare.join("x.png").exists());
     // Left to choose, render draws the quad stream there, and says why.
-    let out = forest(&[
-        "render",
-        &bare.join("bare.json").display().to_string(),
-        "-o",
-        &bare.join("x.png").display().to_string(),
-        "--view",
-        "birds-eye",
-        "--json",
-    ]);
+    let out = render_bare(&["--json"]);
     let text = ok(&out);
     let note = String::from_utf8_lossy(&out.stderr);
     assert!(

@@ -25,10 +25,10 @@ pub const CLEARANCE: f32 = 3.0;
 pub const NAMES: [&str; 3] = ["inside", "hill", "birds-eye"];
 
 /// Ring step (metres) of the search around the clump for a clear standing spot.
-const RING_STEP: f32 = 2.0;
+pub const RING_STEP: f32 = 2.0;
 
 /// Spacing (metres) of the spots along one ring of that search (at least 16 per ring).
-const SPOT_SPACING: f32 = 4.0;
+pub const SPOT_SPACING: f32 = 4.0;
 
 /// A species' reach at scale 1: the sphere bounding its whole model, trunk and crown (object
 /// space, metres), as its atlas records it.
