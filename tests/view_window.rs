@@ -250,7 +250,8 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         );
     }
 
-    // The first screenshot is the path's last key, and looks like the stored reference.
+    // The first screenshot is the path's last key drawn by the default method (the hybrid: the
+    // models are given), and looks like the stored reference.
     let (eye0, target0) = key_of(&shots.join("screenshot-000.json"));
     assert!(eye0.distance(Vec3::from_array(last.eye)) < 1e-4, "{eye0}");
     let dir0 = (target0 - eye0).normalize();
