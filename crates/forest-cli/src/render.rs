@@ -532,7 +532,7 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
 pub fn named_view(name: &str, forest: &Forest, species: &[SpeciesData]) -> Result<(Vec3, Vec3)> {
     let shapes: Vec<TreeShape> = species
         .iter()
-        .map(|s| TreeShape::of(&s.atlas.manifest))
+        .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
         .collect();
     forest_format::views::named(name, forest, &Clearances::new(forest, &shapes))
         .ok_or_else(|| anyhow::anyhow!("no view named {name:?}: give one of {:?}", views::NAMES))

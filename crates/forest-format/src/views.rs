@@ -3,10 +3,11 @@
 //! one placement rule serves them all.
 //!
 //! The rule: a view that stands in the forest keeps [`CLEARANCE`] metres from every tree's
-//! bounding sphere ([`TreeShape`], the sphere the species' atlas frames, which holds its trunk
-//! and crown), so no first frame starts inside a crown or against a trunk. [`Clearances`]
-//! answers "how far is the nearest tree" through a grid over the trees, so a search over
-//! thousands of spots in a forest of a million trees stays cheap.
+//! trunk and crown ([`TreeShape`]: per height band, the reach from the trunk's axis of every
+//! voxel of the species' opacity volume that holds leaf or wood area; the bounding sphere
+//! the atlas frames where the volume is not known), so no first frame starts inside a crown or
+//! against a trunk. [`Clearances`] answers "how far is the nearest tree" through a grid over
+//! the trees, so a search over thousands of spots in a forest of a million trees stays cheap.
 
 use std::collections::HashMap;
 
@@ -14,6 +15,7 @@ use glam::{Quat, Vec3};
 
 use crate::atlas::AtlasManifest;
 use crate::forest::Forest;
+use crate::opacity::OpacityVolume;
 
 /// Eye height above the ground of the views that stand on it (metres).
 pub const EYE_HEIGHT: f32 = 1.7;
@@ -30,39 +32,163 @@ pub const RING_STEP: f32 = 2.0;
 /// Spacing (metres) of the spots along one ring of that search (at least 16 per ring).
 pub const SPOT_SPACING: f32 = 4.0;
 
-/// A species' reach at scale 1: the sphere bounding its whole model, trunk and crown (object
-/// space, metres), as its atlas records it.
+/// Part of a tree between two heights: everything of it within `y0..y1` lies within
+/// `radius` of its vertical axis (the model's y axis, about which instances turn).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TreeShape {
-    /// Centre in the model's frame (metres; the tree stands on y = 0).
-    pub center: Vec3,
-    /// Radius (metres, > 0).
+pub struct Band {
+    /// Bottom (metres, model space).
+    pub y0: f32,
+    /// Top (metres, model space, ≥ `y0`).
+    pub y1: f32,
+    /// Reach from the axis (metres, ≥ 0).
     pub radius: f32,
 }
 
+/// A species' reach at scale 1 (model space, metres; the tree stands on y = 0 around its y
+/// axis): the sphere bounding its whole model, trunk and crown, as its atlas records it,
+/// and where known the bands it fills.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeShape {
+    /// Centre of the bounding sphere in the model's frame.
+    pub center: Vec3,
+    /// Radius of the bounding sphere (> 0).
+    pub radius: f32,
+    /// The occupied bands, bottom up, all within the bounding cube; empty where only the
+    /// sphere is known (then the sphere is the tree's shape).
+    pub bands: Vec<Band>,
+}
+
 impl TreeShape {
-    /// The shape an atlas's manifest records.
+    /// The bounding sphere an atlas's manifest records, as the whole shape.
     pub fn of(manifest: &AtlasManifest) -> Self {
         Self {
             center: manifest.bounding_sphere.center,
             radius: manifest.bounding_sphere.radius,
+            bands: Vec::new(),
         }
+    }
+
+    /// The shape of a species whose opacity volume is known: [`Self::of`] its manifest,
+    /// [`Self::banded`] by its volume.
+    pub fn with_volume(manifest: &AtlasManifest, volume: &OpacityVolume) -> Self {
+        Self::of(manifest).banded(volume)
+    }
+
+    /// This shape's bands taken from `volume`, the opacity volume on the cube around its
+    /// sphere: one band per voxel layer holding any leaf or wood area (a code above 0),
+    /// reaching to the farthest corner of its occupied voxels. An empty volume leaves the
+    /// sphere alone.
+    pub fn banded(self, volume: &OpacityVolume) -> Self {
+        let mut shape = Self {
+            bands: Vec::new(),
+            ..self
+        };
+        let n = volume.resolution as usize;
+        if n == 0 || volume.codes.len() != n * n * n || volume.max_depth <= 0.0 {
+            return shape;
+        }
+        let h = 2.0 * shape.radius / n as f32;
+        let lo = shape.center - Vec3::splat(shape.radius);
+        for j in 0..n {
+            let mut reach = None;
+            for k in 0..n {
+                for i in 0..n {
+                    if volume.codes[i + n * (j + n * k)] == 0 {
+                        continue;
+                    }
+                    let x = (lo.x + (i as f32 + 0.5) * h).abs() + 0.5 * h;
+                    let z = (lo.z + (k as f32 + 0.5) * h).abs() + 0.5 * h;
+                    let r = x.hypot(z);
+                    reach = Some(reach.map_or(r, |m: f32| m.max(r)));
+                }
+            }
+            if let Some(radius) = reach {
+                let y0 = lo.y + j as f32 * h;
+                shape.bands.push(Band {
+                    y0,
+                    y1: y0 + h,
+                    radius,
+                });
+            }
+        }
+        shape
+    }
+
+    /// Radius (metres, model space) of a sphere about [`Self::center`] holding every band.
+    fn bound(&self) -> f32 {
+        let axis = self.center.with_y(0.0).length();
+        self.bands
+            .iter()
+            .map(|b| {
+                let up = (b.y0 - self.center.y)
+                    .abs()
+                    .max((b.y1 - self.center.y).abs());
+                (axis + b.radius).hypot(up)
+            })
+            .fold(self.radius, f32::max)
+    }
+
+    /// Distance (metres, model space) from `q` to the shape: to the union of its bands'
+    /// cylinders, or to its sphere (negative inside) where it has none.
+    fn distance(&self, q: Vec3) -> f32 {
+        if self.bands.is_empty() {
+            return q.distance(self.center) - self.radius;
+        }
+        let across = q.with_y(0.0).length();
+        self.bands
+            .iter()
+            .map(|b| {
+                let dh = (across - b.radius).max(0.0);
+                let dv = (b.y0 - q.y).max(q.y - b.y1).max(0.0);
+                dh.hypot(dv)
+            })
+            .fold(f32::INFINITY, f32::min)
     }
 }
 
-/// The world-space sphere of one tree: its species' [`TreeShape`] turned, scaled and placed.
-fn world_sphere(forest: &Forest, shapes: &[TreeShape], i: usize) -> Option<(Vec3, f32)> {
-    let t = &forest.instances[i];
-    let s = shapes.get(t.species as usize)?;
-    let c = Vec3::from_array(t.position) + Quat::from_rotation_y(t.rotation) * (s.center * t.scale);
-    Some((c, s.radius * t.scale))
+/// One tree placed in the world: its species' shape, where it stands, its turn and scale.
+#[derive(Clone, Copy)]
+struct Placed {
+    species: u32,
+    position: Vec3,
+    rotation: f32,
+    scale: f32,
+    /// Centre and radius of a world sphere holding the whole shape.
+    center: Vec3,
+    bound: f32,
 }
 
-/// The trees' bounding spheres, bucketed on a square grid for distance queries.
+impl Placed {
+    fn of(forest: &Forest, shapes: &[TreeShape], bounds: &[f32], i: usize) -> Option<Self> {
+        let t = &forest.instances[i];
+        let s = shapes.get(t.species as usize)?;
+        let position = Vec3::from_array(t.position);
+        let center = position + Quat::from_rotation_y(t.rotation) * (s.center * t.scale);
+        let p = Self {
+            species: t.species,
+            position,
+            rotation: t.rotation,
+            scale: t.scale,
+            center,
+            bound: bounds[t.species as usize] * t.scale,
+        };
+        (center.is_finite() && p.bound.is_finite() && t.scale > 0.0).then_some(p)
+    }
+
+    /// Distance (metres) from world point `p` to this tree's shape.
+    fn distance(&self, shapes: &[TreeShape], p: Vec3) -> f32 {
+        let q = Quat::from_rotation_y(-self.rotation) * (p - self.position) / self.scale;
+        shapes[self.species as usize].distance(q) * self.scale
+    }
+}
+
+/// The trees' shapes, bucketed on a square grid by the spheres holding them, for distance
+/// queries.
 pub struct Clearances<'a> {
     forest: &'a Forest,
-    spheres: Vec<(Vec3, f32)>,
-    /// Grid cell side (metres): the largest sphere radius plus [`CLEARANCE`].
+    shapes: Vec<TreeShape>,
+    trees: Vec<Placed>,
+    /// Grid cell side (metres): the largest holding sphere's radius plus [`CLEARANCE`].
     cell: f32,
     cells: HashMap<(i64, i64), Vec<u32>>,
 }
@@ -71,18 +197,22 @@ impl<'a> Clearances<'a> {
     /// The trees of `forest`, each species shaped by `shapes` (in the forest's species order;
     /// a tree whose species has no shape, or whose sphere is not finite, is left out).
     pub fn new(forest: &'a Forest, shapes: &[TreeShape]) -> Self {
-        let spheres: Vec<(Vec3, f32)> = (0..forest.instances.len())
-            .filter_map(|i| world_sphere(forest, shapes, i))
-            .filter(|(c, r)| c.is_finite() && r.is_finite())
+        let bounds: Vec<f32> = shapes.iter().map(TreeShape::bound).collect();
+        let trees: Vec<Placed> = (0..forest.instances.len())
+            .filter_map(|i| Placed::of(forest, shapes, &bounds, i))
             .collect();
-        let cell = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max) + CLEARANCE;
+        let cell = trees.iter().map(|t| t.bound).fold(0.0f32, f32::max) + CLEARANCE;
         let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
-        for (k, (c, _)) in spheres.iter().enumerate() {
-            cells.entry(Self::key(cell, *c)).or_default().push(k as u32);
+        for (k, t) in trees.iter().enumerate() {
+            cells
+                .entry(Self::key(cell, t.center))
+                .or_default()
+                .push(k as u32);
         }
         Self {
             forest,
-            spheres,
+            shapes: shapes.to_vec(),
+            trees,
             cell,
             cells,
         }
@@ -92,24 +222,30 @@ impl<'a> Clearances<'a> {
         ((p.x / cell).floor() as i64, (p.z / cell).floor() as i64)
     }
 
-    /// Distance (metres) from `p` to the nearest tree's bounding sphere, negative inside one.
-    /// Exact where it is below [`CLEARANCE`]; elsewhere some value of at least that (a sphere
-    /// outside the 3×3 grid cells around `p` lies farther). Infinite without a tree near.
+    /// Distance (metres) from `p` to the nearest tree's shape (0 or negative inside one).
+    /// Exact where it is below [`CLEARANCE`]; elsewhere some value of at least that (a tree
+    /// outside the 3×3 grid cells around `p`, or whose holding sphere keeps that far, lies
+    /// farther). Infinite without a tree near.
     pub fn distance(&self, p: Vec3) -> f32 {
         let (x, z) = Self::key(self.cell, p);
         let mut d = f32::INFINITY;
         for dx in -1..=1 {
             for dz in -1..=1 {
                 for &k in self.cells.get(&(x + dx, z + dz)).into_iter().flatten() {
-                    let (c, r) = self.spheres[k as usize];
-                    d = d.min(c.distance(p) - r);
+                    let t = &self.trees[k as usize];
+                    let far = t.center.distance(p) - t.bound;
+                    d = d.min(if far >= CLEARANCE {
+                        far
+                    } else {
+                        t.distance(&self.shapes, p)
+                    });
                 }
             }
         }
         d
     }
 
-    /// Whether `p` keeps [`CLEARANCE`] from every tree's sphere.
+    /// Whether `p` keeps [`CLEARANCE`] from every tree's shape.
     pub fn clear(&self, p: Vec3) -> bool {
         self.distance(p) >= CLEARANCE
     }
@@ -189,9 +325,9 @@ pub fn inside(forest: &Forest, trees: &Clearances) -> (Vec3, Vec3) {
     };
     // Far enough to leave every tree behind: past the farthest sphere from the clump.
     let reach = trees
-        .spheres
+        .trees
         .iter()
-        .map(|(s, r)| flat(*s, c) + r)
+        .map(|t| flat(t.center, c) + t.bound)
         .fold(0.0f32, f32::max)
         + CLEARANCE
         + RING_STEP;
@@ -292,64 +428,107 @@ mod tests {
     use crate::terrain::{Terrain, TerrainParams};
     use proptest::prelude::*;
 
-    /// Two species of real size: a broad crown (14 m tall) and a tall narrow one (24 m).
+    /// Two species of real size as spheres alone: a broad crown (14 m tall) and a tall
+    /// narrow one (24 m).
     fn shapes() -> Vec<TreeShape> {
         vec![
             TreeShape {
                 center: Vec3::new(0.3, 7.0, -0.2),
                 radius: 7.5,
+                bands: Vec::new(),
             },
             TreeShape {
                 center: Vec3::new(0.0, 12.0, 0.0),
                 radius: 12.5,
+                bands: Vec::new(),
             },
         ]
     }
 
+    /// The same two with their trunks and crowns as bands.
+    fn banded_shapes() -> Vec<TreeShape> {
+        let band = |y0, y1, radius| Band { y0, y1, radius };
+        let mut s = shapes();
+        s[0].bands = vec![
+            band(0.0, 3.0, 0.3),
+            band(3.0, 6.0, 4.0),
+            band(6.0, 11.0, 6.5),
+            band(11.0, 14.0, 3.0),
+        ];
+        s[1].bands = vec![
+            band(0.0, 8.0, 0.4),
+            band(8.0, 16.0, 4.0),
+            band(16.0, 24.0, 2.5),
+        ];
+        s
+    }
+
+    fn both() -> [Vec<TreeShape>; 2] {
+        [shapes(), banded_shapes()]
+    }
+
+    /// A seeded forest, on hills of 60 m relief when `hills` (halved until the generator's
+    /// slope rules accept the trees: a dense forest covers little ground).
     fn forest(seed: u64, trees: u32, area_per_tree: f32, hills: bool) -> Forest {
         let side = (trees as f32 * area_per_tree).sqrt();
-        let terrain = hills.then(|| {
-            Terrain::generate(&TerrainParams {
-                half_extent: side.max(200.0),
-                relief: 60.0,
-                hill_size: (side / 4.0).max(150.0),
-                fade: 0.5,
+        let make = |relief: Option<f32>| {
+            let terrain = relief.map(|relief| {
+                Terrain::generate(&TerrainParams {
+                    half_extent: side.max(200.0),
+                    relief,
+                    hill_size: (side / 4.0).max(150.0),
+                    fade: 0.5,
+                    seed,
+                    ..TerrainParams::default()
+                })
+                .unwrap()
+            });
+            generate(&GenerateParams {
+                trees,
+                species: vec!["a.atlas".into(), "b.atlas".into()],
+                area_per_tree,
                 seed,
-                ..TerrainParams::default()
+                terrain,
+                ..GenerateParams::default()
             })
-            .unwrap()
-        });
-        generate(&GenerateParams {
-            trees,
-            species: vec!["a.atlas".into(), "b.atlas".into()],
-            area_per_tree,
-            seed,
-            terrain,
-            ..GenerateParams::default()
-        })
-        .unwrap()
+        };
+        if !hills {
+            return make(None).unwrap();
+        }
+        [60.0, 30.0, 15.0, 7.5]
+            .into_iter()
+            .find_map(|relief| make(Some(relief)).ok())
+            .expect("hills the generator accepts")
     }
 
     /// Every tree's distance from `p`, by brute force.
-    fn nearest(f: &Forest, p: Vec3) -> f32 {
-        (0..f.instances.len())
-            .filter_map(|i| world_sphere(f, &shapes(), i))
-            .map(|(c, r)| c.distance(p) - r)
+    fn nearest_to(f: &Forest, shapes: &[TreeShape], p: Vec3) -> f32 {
+        f.instances
+            .iter()
+            .map(|t| {
+                let q = Quat::from_rotation_y(-t.rotation) * (p - Vec3::from_array(t.position));
+                shapes[t.species as usize].distance(q / t.scale) * t.scale
+            })
             .fold(f32::INFINITY, f32::min)
     }
 
     #[test]
     fn the_grid_finds_the_nearest_tree_within_the_clearance() {
+        for s in both() {
+            grid_against_brute_force(&s);
+        }
+    }
+
+    fn grid_against_brute_force(s: &[TreeShape]) {
         let f = forest(3, 400, 20.0, true);
-        let s = shapes();
-        let trees = Clearances::new(&f, &s);
+        let trees = Clearances::new(&f, s);
         let mut rng = crate::generate::SplitMix64(9);
         let mut r = |lo: f32, hi: f32| lo + (hi - lo) * rng.next_f32();
         let mut near = 0;
         for _ in 0..2000 {
             let (x, z) = (r(-60.0, 60.0), r(-60.0, 60.0));
             let p = Vec3::new(x, f.ground_height(x, z) + r(0.0, 30.0), z);
-            let (grid, brute) = (trees.distance(p), nearest(&f, p));
+            let (grid, brute) = (trees.distance(p), nearest_to(&f, s, p));
             if brute < CLEARANCE {
                 near += 1;
                 assert!((grid - brute).abs() < 1e-4, "{p}: {grid} against {brute}");
@@ -365,8 +544,14 @@ mod tests {
     /// The views' eyes keep the clearance from every tree and the standing one stands at eye
     /// height on the ground, on flat ground, hills and in a dense forest.
     fn check_views(f: &Forest) -> Result<(), TestCaseError> {
-        let s = shapes();
-        let trees = Clearances::new(f, &s);
+        for s in both() {
+            check_views_of(f, &s)?;
+        }
+        Ok(())
+    }
+
+    fn check_views_of(f: &Forest, s: &[TreeShape]) -> Result<(), TestCaseError> {
+        let trees = Clearances::new(f, s);
         for name in NAMES {
             let (eye, target) = named(name, f, &trees).unwrap();
             prop_assert!(
@@ -374,7 +559,7 @@ mod tests {
                 "{name}: {eye} {target}"
             );
             prop_assert!((target - eye).length() > 1.0, "{name}: {eye} {target}");
-            let d = nearest(f, eye);
+            let d = nearest_to(f, s, eye);
             prop_assert!(d >= CLEARANCE, "{name}: {eye} is {d} m from a tree");
         }
         let (eye, _) = start(f, &trees);
@@ -408,9 +593,8 @@ mod tests {
     #[test]
     fn the_inside_view_stands_among_the_trees_where_there_is_room() {
         // At the demo's density a clear spot is found inside the trees' square.
-        for seed in 0..4 {
+        for (seed, s) in (0..4).zip(both().into_iter().cycle()) {
             let f = forest(seed, 1500, 60.0, seed % 2 == 1);
-            let s = shapes();
             let (eye, _) = inside(&f, &Clearances::new(&f, &s));
             let half = f
                 .instances
@@ -434,6 +618,70 @@ mod tests {
                 .count();
             assert!(around >= 5, "{around} trees within 30 m of {eye}");
         }
+    }
+
+    /// A volume holding a trunk (the four central columns of voxels, lower half) and a ball
+    /// of crown: the bands hold every occupied voxel, the trunk's band reaches to its
+    /// voxels' far corners (√2 voxel sides), and a point beside the trunk under the crown
+    /// is as far from the shape as from that band.
+    #[test]
+    fn bands_hold_the_volume_and_measure_the_trunk() {
+        let n = 32usize;
+        let (center, radius) = (Vec3::new(0.0, 5.0, 0.0), 5.0);
+        let h = 2.0 * radius / n as f32;
+        let at = |i: usize, j: usize, k: usize| {
+            center - Vec3::splat(radius) + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h
+        };
+        let crown = Vec3::new(0.0, 7.0, 0.0);
+        let mut depths = vec![0.0f32; n * n * n];
+        for k in 0..n {
+            for j in 0..n {
+                for i in 0..n {
+                    let trunk = (15..=16).contains(&i) && (15..=16).contains(&k) && j < n / 2;
+                    let leaf = j >= n / 2 && at(i, j, k).distance(crown) < 4.0;
+                    if trunk || leaf {
+                        depths[i + n * (j + n * k)] = 1.0;
+                    }
+                }
+            }
+        }
+        let volume = OpacityVolume::from_depths(n as u32, &depths);
+        let shape = TreeShape {
+            center,
+            radius,
+            bands: Vec::new(),
+        }
+        .banded(&volume);
+        assert_eq!(shape.bands.len(), n);
+        assert!(
+            (shape.bands[0].radius - h * 2f32.sqrt()).abs() < 1e-5,
+            "{:?}",
+            shape.bands[0]
+        );
+        for (k, d) in depths.iter().enumerate() {
+            if *d > 0.0 {
+                let p = at(k % n, k / n % n, k / (n * n));
+                assert_eq!(shape.distance(p), 0.0, "{p}");
+            }
+        }
+        let beside = Vec3::new(2.0, 1.7, 0.0);
+        let want = 2.0 - h * 2f32.sqrt();
+        assert!(
+            (shape.distance(beside) - want).abs() < 1e-5,
+            "{}",
+            shape.distance(beside)
+        );
+        // The sphere alone puts that point inside the tree.
+        assert!(
+            TreeShape {
+                bands: Vec::new(),
+                ..shape.clone()
+            }
+            .distance(beside)
+                < 0.0
+        );
+        // An empty volume leaves the sphere alone.
+        assert!(shape.banded(&OpacityVolume::empty(8)).bands.is_empty());
     }
 
     #[test]

@@ -160,7 +160,7 @@ fn terrain(
     let shapes: Vec<TreeShape> = forest
         .species
         .iter()
-        .map(|s| TreeShape::of(&s.atlas.manifest))
+        .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
         .collect();
     let (eye, target) = views::start(f, &Clearances::new(f, &shapes));
     for mut t in &mut cams {

@@ -76,7 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The viewer's opening view (clear of every tree), and one from 60 m above.
     let shapes: Vec<_> = species
         .iter()
-        .map(|s| forest_format::views::TreeShape::of(&s.atlas.manifest))
+        .map(|s| forest_format::views::TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
         .collect();
     let (eye, target) = forest_format::views::start(
         &forest,

@@ -67,7 +67,7 @@ fn load(ctx: &GpuContext, path: &Path) -> Result<Loaded, Error> {
     let scene = Arc::new(GpuScene::new(ctx, &species, &forest)?);
     let shapes: Vec<TreeShape> = species
         .iter()
-        .map(|s| TreeShape::of(&s.atlas.manifest))
+        .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
         .collect();
     let start = views::start(&forest, &Clearances::new(&forest, &shapes));
     Ok(Loaded {
