@@ -162,7 +162,12 @@ fn terrain(
         .iter()
         .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
         .collect();
+    // forest-format's glam is not Bevy's: the points cross as arrays.
     let (eye, target) = views::start(f, &Clearances::new(f, &shapes));
+    let (eye, target) = (
+        Vec3::from_array(eye.to_array()),
+        Vec3::from_array(target.to_array()),
+    );
     for mut t in &mut cams {
         *t = Transform::from_translation(eye).looking_at(target, Vec3::Y);
     }

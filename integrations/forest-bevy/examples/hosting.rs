@@ -84,7 +84,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let ground = forest.ground_height(0.0, 0.0);
     let views = [
-        ("inside", eye, target),
+        // forest-format's glam is not Bevy's: the points cross as arrays.
+        (
+            "inside",
+            Vec3::from_array(eye.to_array()),
+            Vec3::from_array(target.to_array()),
+        ),
         (
             "above",
             Vec3::new(-60.0, ground + 60.0, -60.0),
