@@ -10,7 +10,7 @@ use forest_baselines::geometry::{
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
-use forest_format::views::{self, Clearances, TreeShape};
+use forest_format::views;
 use forest_render::fragments::{FragmentCounter, FragmentCounts, FragmentSummary};
 use forest_render::gpu_types::WEIGHT_ONE;
 use forest_render::options::{AspectBlend, Atmosphere, RendererOptions, StreamOptions};
@@ -527,14 +527,10 @@ pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
     Ok((forest, species))
 }
 
-/// The named view `name` of a forest ([`forest_format::views::named`]: clear of every tree's
-/// bounding sphere, as its species' atlases record them).
+/// The named view `name` of a forest ([`forest_render::named_view`]: clear of every tree's
+/// trunk and crown).
 pub fn named_view(name: &str, forest: &Forest, species: &[SpeciesData]) -> Result<(Vec3, Vec3)> {
-    let shapes: Vec<TreeShape> = species
-        .iter()
-        .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
-        .collect();
-    forest_format::views::named(name, forest, &Clearances::new(forest, &shapes))
+    forest_render::named_view(name, forest, species)
         .ok_or_else(|| anyhow::anyhow!("no view named {name:?}: give one of {:?}", views::NAMES))
 }
 

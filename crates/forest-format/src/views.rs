@@ -14,7 +14,7 @@ use std::collections::HashMap;
 use glam::{Quat, Vec3};
 
 use crate::atlas::AtlasManifest;
-use crate::forest::Forest;
+use crate::forest::{Forest, Instance};
 use crate::opacity::OpacityVolume;
 
 /// Eye height above the ground of the views that stand on it (metres).
@@ -146,47 +146,26 @@ impl TreeShape {
     }
 }
 
-/// One tree placed in the world: its species' shape, where it stands, its turn and scale.
+/// One tree of the forest with a world sphere holding its whole shape.
 #[derive(Clone, Copy)]
 struct Placed {
-    species: u32,
-    position: Vec3,
-    rotation: f32,
-    scale: f32,
-    /// Centre and radius of a world sphere holding the whole shape.
+    /// Its index in the forest's instances.
+    index: u32,
     center: Vec3,
     bound: f32,
 }
 
-impl Placed {
-    fn of(forest: &Forest, shapes: &[TreeShape], bounds: &[f32], i: usize) -> Option<Self> {
-        let t = &forest.instances[i];
-        let s = shapes.get(t.species as usize)?;
-        let position = Vec3::from_array(t.position);
-        let center = position + Quat::from_rotation_y(t.rotation) * (s.center * t.scale);
-        let p = Self {
-            species: t.species,
-            position,
-            rotation: t.rotation,
-            scale: t.scale,
-            center,
-            bound: bounds[t.species as usize] * t.scale,
-        };
-        (center.is_finite() && p.bound.is_finite() && t.scale > 0.0).then_some(p)
-    }
-
-    /// Distance (metres) from world point `p` to this tree's shape.
-    fn distance(&self, shapes: &[TreeShape], p: Vec3) -> f32 {
-        let q = Quat::from_rotation_y(-self.rotation) * (p - self.position) / self.scale;
-        shapes[self.species as usize].distance(q) * self.scale
-    }
+/// Distance (metres) from world point `p` to the shape of tree `t`, of species shape `s`.
+fn tree_distance(s: &TreeShape, t: &Instance, p: Vec3) -> f32 {
+    let q = Quat::from_rotation_y(-t.rotation) * (p - Vec3::from_array(t.position));
+    s.distance(q / t.scale) * t.scale
 }
 
 /// The trees' shapes, bucketed on a square grid by the spheres holding them, for distance
 /// queries.
 pub struct Clearances<'a> {
     forest: &'a Forest,
-    shapes: Vec<TreeShape>,
+    shapes: &'a [TreeShape],
     trees: Vec<Placed>,
     /// Grid cell side (metres): the largest holding sphere's radius plus [`CLEARANCE`].
     cell: f32,
@@ -196,10 +175,20 @@ pub struct Clearances<'a> {
 impl<'a> Clearances<'a> {
     /// The trees of `forest`, each species shaped by `shapes` (in the forest's species order;
     /// a tree whose species has no shape, or whose sphere is not finite, is left out).
-    pub fn new(forest: &'a Forest, shapes: &[TreeShape]) -> Self {
+    pub fn new(forest: &'a Forest, shapes: &'a [TreeShape]) -> Self {
         let bounds: Vec<f32> = shapes.iter().map(TreeShape::bound).collect();
-        let trees: Vec<Placed> = (0..forest.instances.len())
-            .filter_map(|i| Placed::of(forest, shapes, &bounds, i))
+        let trees: Vec<Placed> = (forest.instances.iter().enumerate())
+            .filter_map(|(i, t)| {
+                let s = shapes.get(t.species as usize)?;
+                let center = Vec3::from_array(t.position)
+                    + Quat::from_rotation_y(t.rotation) * (s.center * t.scale);
+                let bound = bounds[t.species as usize] * t.scale;
+                (center.is_finite() && bound.is_finite() && t.scale > 0.0).then_some(Placed {
+                    index: i as u32,
+                    center,
+                    bound,
+                })
+            })
             .collect();
         let cell = trees.iter().map(|t| t.bound).fold(0.0f32, f32::max) + CLEARANCE;
         let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
@@ -211,7 +200,7 @@ impl<'a> Clearances<'a> {
         }
         Self {
             forest,
-            shapes: shapes.to_vec(),
+            shapes,
             trees,
             cell,
             cells,
@@ -237,7 +226,8 @@ impl<'a> Clearances<'a> {
                     d = d.min(if far >= CLEARANCE {
                         far
                     } else {
-                        t.distance(&self.shapes, p)
+                        let tree = &self.forest.instances[t.index as usize];
+                        tree_distance(&self.shapes[tree.species as usize], tree, p)
                     });
                 }
             }
@@ -505,10 +495,7 @@ mod tests {
     fn nearest_to(f: &Forest, shapes: &[TreeShape], p: Vec3) -> f32 {
         f.instances
             .iter()
-            .map(|t| {
-                let q = Quat::from_rotation_y(-t.rotation) * (p - Vec3::from_array(t.position));
-                shapes[t.species as usize].distance(q / t.scale) * t.scale
-            })
+            .map(|t| tree_distance(&shapes[t.species as usize], t, p))
             .fold(f32::INFINITY, f32::min)
     }
 

@@ -70,6 +70,6 @@ pub use camera::Camera;
 pub use context::{ColourFormat, GpuContext, RenderError};
 pub use frame::{FrameParams, Targets};
 pub use options::{Background, DebugView, RendererOptions, StreamOptions};
-pub use scene::{GpuScene, SpeciesData};
+pub use scene::{GpuScene, SpeciesData, named_view, start_view};
 pub use stats::FrameStats;
 pub use stream::QuadStream;

@@ -2,7 +2,7 @@
 //! camera, a PBR sphere among the trees and a method switch. The forest is drawn by the
 //! hybrid (`ForestCamera::default()`), and the camera starts where the viewer and `forest
 //! render --view inside` start: standing on the ground, clear of every tree
-//! (`forest_format::views::start`).
+//! (`forest_render::start_view`).
 //!
 //! ```sh
 //! bash scripts/demo.sh   # once, from the repository root: bakes and writes out/forest-100k.forest
@@ -23,7 +23,6 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_dis
 use forest_bevy::{
     ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats, terrain_mesh,
 };
-use forest_format::views::{self, Clearances, TreeShape};
 
 /// The sun's azimuth and elevation, degrees.
 #[derive(Resource)]
@@ -157,13 +156,8 @@ fn terrain(
         return;
     };
     let f = &forest.forest;
-    let shapes: Vec<TreeShape> = forest
-        .species
-        .iter()
-        .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
-        .collect();
     // forest-format's glam is not Bevy's: the points cross as arrays.
-    let (eye, target) = views::start(f, &Clearances::new(f, &shapes));
+    let (eye, target) = forest_render::start_view(f, &forest.species);
     let (eye, target) = (
         Vec3::from_array(eye.to_array()),
         Vec3::from_array(target.to_array()),

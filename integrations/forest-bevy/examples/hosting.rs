@@ -74,14 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| forest_render::SpeciesData::load(&folder.join(s)))
         .collect::<Result<Vec<_>, _>>()?;
     // The viewer's opening view (clear of every tree), and one from 60 m above.
-    let shapes: Vec<_> = species
-        .iter()
-        .map(|s| forest_format::views::TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
-        .collect();
-    let (eye, target) = forest_format::views::start(
-        &forest,
-        &forest_format::views::Clearances::new(&forest, &shapes),
-    );
+    let (eye, target) = forest_render::start_view(&forest, &species);
     let ground = forest.ground_height(0.0, 0.0);
     let views = [
         // forest-format's glam is not Bevy's: the points cross as arrays.

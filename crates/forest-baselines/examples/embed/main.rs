@@ -19,7 +19,6 @@ use std::sync::Arc;
 use forest_baselines::{GeometrySpecies, PreparedGeometry};
 use forest_format::forest::Forest;
 use forest_format::model::PreparedModel;
-use forest_format::views::{self, Clearances, TreeShape};
 use forest_render::target::Target;
 use forest_render::{GpuContext, GpuScene, SpeciesData};
 use glam::Vec3;
@@ -65,11 +64,7 @@ fn load(ctx: &GpuContext, path: &Path) -> Result<Loaded, Error> {
     }
     let models = (models.len() == species.len()).then(|| PreparedGeometry::new(&models));
     let scene = Arc::new(GpuScene::new(ctx, &species, &forest)?);
-    let shapes: Vec<TreeShape> = species
-        .iter()
-        .map(|s| TreeShape::with_volume(&s.atlas.manifest, &s.opacity))
-        .collect();
-    let start = views::start(&forest, &Clearances::new(&forest, &shapes));
+    let start = forest_render::start_view(&forest, &species);
     Ok(Loaded {
         forest,
         scene,
