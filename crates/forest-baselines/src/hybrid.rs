@@ -63,7 +63,7 @@ pub struct Hybrid {
 
 /// Default [`Hybrid::sharpen`]: 20 % of a weight of one, against the stream's 10 %
 /// ([`forest_render::options::SHARPEN_DEFAULT`]). Chosen by the measurements under "The
-/// hybrid's aspect sharpening" in docs/rendering.md.
+/// hybrid's aspect sharpening" in docs/overdraw.md.
 pub const HYBRID_SHARPEN_DEFAULT: u32 = 819;
 
 impl Default for Hybrid {

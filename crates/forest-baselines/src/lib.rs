@@ -16,7 +16,7 @@
 //! ```no_run
 //! use forest_baselines::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
 //! use forest_format::forest::Forest;
-//! use forest_render::{Camera, GpuContext, RendererOptions, SpeciesData};
+//! use forest_render::{Camera, ForestView, GpuContext, RendererOptions, SpeciesData};
 //!
 //! let ctx = GpuContext::headless()?;
 //! let forest = Forest::load("f.forest".as_ref())?;

@@ -7,9 +7,12 @@
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::forms::{FORMS_GEOMETRY, FORMS_QUADS};
+use forest_render::options::Background;
 use forest_render::stats::PassTimes;
 use forest_render::stream::QuadStream;
 use forest_render::target::Target;
+use forest_render::view::HostMaps;
+use forest_render::{ForestView, Form};
 
 use forest_render::stats::FrameStats;
 
@@ -56,7 +59,7 @@ impl Method {
     /// Whether the method's quads run the opaque pass in place of the stream's own choice
     /// ([`QuadStream::set_opaque_override`]): off for the hybrid, whose quads are the trees
     /// beyond its switch, where the pass shaded more fragments than it saved (see "The opaque
-    /// pass" in docs/rendering.md); None for every other method.
+    /// pass" in docs/overdraw.md); None for every other method.
     pub fn quad_opaque_first(&self) -> Option<bool> {
         match self {
             Method::Hybrid(_) => Some(false),
@@ -141,37 +144,6 @@ impl ForestRenderer {
         self.method
     }
 
-    /// Draw over `background` from the next frame on, every method: the sky and ground, or
-    /// transparent black (whose alpha is the trees' coverage).
-    pub fn set_background(&mut self, background: forest_render::options::Background) {
-        self.stream.set_background(background);
-        if let Some(g) = &mut self.geometry {
-            g.set_background(background);
-        }
-    }
-
-    /// Gather pipeline statistics in every method's frames from the next frame on (off by
-    /// default; see `QuadStream::set_pipeline_statistics`).
-    pub fn set_pipeline_statistics(&mut self, on: bool) {
-        self.stream.set_pipeline_statistics(on);
-        if let Some(g) = &mut self.geometry {
-            g.set_pipeline_statistics(on);
-        }
-    }
-
-    /// Count every method's tree fragments into `counter` from the next frame on, or stop
-    /// counting (`None`); see `forest_render::fragments`.
-    pub fn set_fragment_counter(
-        &mut self,
-        device: &wgpu::Device,
-        counter: Option<&forest_render::fragments::FragmentCounter>,
-    ) {
-        self.stream.set_fragment_counter(device, counter);
-        if let Some(g) = &mut self.geometry {
-            g.set_fragment_counter(device, counter);
-        }
-    }
-
     /// The exact fragment counts of the current method's frame from `camera` into `target`
     /// (drawn twice: see `FragmentCounter::count_frame`). Counting is on only for these two
     /// frames.
@@ -191,7 +163,7 @@ impl ForestRenderer {
             ctx,
             &counter,
             self,
-            Self::set_fragment_counter,
+            |r: &mut Self, d, c| ForestView::set_fragment_counter(r, d, c),
             |r| Ok(r.render_frame(ctx, camera, target)?),
         )
     }
@@ -199,24 +171,6 @@ impl ForestRenderer {
     /// Whether frames gather pipeline statistics.
     pub fn pipeline_statistics(&self) -> bool {
         self.stream.pipeline_statistics()
-    }
-
-    /// The background every method draws over.
-    pub fn background(&self) -> forest_render::options::Background {
-        self.stream.options_built().background
-    }
-
-    /// Light every method's next frames with `light` (the quad stream's and the geometry
-    /// renderer's, so that the hybrid's two forms agree); the error names a bad value.
-    pub fn set_light(
-        &mut self,
-        light: forest_format::shading::Lighting,
-    ) -> Result<(), RenderError> {
-        self.stream.set_light(light)?;
-        if let Some(g) = &mut self.geometry {
-            g.set_light(light)?;
-        }
-        Ok(())
     }
 
     /// Cast and receive the sun's shadows with `opts` from the next frame on, or not
@@ -272,10 +226,7 @@ impl ForestRenderer {
                 self.stream.set_refine(true);
             }
         }
-        self.stream.set_forms(FORMS_QUADS);
-        if let Some(g) = &mut self.geometry {
-            g.set_forms(FORMS_GEOMETRY);
-        }
+        self.set_forms(FORMS_QUADS, FORMS_GEOMETRY);
         if shadows_for(method, self.shadows) != shadows_for(self.method, self.shadows) {
             self.apply_shadows(&ctx.device, method, self.shadows)?;
         }
@@ -287,121 +238,50 @@ impl ForestRenderer {
         Ok(())
     }
 
-    /// Write the camera and record one frame of the current method.
-    pub fn encode(
+    /// Which trees each form draws from the next frame on: `quads` for the stream, `geometry`
+    /// for the geometry renderer ([`forest_render::forms`]).
+    fn set_forms(&mut self, quads: [f32; 4], geometry: [f32; 4]) {
+        self.stream.inputs_mut().set_forms(quads);
+        if let Some(g) = &mut self.geometry {
+            g.inputs_mut().set_forms(geometry);
+        }
+    }
+
+    /// Every form, drawn by the current method or not (for state every form keeps).
+    fn forms_mut(&mut self) -> impl Iterator<Item = &mut dyn ForestView> {
+        std::iter::once(&mut self.stream as &mut dyn ForestView)
+            .chain(self.geometry.as_mut().map(|g| g as &mut dyn ForestView))
+    }
+
+    /// The forms the current method draws: the geometry (drawn first, opaque, depth
+    /// written) and the quads (then, back to front, depth-tested against it).
+    fn drawn(&self) -> (Option<&GeometryRenderer>, Option<&QuadStream>) {
+        match (self.method, &self.geometry) {
+            (Method::Mesh(_), Some(g)) => (Some(g), None),
+            (Method::Hybrid(_), Some(g)) => (Some(g), Some(&self.stream)),
+            _ => (None, Some(&self.stream)),
+        }
+    }
+
+    /// Write each form's camera for the current method with `write`; the hybrid's per-tree
+    /// forms first, from `forms`.
+    fn write_drawn<E>(
         &mut self,
-        ctx: &GpuContext,
-        camera: &Camera,
-        encoder: &mut wgpu::CommandEncoder,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-    ) -> Result<(), CameraError> {
-        match (self.method, &mut self.geometry) {
-            (Method::Mesh(_), Some(g)) => g.encode(ctx, camera, encoder, colour, depth),
-            (Method::Hybrid(h), Some(g)) => {
-                camera.validate()?;
-                let forms = h.forms(camera);
-                self.stream.set_forms(forms);
-                g.set_forms(forms);
-                self.stream.set_camera(ctx, camera)?;
-                g.set_camera(ctx, camera)?;
-                // Both forms cast into the stream's maps, each tree in the form it is drawn in.
-                self.stream.encode_shadows(encoder, true, Some(&*g));
-                self.stream.encode_view_compute(encoder);
-                g.encode_compute(encoder);
-                {
-                    let opts = self.stream.options_built();
-                    let targets = forest_render::Targets::cleared(
-                        colour,
-                        depth,
-                        opts.background.clear_colour(),
-                        opts.depth_clear(),
-                    );
-                    let mut pass =
-                        targets.begin(encoder, "hybrid draw", self.stream.draw_timestamps());
-                    // Opaque geometry first, depth written; then the quads back to front,
-                    // depth-tested against it.
-                    g.record_draw(&mut pass, true);
-                    self.stream.record_draw(&mut pass, false);
-                }
-                self.stream.resolve_times(encoder);
-                g.resolve_times(encoder, false);
-                Ok(())
-            }
-            _ => {
-                self.stream.set_camera(ctx, camera)?;
-                self.stream.encode(encoder, colour, depth);
-                Ok(())
-            }
+        forms: impl FnOnce(&crate::hybrid::Hybrid) -> [f32; 4],
+        mut write: impl FnMut(&mut dyn ForestView) -> Result<(), E>,
+    ) -> Result<(), E> {
+        if let Method::Hybrid(h) = self.method {
+            let f = forms(&h);
+            self.set_forms(f, f);
         }
-    }
-
-    /// A host's frame (the middleware's `prepare`): write the current method's cameras from
-    /// the host's matrices; the hybrid's per-tree forms follow the projection's focal length.
-    /// Then [`Self::encode_compute`] and [`Self::render`] into the host's pass.
-    pub fn prepare(
-        &mut self,
-        queue: &wgpu::Queue,
-        frame: &forest_render::FrameParams,
-    ) -> Result<(), RenderError> {
-        match (self.method, &mut self.geometry) {
-            (Method::Mesh(_), Some(g)) => g.prepare(queue, frame),
-            (Method::Hybrid(h), Some(g)) => {
-                let forms = h.forms_for_focal(frame.focal_pixels());
-                self.stream.set_forms(forms);
-                g.set_forms(forms);
-                self.stream.prepare(queue, frame)?;
-                g.prepare(queue, frame)
-            }
-            _ => self.stream.prepare(queue, frame),
+        let (g, q) = self.drawn();
+        let (g, q) = (g.is_some(), q.is_some());
+        if q {
+            write(&mut self.stream)?;
         }
-    }
-
-    /// The compute passes of a host's frame, after [`Self::prepare`]: the current method's
-    /// culls (and the quad stream's refinement).
-    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
-        match (self.method, &self.geometry) {
-            (Method::Mesh(_), Some(g)) => g.encode_compute(encoder),
-            (Method::Hybrid(_), Some(g)) => {
-                self.stream.encode_compute(encoder);
-                g.encode_compute(encoder);
-            }
-            _ => self.stream.encode_compute(encoder),
-        }
-    }
-
-    /// Draw into the host's render pass, after [`Self::encode_compute`]: the geometry first
-    /// (opaque and alpha-tested, depth written), then the quads back to front, depth-tested.
-    pub fn render(&self, pass: &mut wgpu::RenderPass) {
-        match (self.method, &self.geometry) {
-            (Method::Mesh(_), Some(g)) => g.record_draw(pass, false),
-            (Method::Hybrid(_), Some(g)) => {
-                g.record_draw(pass, false);
-                self.stream.render(pass);
-            }
-            _ => self.stream.render(pass),
-        }
-    }
-
-    /// Timestamp writes for the host's render pass that draws the forest: the quad stream's
-    /// draw time (`None` for the geometry methods, whose draw is not timed in a host's pass).
-    pub fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        match (self.method, &self.geometry) {
-            (Method::Mesh(_), Some(_)) => None,
-            _ => self.stream.draw_timestamps(),
-        }
-    }
-
-    /// Resolve a host's frame's pass times and counters (after the pass [`Self::render`]
-    /// recorded into).
-    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder) {
-        match (self.method, &self.geometry) {
-            (Method::Mesh(_), Some(g)) => g.resolve_times(encoder, false),
-            (Method::Hybrid(_), Some(g)) => {
-                self.stream.resolve_times(encoder);
-                g.resolve_times(encoder, false);
-            }
-            _ => self.stream.resolve_times(encoder),
+        match &mut self.geometry {
+            Some(geo) if g => write(geo),
+            _ => Ok(()),
         }
     }
 
@@ -415,59 +295,13 @@ impl ForestRenderer {
         self.stream.resize(device, viewport)
     }
 
-    /// Receive a host's sun shadows in both forms (see `QuadStream::receive_host_shadows`);
-    /// `None` stops.
-    pub fn receive_host_shadows(
-        &mut self,
-        device: &wgpu::Device,
-        maps: Option<(&wgpu::TextureView, u32, bool)>,
-    ) {
-        self.stream.receive_host_shadows(device, maps);
-        if let Some(g) = &mut self.geometry {
-            g.receive_host_shadows(device, maps);
-        }
-    }
-
-    /// The host's cascades for both forms' receivers (see `QuadStream::set_host_cascades`).
-    pub fn set_host_cascades(
-        &mut self,
-        cascades: &[forest_render::shadow::Cascade],
-    ) -> Result<(), RenderError> {
-        self.stream.set_host_cascades(cascades)?;
-        if let Some(g) = &mut self.geometry {
-            g.set_host_cascades(cascades)?;
-        }
-        Ok(())
-    }
-
     /// Camera writes of both forms since they were created: (count, bytes). A hybrid frame
     /// writes the camera once for each form and nothing else.
     pub fn uploads(&self) -> (u64, u64) {
-        let (n, b) = self.stream.uploads();
-        let (gn, gb) = self.geometry.as_ref().map_or((0, 0), |g| g.uploads());
-        (n + gn, b + gb)
+        ForestView::uploads(self)
     }
 
-    /// Write the camera, record the frame into `target`, and submit.
-    pub fn render_frame(
-        &mut self,
-        ctx: &GpuContext,
-        camera: &Camera,
-        target: &Target,
-    ) -> Result<(), CameraError> {
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        self.encode(
-            ctx,
-            camera,
-            &mut enc,
-            &target.colour_view,
-            &target.depth_view,
-        )?;
-        ctx.queue.submit([enc.finish()]);
-        Ok(())
-    }
-
-    /// [`Self::render_frame`], drawn again while the frame overflows the quad stream and
+    /// [`ForestView::render_frame`], drawn again while the frame overflows the quad stream and
     /// [`Self::fit`] can grow it; the last frame's counters (waits for the GPU).
     pub fn render_fitted(
         &mut self,
@@ -577,5 +411,129 @@ impl ForestRenderer {
                 }
             }
         }
+    }
+}
+
+/// Every method through one frame API: state every form keeps goes to both forms, a frame to
+/// the forms the method draws. The hybrid's stream casts both forms into the shared shadow
+/// maps, each tree in the form it is drawn in.
+impl ForestView for ForestRenderer {
+    fn set_background(&mut self, background: Background) {
+        self.forms_mut().for_each(|f| f.set_background(background));
+    }
+
+    fn background(&self) -> Background {
+        self.stream.background()
+    }
+
+    /// Both forms' light, so that the hybrid's two forms agree.
+    fn set_light(&mut self, light: forest_format::shading::Lighting) -> Result<(), RenderError> {
+        self.forms_mut().try_for_each(|f| f.set_light(light))
+    }
+
+    fn light(&self) -> forest_format::shading::Lighting {
+        self.stream.light()
+    }
+
+    fn set_pipeline_statistics(&mut self, on: bool) {
+        self.forms_mut().for_each(|f| f.set_pipeline_statistics(on));
+    }
+
+    fn set_fragment_counter(
+        &mut self,
+        device: &wgpu::Device,
+        counter: Option<&forest_render::fragments::FragmentCounter>,
+    ) {
+        self.forms_mut()
+            .for_each(|f| f.set_fragment_counter(device, counter));
+    }
+
+    fn receive_host_shadows(&mut self, device: &wgpu::Device, maps: Option<HostMaps<'_>>) {
+        self.forms_mut()
+            .for_each(|f| f.receive_host_shadows(device, maps));
+    }
+
+    fn set_host_cascades(
+        &mut self,
+        cascades: &[forest_render::shadow::Cascade],
+    ) -> Result<(), RenderError> {
+        self.forms_mut()
+            .try_for_each(|f| f.set_host_cascades(cascades))
+    }
+
+    /// The current method's cameras from the host's matrices; the hybrid's per-tree forms
+    /// follow the projection's focal length.
+    fn prepare(
+        &mut self,
+        queue: &wgpu::Queue,
+        frame: &forest_render::FrameParams,
+    ) -> Result<(), RenderError> {
+        frame.validate()?;
+        let focal = frame.focal_pixels();
+        self.write_drawn(|h| h.forms_for_focal(focal), |f| f.prepare(queue, frame))
+    }
+
+    fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
+        camera.validate()?;
+        self.write_drawn(|h| h.forms(camera), |f| f.set_camera(ctx, camera))
+    }
+
+    /// The shadow maps (the forms the method draws cast into them), then each form's cull
+    /// (and the quad stream's refinement).
+    fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        match self.drawn() {
+            (Some(g), Some(q)) => {
+                q.encode_shadows(encoder, true, Some(g));
+                q.encode_view_compute(encoder);
+                g.encode_view_compute(encoder);
+            }
+            (Some(g), None) => Form::encode_compute(g, encoder),
+            (None, Some(q)) => Form::encode_compute(q, encoder),
+            (None, None) => {}
+        }
+    }
+
+    /// The geometry first (opaque and alpha-tested, depth written; the ground when `ground`),
+    /// then the quads back to front, depth-tested.
+    fn record(&self, pass: &mut wgpu::RenderPass, ground: bool) {
+        match self.drawn() {
+            (Some(g), quads) => {
+                g.record_draw(pass, ground);
+                if let Some(q) = quads {
+                    q.record_draw(pass, false);
+                }
+            }
+            (None, Some(q)) => q.record_draw(pass, ground),
+            (None, None) => {}
+        }
+    }
+
+    fn depth_clear(&self) -> f32 {
+        self.stream.depth_clear()
+    }
+
+    /// The quad stream's draw time when the method draws quads, else the geometry's.
+    fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        match self.drawn() {
+            (_, Some(q)) => Form::draw_timestamps(q),
+            (Some(g), None) => Form::draw_timestamps(g),
+            (None, None) => None,
+        }
+    }
+
+    fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder) {
+        let (g, q) = self.drawn();
+        if let Some(q) = q {
+            q.resolve_queries(encoder, true);
+        }
+        if let Some(g) = g {
+            g.resolve_queries(encoder, q.is_none());
+        }
+    }
+
+    fn uploads(&self) -> (u64, u64) {
+        let (n, b) = self.stream.uploads();
+        let (gn, gb) = self.geometry.as_ref().map_or((0, 0), |g| g.uploads());
+        (n + gn, b + gb)
     }
 }

@@ -1,5 +1,6 @@
 //! `forest render`: headless rendering of camera views of a forest to PNG.
 
+use forest_render::ForestView;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};

@@ -7,6 +7,7 @@
 mod common;
 
 use forest_format::shading::{srgb_decode_table, srgb_encode};
+use forest_render::ForestView;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::target::Target;
 use forest_render::{GpuScene, QuadStream};

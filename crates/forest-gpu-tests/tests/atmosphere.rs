@@ -11,6 +11,7 @@ use forest_baselines::geometry::{GeometryRenderer, MeshMethod};
 use forest_format::forest::Forest;
 use forest_format::shading::srgb_decode_table;
 use forest_format::terrain::Terrain;
+use forest_render::ForestView;
 use forest_render::options::{
     Atmosphere, Background, KOSCHMIEDER, RendererOptions, SUN_DISC_DEGREES, ground_albedo,
 };

@@ -5,6 +5,7 @@
 mod common;
 
 use forest_format::shading::srgb_decode_table;
+use forest_render::ForestView;
 use forest_render::options::{
     Background, DebugView, LEVEL_COLOURS, RendererOptions, direction_colour,
 };

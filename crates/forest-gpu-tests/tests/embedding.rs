@@ -5,6 +5,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use std::sync::Arc;
 
 use forest_baselines::{ForestRenderer, GeometryRenderer};
@@ -160,7 +161,7 @@ fn drawing_over_a_host_frame_keeps_its_pixels_where_no_tree_is() {
 fn a_frame_before_the_first_prepare_draws_nothing() {
     let ctx = common::ctx();
     let stream = QuadStream::new(&ctx.device, scene(&ctx), &opts(Background::Transparent)).unwrap();
-    assert!(!stream.is_prepared());
+    assert!(!forest_render::Form::inputs(&stream).is_prepared());
     let target = Target::new(&ctx, SIZE.0, SIZE.1);
     host_clear(&ctx, &target, MAGENTA);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
@@ -243,7 +244,7 @@ fn reverse_z_and_msaa_targets_of_the_host() {
     s.encode_compute(&mut enc);
     {
         let mut pass = targets.begin(&mut enc, "host msaa", None);
-        s.record_draw(&mut pass, true);
+        forest_render::Form::record_draw(&s, &mut pass, true);
     }
     ctx.queue.submit([enc.finish()]);
     let img = resolved.read(&ctx);
@@ -354,7 +355,7 @@ fn the_geometry_renderer_draws_into_reverse_z_msaa_targets() {
             ..Targets::cleared(&msaa, &depth, forest_render::options::SKY, 0.0)
         };
         let mut pass = targets.begin(&mut enc, "host msaa", None);
-        geo.record_draw(&mut pass, true);
+        forest_render::Form::record_draw(&geo, &mut pass, true);
     }
     ctx.queue.submit([enc.finish()]);
     let img = resolved.read(&ctx);

@@ -6,6 +6,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use std::sync::OnceLock;
 
 use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeometry, downsample};

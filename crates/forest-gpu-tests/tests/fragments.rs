@@ -9,6 +9,7 @@ mod common;
 use forest_baselines::geometry::{GeometryRenderer, Lods, MeshMethod, Stochastic};
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
+use forest_render::ForestView;
 use forest_render::fragments::{FragmentCounter, FragmentCounts, PixelCounts};
 use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};

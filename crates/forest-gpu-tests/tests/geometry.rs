@@ -3,6 +3,7 @@
 mod common;
 
 use forest_baselines::geometry::{GeometryRenderer, downsample};
+use forest_render::ForestView;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{GpuScene, QuadStream};

@@ -11,6 +11,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 

@@ -2,6 +2,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use std::path::PathBuf;
 
 use forest_render::options::RendererOptions;
@@ -98,7 +99,7 @@ fn a_frame_writes_only_the_camera() {
             3,
             3 * std::mem::size_of::<forest_render::gpu_types::GpuCamera>() as u64
         ),
-        "one 288-byte camera write (the camera and its light) per frame"
+        "one camera write (the camera uniform, its light included) per frame"
     );
     assert_ne!(
         streams[0], streams[1],

@@ -2,6 +2,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use forest_render::options::RendererOptions;
 use forest_render::reference;
 use forest_render::scene::SpeciesData;

@@ -5,6 +5,7 @@ mod common;
 
 use forest_baselines::geometry::{GeometryRenderer, downsample};
 use forest_format::shading::Lighting;
+use forest_render::ForestView;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuScene, QuadStream};
@@ -151,7 +152,7 @@ fn a_low_sun_matches_the_reference_and_baked_light_does_not() {
         let target = Target::new(&ctx, SIZE, SIZE);
         stream.prepare(&ctx.queue, &frame).unwrap();
         let mut enc = ctx.device.create_command_encoder(&Default::default());
-        stream.encode(&mut enc, &target.colour_view, &target.depth_view);
+        stream.encode_frame(&mut enc, &target.colour_view, &target.depth_view);
         ctx.queue.submit([enc.finish()]);
         target.read(&ctx)
     };

@@ -7,6 +7,7 @@ mod common;
 use forest_bake::lod::BANDS;
 use forest_baselines::geometry::{GeometryRenderer, Lods, MeshMethod, Stochastic};
 use forest_format::forest::Forest;
+use forest_render::ForestView;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};

@@ -3,6 +3,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::shadow::{ShadowOptions, cameras};
 use forest_render::{GpuScene, QuadStream, reference};

@@ -3,6 +3,7 @@
 
 mod common;
 
+use forest_render::ForestView;
 use forest_render::options::{AspectBlend, Background, RendererOptions};
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::work::{self, StatisticsQueries};

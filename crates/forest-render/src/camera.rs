@@ -1,8 +1,6 @@
 //! A perspective camera and its GPU form (the only per-frame upload).
 
-#[cfg(test)]
-use glam::Vec4;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
 use crate::gpu_types::GpuCamera;
 
@@ -29,10 +27,7 @@ pub struct Camera {
 /// [`forest_format::forest::MAX_COORDINATE`].
 pub const MAX_CAMERA_COORDINATE: f32 = 10.0 * forest_format::forest::MAX_COORDINATE;
 
-/// Why a camera cannot be used.
-#[derive(Debug, thiserror::Error, PartialEq)]
-#[error("invalid camera: {0}")]
-pub struct CameraError(pub String);
+pub use crate::error::CameraError;
 
 impl Camera {
     /// Check every field; the error names the bad one.
@@ -112,7 +107,7 @@ impl Camera {
     /// The GPU form: matrix, eye and ε, forward, viewport, normalised frustum planes; every
     /// tree drawn as quads (renderers set `forms` for the method they draw).
     pub fn to_gpu(&self) -> GpuCamera {
-        crate::frame::gpu_camera(
+        gpu_camera(
             self.view_proj(),
             self.eye,
             self.forward(),
@@ -144,6 +139,67 @@ pub fn upload_all(
     queue.write_buffer(buffer, 0, bytemuck::cast_slice(cameras));
     writes.0 += 1;
     writes.1 += std::mem::size_of_val(cameras) as u64;
+}
+
+/// The camera uniform from its parts: matrix, eye and ε, forward, viewport, frustum planes,
+/// with the default stream options (what a stream writes unless given others).
+pub(crate) fn gpu_camera(
+    m: Mat4,
+    eye: Vec3,
+    forward: Vec3,
+    viewport: (u32, u32),
+    epsilon: f32,
+) -> GpuCamera {
+    let mut g = GpuCamera {
+        view_proj: m.to_cols_array_2d(),
+        eye: eye.extend(epsilon).to_array(),
+        form_eye: eye.extend(0.0).to_array(),
+        forward: forward.extend(0.0).to_array(),
+        viewport: [viewport.0 as f32, viewport.1 as f32, 0.0, 0.0],
+        planes: frustum_planes(m),
+        forms: crate::forms::FORMS_QUADS,
+        ..Default::default()
+    };
+    crate::options::StreamOptions::default().apply(&mut g);
+    g
+}
+
+/// The six frustum planes of a clip matrix (`xyz · p + w ≥ 0` inside, unit normals, metres):
+/// left, right, bottom, top, and the two depth planes `z ≥ 0`, `z ≤ w`, whichever is near.
+/// A plane at infinity (the far plane of an infinite projection) has no normal and becomes
+/// `(0, 0, 0, 1)`: everything is inside it.
+pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
+    let rows = [m.row(0), m.row(1), m.row(2), m.row(3)];
+    [
+        rows[3] + rows[0],
+        rows[3] - rows[0],
+        rows[3] + rows[1],
+        rows[3] - rows[1],
+        rows[2],
+        rows[3] - rows[2],
+    ]
+    .map(|p: Vec4| {
+        let n = p.truncate().length();
+        if n > 1e-12 * p.w.abs().max(1.0) {
+            (p / n).to_array()
+        } else {
+            [0.0, 0.0, 0.0, 1.0]
+        }
+    })
+}
+
+/// The camera uniform a stream holds before its first [`FrameParams`]: every plane rejects
+/// everything, so a frame encoded before the first `prepare` draws nothing.
+pub(crate) fn nothing_visible() -> GpuCamera {
+    GpuCamera {
+        view_proj: Mat4::IDENTITY.to_cols_array_2d(),
+        eye: [0.0, 0.0, 0.0, 1.0],
+        forward: [0.0, 0.0, -1.0, 0.0],
+        viewport: [1.0, 1.0, 0.0, 0.0],
+        planes: [[0.0, 0.0, 0.0, -3.0e38]; 6],
+        forms: crate::forms::FORMS_QUADS,
+        ..Default::default()
+    }
 }
 
 #[cfg(test)]

@@ -78,7 +78,7 @@ pub enum RenderError {
     },
     /// The camera or frame parameters are invalid.
     #[error(transparent)]
-    Camera(#[from] crate::camera::CameraError),
+    Camera(#[from] CameraError),
     /// The device reported validation or out-of-memory errors.
     #[error("the GPU reported: {}", .0.join("; "))]
     Gpu(Vec<String>),
@@ -137,3 +137,8 @@ mod tests {
         assert_eq!(storage_limit(&limits), 50);
     }
 }
+
+/// Why a camera cannot be used.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("invalid camera: {0}")]
+pub struct CameraError(pub String);

@@ -3,7 +3,8 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::camera::{Camera, CameraError};
+pub use crate::camera::frustum_planes;
+use crate::camera::{Camera, CameraError, gpu_camera};
 use crate::gpu_types::GpuCamera;
 
 /// One view of one frame, in the host's own matrices.
@@ -103,67 +104,6 @@ impl FrameParams {
         );
         g.set_light(&self.light);
         g
-    }
-}
-
-/// The camera uniform from its parts: matrix, eye and ε, forward, viewport, frustum planes,
-/// with the default stream options (what a stream writes unless given others).
-pub(crate) fn gpu_camera(
-    m: Mat4,
-    eye: Vec3,
-    forward: Vec3,
-    viewport: (u32, u32),
-    epsilon: f32,
-) -> GpuCamera {
-    let mut g = GpuCamera {
-        view_proj: m.to_cols_array_2d(),
-        eye: eye.extend(epsilon).to_array(),
-        form_eye: eye.extend(0.0).to_array(),
-        forward: forward.extend(0.0).to_array(),
-        viewport: [viewport.0 as f32, viewport.1 as f32, 0.0, 0.0],
-        planes: frustum_planes(m),
-        forms: crate::forms::FORMS_QUADS,
-        ..Default::default()
-    };
-    crate::options::StreamOptions::default().apply(&mut g);
-    g
-}
-
-/// The six frustum planes of a clip matrix (`xyz · p + w ≥ 0` inside, unit normals, metres):
-/// left, right, bottom, top, and the two depth planes `z ≥ 0`, `z ≤ w`, whichever is near.
-/// A plane at infinity (the far plane of an infinite projection) has no normal and becomes
-/// `(0, 0, 0, 1)`: everything is inside it.
-pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
-    let rows = [m.row(0), m.row(1), m.row(2), m.row(3)];
-    [
-        rows[3] + rows[0],
-        rows[3] - rows[0],
-        rows[3] + rows[1],
-        rows[3] - rows[1],
-        rows[2],
-        rows[3] - rows[2],
-    ]
-    .map(|p: Vec4| {
-        let n = p.truncate().length();
-        if n > 1e-12 * p.w.abs().max(1.0) {
-            (p / n).to_array()
-        } else {
-            [0.0, 0.0, 0.0, 1.0]
-        }
-    })
-}
-
-/// The camera uniform a stream holds before its first [`FrameParams`]: every plane rejects
-/// everything, so a frame encoded before the first `prepare` draws nothing.
-pub(crate) fn nothing_visible() -> GpuCamera {
-    GpuCamera {
-        view_proj: Mat4::IDENTITY.to_cols_array_2d(),
-        eye: [0.0, 0.0, 0.0, 1.0],
-        forward: [0.0, 0.0, -1.0, 0.0],
-        viewport: [1.0, 1.0, 0.0, 0.0],
-        planes: [[0.0, 0.0, 0.0, -3.0e38]; 6],
-        forms: crate::forms::FORMS_QUADS,
-        ..Default::default()
     }
 }
 
@@ -308,7 +248,7 @@ mod tests {
 
     #[test]
     fn nothing_is_visible_before_the_first_frame() {
-        let g = nothing_visible();
+        let g = crate::camera::nothing_visible();
         for p in [Vec3::ZERO, Vec3::splat(1e6), Vec3::splat(-1e6)] {
             assert!(
                 g.planes

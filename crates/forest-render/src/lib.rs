@@ -45,6 +45,7 @@
 
 #![deny(missing_docs)]
 
+pub mod bindings;
 pub mod camera;
 pub mod capacity;
 pub mod context;
@@ -56,14 +57,17 @@ pub mod gpu_types;
 pub mod opacity;
 pub mod options;
 pub mod passes;
+pub mod receivers;
 pub mod reference;
 pub mod scene;
+pub mod shaders;
 pub mod shadow;
 pub mod shadow_maps;
 pub mod stats;
 pub mod stream;
 pub mod target;
 pub mod terrain;
+pub mod view;
 pub mod work;
 
 pub use camera::Camera;
@@ -73,3 +77,4 @@ pub use options::{Background, DebugView, RendererOptions, StreamOptions};
 pub use scene::{GpuScene, SpeciesData, named_view, start_view};
 pub use stats::FrameStats;
 pub use stream::QuadStream;
+pub use view::{ForestView, Form, FrameInputs};

@@ -98,7 +98,7 @@ mod tests {
     /// The WGSL march's constants are the CPU mirror's.
     #[test]
     fn the_shader_marches_as_the_format_says() {
-        let src = crate::passes::COMMON_WGSL;
+        let src = crate::shaders::COMMON_WGSL;
         for line in [
             format!("const OPACITY_RES: f32 = {:.1};", VOLUME_RESOLUTION as f32),
             format!("const OPACITY_STEPS: u32 = {MARCH_STEPS}u;"),

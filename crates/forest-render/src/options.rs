@@ -4,7 +4,7 @@
 
 use forest_format::shading::Lighting;
 
-use crate::gpu_types::{GpuEnvironment, WEIGHT_ONE};
+use crate::gpu_types::WEIGHT_ONE;
 
 /// What the trees are drawn over.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -207,7 +207,7 @@ pub struct StreamOptions {
     /// S pixels wide with S < far_span · ε and S · sin θ < ε (θ from the view to its nearest
     /// aspect) is drawn as one aspect, its slabs composited, unrefined. Default
     /// [`FAR_SPAN_DEFAULT`], chosen by the measurements under "The far span and aspect
-    /// sharpening" in docs/rendering.md. 1 is the stream before this option: only trees
+    /// sharpening" in docs/overdraw.md. 1 is the stream before this option: only trees
     /// narrower than ε are far.
     pub far_span: u32,
     /// Draw such a tree's slabs as one quad, composited in the fragment shader on the plane
@@ -219,7 +219,7 @@ pub struct StreamOptions {
     /// 0) and the rest are scaled back to a sum of one, so an aspect of small weight fades out
     /// continuously (no pop) instead of adding a faint layer of quads. Default
     /// [`SHARPEN_DEFAULT`] (10 %), chosen by the measurements under "The far span and aspect
-    /// sharpening" in docs/rendering.md. 0 is the paper's barycentric blend. The hybrid
+    /// sharpening" in docs/overdraw.md. 0 is the paper's barycentric blend. The hybrid
     /// draws its quads with its own (`QuadStream::set_sharpen_override`).
     pub sharpen: u32,
     /// How far beyond the far span the sharpening grows, in units of the far span (1 to
@@ -229,7 +229,7 @@ pub struct StreamOptions {
     /// far and keeps its nearest aspect alone. So a tree's faint aspects fade out as it
     /// recedes instead of all at once at the far span, and the small trees, which make most
     /// of a forest's layers, shade fewer. Default [`SHARPEN_REACH_DEFAULT`], chosen by the
-    /// measurements under "The sharpening reach" in docs/rendering.md. Off with
+    /// measurements under "The sharpening reach" in docs/overdraw.md. Off with
     /// [`Self::far_nearest`] off (the paper's blend of every tree).
     pub sharpen_reach: u32,
     /// The opaque pass (on by default; with [`AspectBlend::Over`] only): before the blended
@@ -239,7 +239,7 @@ pub struct StreamOptions {
     /// slab, the trees behind), which those fragments would cover. The blended draw moves
     /// nothing, so it draws the same image as without the pass (the same fragments shaded
     /// again, over what is left behind them). It writes that depth into the host's depth
-    /// target; see "The opaque pass" in docs/rendering.md.
+    /// target; see "The opaque pass" in docs/overdraw.md.
     pub opaque_first: bool,
 }
 
@@ -583,37 +583,6 @@ pub fn ground_moss(x: f32, z: f32) -> f32 {
 /// [`ground_moss`].
 pub fn ground_albedo(x: f32, z: f32) -> glam::Vec3 {
     GROUND_ALBEDO.lerp(GROUND_MOSS, ground_moss(x, z))
-}
-
-/// The environment uniform: ground colour, sky, sun disc, haze and the terrain's grid (see
-/// `shaders/environment.wgsl`).
-pub fn environment_uniform(
-    atmosphere: &Atmosphere,
-    terrain: &crate::terrain::TerrainGrid,
-) -> GpuEnvironment {
-    let g = GROUND_MOSS;
-    let [hr, hg, hb] = atmosphere.horizon;
-    let [zr, zg, zb] = atmosphere.zenith;
-    // A cosine above 1 draws no disc.
-    let disc = if atmosphere.sun_disc {
-        SUN_DISC_DEGREES.to_radians().cos()
-    } else {
-        2.0
-    };
-    GpuEnvironment {
-        ground: [g.x, g.y, g.z, 0.0],
-        horizon: [hr, hg, hb, atmosphere.haze_density()],
-        zenith: [zr, zg, zb, atmosphere.haze_falloff()],
-        sun: [disc, 0.0, 0.0, 0.0],
-        albedo: GROUND_ALBEDO.extend(0.0).to_array(),
-        terrain: [
-            terrain.origin[0],
-            terrain.origin[1],
-            terrain.spacing,
-            if terrain.present() { 1.0 } else { 0.0 },
-        ],
-        terrain_size: [terrain.size[0], terrain.size[1], 0, 0],
-    }
 }
 
 impl RendererOptions {

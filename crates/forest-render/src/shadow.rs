@@ -38,7 +38,7 @@ pub struct ShadowOptions {
     /// at least the tallest tree's height over the sine of the lowest sun wanted.
     pub reach: f32,
     /// Receivers look their shadow up this many texels towards the sun and along their normal
-    /// (the bias against acne; it also bounds the peter-panning, see `docs/rendering.md`).
+    /// (the bias against acne; it also bounds the peter-panning, see `docs/shadows.md`).
     pub offset_texels: f32,
     /// Cast, into each cascade, only the trees whose shadow can reach that cascade's slice of
     /// the view ([`caster_planes`]); off, every tree in the cascade's box casts. The maps'
@@ -477,7 +477,7 @@ fn towards(
     stream: crate::options::StreamOptions,
 ) -> GpuCamera {
     let to_light = to_light.normalize_or(Vec3::Y);
-    let mut g = crate::frame::gpu_camera(
+    let mut g = crate::camera::gpu_camera(
         view_proj,
         centre + to_light * (1e4 * reach),
         -to_light,

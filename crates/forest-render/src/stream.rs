@@ -14,21 +14,19 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use wgpu::util::DeviceExt;
 
-use crate::camera::{Camera, CameraError};
+use crate::camera::Camera;
 use crate::capacity::{Capacity, CapacityInput};
 use crate::context::{GpuContext, RenderError};
-use crate::frame::{FrameParams, Targets};
+use crate::frame::Targets;
 use crate::gpu_types::{GpuArgs, GpuCamera, GpuState, Quad, SceneConsts};
-use crate::options::{
-    Atmosphere, Background, DebugView, RendererOptions, StreamOptions, environment_uniform,
-};
+use crate::options::{Atmosphere, Background, DebugView, RendererOptions, StreamOptions};
 use crate::passes::ComputeShared;
 use crate::passes::cull::CullPass;
 use crate::passes::draw::DrawPass;
 use crate::passes::refine::RefinePass;
 use crate::scene::GpuScene;
-use crate::shadow_maps::HostShadows;
 use crate::stats::{FrameStats, PassTimes, StatsRing};
+use crate::view::{ForestView, Form};
 use crate::work::{CountingPass, FrameWork, StatisticsQueries};
 
 /// Bytes of the resolved timestamps (six queries).
@@ -78,8 +76,6 @@ fn readback<'a>(
 pub struct QuadStream {
     /// The counting quad pipelines, built at the first attached counter and kept.
     counting_draw: Option<crate::passes::draw::CountingDraw>,
-    /// The attached counters' bind group, while counting fragments.
-    fragment_counts: Option<wgpu::BindGroup>,
     /// The uploaded scene (shared, immutable).
     pub scene: Arc<GpuScene>,
     /// Buffer sizes.
@@ -88,35 +84,25 @@ pub struct QuadStream {
     grown: u32,
     opts: RendererOptions,
     passes: Passes,
-    camera: wgpu::Buffer,
+    inputs: crate::view::FrameInputs,
     environment: wgpu::Buffer,
     sized: Sized,
     levels: u32,
     iterations: u32,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     statistics: Option<StatisticsQueries>,
-    /// Whether frames gather pipeline statistics ([`Self::set_pipeline_statistics`]).
-    count_work: bool,
     /// Dispatches and draws of the last recorded frame (counted as recorded).
     recorded: (AtomicU32, AtomicU32),
-    writes: (u64, u64),
-    prepared: bool,
     debug: DebugView,
     options: StreamOptions,
     /// Replaces `options.sharpen` in the frames drawn ([`Self::set_sharpen_override`]).
     sharpen_override: Option<u32>,
     /// Replaces `options.opaque_first` in the frames drawn ([`Self::set_opaque_override`]).
     opaque_override: Option<bool>,
-    forms: [f32; 4],
-    light: forest_format::shading::Lighting,
     /// The sun's shadow maps, when on ([`Self::set_shadows`]).
     shadows: Option<crate::shadow_maps::ShadowMaps>,
     /// The last maps switched off, kept for switching them on again.
     parked: Option<crate::shadow_maps::ShadowMaps>,
-    /// The receivers' group while shadows are off.
-    no_shadows: wgpu::BindGroup,
-    /// A host's shadow maps the forest receives ([`Self::receive_host_shadows`]).
-    host_shadows: Option<HostShadows>,
     /// The casting pipeline into a host's map ([`Self::prepare_light`]).
     host_cast: Option<crate::passes::cast::CastPass>,
 }
@@ -190,14 +176,14 @@ impl QuadStream {
         let camera = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("camera"),
             contents: bytemuck::cast_slice(
-                &[crate::frame::nothing_visible(); 1 + crate::shadow::MAX_CASCADES as usize],
+                &[crate::camera::nothing_visible(); 1 + crate::shadow::MAX_CASCADES as usize],
             ),
             usage: U::UNIFORM | U::COPY_DST | U::COPY_SRC,
         });
         debug_assert_eq!(camera.size() as usize, CAMERA_BYTES);
         let environment = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("environment"),
-            contents: bytemuck::bytes_of(&environment_uniform(
+            contents: bytemuck::bytes_of(&crate::terrain::environment_uniform(
                 &opts.atmosphere,
                 &scene.terrain.grid,
             )),
@@ -231,10 +217,15 @@ impl QuadStream {
             &readback(queries.as_ref(), statistics.as_ref()),
         )?;
         let levels = scene.tables.max_levels;
-        let no_shadows = crate::shadow_maps::no_shadows(device, &passes.draw.shadow_layout);
+        let inputs = crate::view::FrameInputs::new(
+            device,
+            camera,
+            passes.draw.shadow_layout.clone(),
+            crate::forms::FORMS_QUADS,
+            opts,
+        );
         Ok(Self {
             counting_draw: None,
-            fragment_counts: None,
             iterations: if opts.refine {
                 levels.saturating_sub(1)
             } else {
@@ -246,64 +237,20 @@ impl QuadStream {
             grown: 0,
             opts: opts.clone(),
             passes,
-            camera,
+            inputs,
             environment,
             sized,
             queries,
             statistics,
-            count_work: false,
             recorded: (AtomicU32::new(0), AtomicU32::new(0)),
-            writes: (0, 0),
-            prepared: false,
             debug: DebugView::Off,
             options: StreamOptions::default(),
             sharpen_override: None,
             opaque_override: None,
-            forms: crate::forms::FORMS_QUADS,
-            light: opts.lighting,
             shadows: None,
             parked: None,
-            no_shadows,
-            host_shadows: None,
             host_cast: None,
         })
-    }
-
-    /// Receive a host's sun shadows instead of casting the forest's own: `maps` is the host's
-    /// depth array (a layer per cascade, `resolution`² texels, standard depth or reverse-Z),
-    /// read through the receivers' filter and bias; `None` stops. Each frame's cascades
-    /// come from [`Self::set_host_cascades`]. The forest's own shadows are switched off.
-    pub fn receive_host_shadows(
-        &mut self,
-        device: &wgpu::Device,
-        maps: Option<(&wgpu::TextureView, u32, bool)>,
-    ) {
-        self.host_shadows = maps.map(|(view, resolution, reverse_z)| {
-            self.shadows = None;
-            HostShadows::new(
-                device,
-                &self.passes.draw.shadow_layout,
-                view,
-                resolution,
-                reverse_z,
-            )
-        });
-    }
-
-    /// The host's cascades for the next frames' receivers (see
-    /// [`Self::receive_host_shadows`]): each one's world → shadow clip matrix, the view depth
-    /// where it ends (`split.1`), its texel and its depth range (metres); at most
-    /// [`crate::shadow::MAX_CASCADES`], finite.
-    pub fn set_host_cascades(
-        &mut self,
-        cascades: &[crate::shadow::Cascade],
-    ) -> Result<(), RenderError> {
-        match &mut self.host_shadows {
-            Some(h) => h.set_cascades(cascades),
-            None => Err(RenderError::Parameter(
-                "host cascades without host shadow maps: call receive_host_shadows first".into(),
-            )),
-        }
     }
 
     /// Write a host's light view (the frame's upload for this stream): from here on the stream
@@ -329,8 +276,7 @@ impl QuadStream {
             ));
         }
         let g = light.camera(self.drawn_options());
-        crate::camera::upload(queue, &self.camera, &g, &mut self.writes);
-        self.prepared = true;
+        self.inputs.upload_cameras(queue, &[g]);
         Ok(())
     }
 
@@ -360,7 +306,7 @@ impl QuadStream {
                 }
             }
             Some(o) => {
-                self.host_shadows = None;
+                self.inputs.drop_host_shadows();
                 if self.shadows.as_ref().map(|s| *s.options()) == Some(o) {
                     return Ok(());
                 }
@@ -408,7 +354,7 @@ impl QuadStream {
     /// The camera buffer (a light-view stream's is filled by copies, see
     /// [`crate::shadow_maps`]).
     pub(crate) fn camera_buffer(&self) -> &wgpu::Buffer {
-        &self.camera
+        self.inputs.camera()
     }
 
     /// What the casting pass draws from: the final stream's draw group and the indirect
@@ -681,7 +627,7 @@ impl QuadStream {
             device,
             &self.scene,
             &self.passes,
-            &self.camera,
+            self.inputs.camera(),
             &self.environment,
             &capacity,
             &readback(self.queries.as_ref(), self.statistics.as_ref()),
@@ -732,30 +678,16 @@ impl QuadStream {
         self.debug = view;
     }
 
-    /// Gather pipeline statistics (shader invocations and primitives per pass, in
-    /// [`FrameStats::work`]) from the next frame on, where the device has
-    /// `PIPELINE_STATISTICS_QUERY`. Off by default, so that a host's frame records no query
-    /// it does not read (on lavapipe they cost no measurable time: Table 1's frame times
-    /// with and without them agree within 3 %). Dispatches, draws and bytes are counted
-    /// either way.
-    pub fn set_pipeline_statistics(&mut self, on: bool) {
-        self.count_work = on;
-    }
-
     /// Whether frames gather pipeline statistics.
     pub fn pipeline_statistics(&self) -> bool {
-        self.count_work
+        self.inputs.gathers_statistics()
     }
 
     /// The statistics queries when frames gather them.
     fn counting(&self) -> Option<&StatisticsQueries> {
-        self.statistics.as_ref().filter(|_| self.count_work)
-    }
-
-    /// Draw over `background` from the next frame on (what [`Self::encode`] clears to and
-    /// whether it draws the ground; the pipelines do not depend on it).
-    pub fn set_background(&mut self, background: Background) {
-        self.opts.background = background;
+        self.statistics
+            .as_ref()
+            .filter(|_| self.inputs.gathers_statistics())
     }
 
     /// The sky and haze, fixed when the stream was built.
@@ -801,7 +733,7 @@ impl QuadStream {
     /// Whether the opaque pass runs ([`StreamOptions::opaque_first`]) in the frames written
     /// from the next camera on, whatever [`Self::set_options`] sets; None: the options' own.
     /// The hybrid turns it off for its trees beyond the switch: there it shaded more
-    /// fragments than it saved (docs/rendering.md, "The opaque pass").
+    /// fragments than it saved (docs/overdraw.md, "The opaque pass").
     pub fn set_opaque_override(&mut self, opaque_first: Option<bool>) {
         self.opaque_override = opaque_first;
     }
@@ -814,34 +746,6 @@ impl QuadStream {
             opaque_first: self.opaque_override.unwrap_or(self.options.opaque_first),
             ..self.options
         }
-    }
-
-    /// What the trees are drawn over when the stream clears the targets itself.
-    pub fn background(&self) -> Background {
-        self.opts.background
-    }
-
-    /// Which trees the stream draws from the next [`Self::prepare`] on (the camera's
-    /// `forms`, see [`crate::forms`]); [`crate::forms::FORMS_QUADS`], every tree, unless a
-    /// hybrid method set it.
-    pub fn set_forms(&mut self, forms: [f32; 4]) {
-        self.forms = forms;
-    }
-
-    /// The light of the frames written from the next [`Self::set_camera`] on (a
-    /// [`Self::prepare`] takes its frame's own light). Refused when a value is out of range.
-    pub fn set_light(
-        &mut self,
-        light: forest_format::shading::Lighting,
-    ) -> Result<(), RenderError> {
-        light.validate().map_err(RenderError::Parameter)?;
-        self.light = light;
-        Ok(())
-    }
-
-    /// The light frames are shaded with.
-    pub fn light(&self) -> forest_format::shading::Lighting {
-        self.light
     }
 
     /// Switch refinement on (the quad stream) or off (static impostors: level-0 quads only),
@@ -868,65 +772,14 @@ impl QuadStream {
         }
     }
 
-    /// Write the frame's camera from the host's matrices: the one upload of a frame.
-    pub fn prepare(&mut self, queue: &wgpu::Queue, frame: &FrameParams) -> Result<(), RenderError> {
-        frame.validate()?;
-        self.light = frame.light;
-        self.write_camera(queue, frame.to_gpu());
-        Ok(())
-    }
-
-    /// [`Self::prepare`] from an eye/target [`Camera`] (the crate's front ends).
-    pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
-        camera.validate()?;
-        self.write_camera(&ctx.queue, camera.to_gpu());
-        Ok(())
-    }
-
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
         g.viewport[2] = self.debug.shader_value() as f32;
         self.drawn_options().apply(&mut g);
-        g.forms = self.forms;
-        g.set_light(&self.light);
-        if let Some(h) = &self.host_shadows {
-            h.write(&mut g);
-        }
-        let cameras = match &self.shadows {
-            Some(sh) => crate::shadow::cameras(
-                &g,
-                &self.light,
-                sh.options(),
-                self.drawn_options(),
-                sh.targets().band(),
-            ),
-            None => vec![g],
-        };
-        crate::camera::upload_all(queue, &self.camera, &cameras, &mut self.writes);
-        self.prepared = true;
-    }
-
-    /// Whether a camera was written (before that, frames draw nothing).
-    pub fn is_prepared(&self) -> bool {
-        self.prepared
-    }
-
-    /// Queue writes made by this stream since it was created: (count, bytes).
-    pub fn uploads(&self) -> (u64, u64) {
-        self.writes
-    }
-
-    /// Write the camera, record a frame into `target` (cleared to the background) and submit.
-    pub fn render_frame(
-        &mut self,
-        ctx: &GpuContext,
-        camera: &Camera,
-        target: &crate::target::Target,
-    ) -> Result<(), CameraError> {
-        self.set_camera(ctx, camera)?;
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        self.encode(&mut enc, &target.colour_view, &target.depth_view);
-        ctx.queue.submit([enc.finish()]);
-        Ok(())
+        let own = self
+            .shadows
+            .as_ref()
+            .map(|sh| (sh.options(), self.drawn_options(), sh.targets().band()));
+        self.inputs.upload(queue, g, own);
     }
 
     /// [`Self::render_frame`], drawn again while the frame overflows the stream and
@@ -948,46 +801,15 @@ impl QuadStream {
         }
     }
 
-    /// The crate's own frame: cull, refine, then the ground (with the sky background) and the
-    /// quads into `colour` and `depth`, both cleared first (to the background and the far
-    /// depth).
-    pub fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-    ) {
-        let targets = Targets::cleared(
-            colour,
-            depth,
-            self.opts.background.clear_colour(),
-            self.opts.depth_clear(),
-        );
-        self.encode_compute(encoder);
-        {
-            let mut pass = targets.begin(encoder, "draw", self.draw_timestamps());
-            self.record_draw(&mut pass, true);
-        }
-        self.resolve_times(encoder);
-    }
-
     /// A host's frame: cull and refine, then the quads drawn into `targets` with its load
     /// operations (no ground, nothing cleared unless `targets` says so).
     pub fn encode_into(&self, encoder: &mut wgpu::CommandEncoder, targets: &Targets) {
-        self.encode_compute(encoder);
+        ForestView::encode_compute(self, encoder);
         {
-            let mut pass = targets.begin(encoder, "forest", self.draw_timestamps());
+            let mut pass = targets.begin(encoder, "forest", Form::draw_timestamps(self));
             self.render(&mut pass);
         }
         self.resolve_times(encoder);
-    }
-
-    /// The compute passes of a frame: cull and refine (before the render pass that draws),
-    /// after the sun's shadow maps when shadows are on (each cascade's cull, refine and
-    /// casting pass, [`crate::shadow_maps::ShadowMaps::encode`]).
-    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
-        self.encode_shadows(encoder, true, None);
-        self.encode_view_compute(encoder);
     }
 
     /// The shadow maps' passes alone, when shadows are on: the quad stream's light views
@@ -999,7 +821,7 @@ impl QuadStream {
         extra: Option<&dyn crate::shadow_maps::Caster>,
     ) {
         if let Some(sh) = &self.shadows {
-            sh.encode_with(encoder, &self.camera, quads, extra);
+            sh.encode_with(encoder, self.inputs.camera(), quads, extra);
         }
     }
 
@@ -1052,76 +874,6 @@ impl QuadStream {
         self.recorded.0.store(dispatches, Ordering::Relaxed);
     }
 
-    /// Count fragments into `counter` from the next frame on ([`crate::fragments`]), or stop
-    /// counting (`None`). The counting pipelines are built at the first counter and kept.
-    pub fn set_fragment_counter(
-        &mut self,
-        device: &wgpu::Device,
-        counter: Option<&crate::fragments::FragmentCounter>,
-    ) {
-        if counter.is_some() && self.counting_draw.is_none() {
-            self.counting_draw = Some(self.passes.draw.counting(device, &self.opts));
-        }
-        self.fragment_counts = counter.map(|c| c.bind_group().clone());
-    }
-
-    /// Draw the quads into the host's render pass (after [`Self::encode_compute`] in the same
-    /// or an earlier encoder of the submission): back to front, blended, depth-tested, no
-    /// depth written, after the opaque pass ([`StreamOptions::opaque_first`], on by default),
-    /// which writes depth where the trees' fronts are opaque, a slab's thickness behind them
-    /// (so the host's depth attachment must be writable while it runs).
-    pub fn render(&self, pass: &mut wgpu::RenderPass) {
-        self.record_draw(pass, false);
-    }
-
-    /// Timestamp writes for the render pass that draws the stream (its draw time).
-    pub fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.queries
-            .as_ref()
-            .map(|(set, _)| wgpu::RenderPassTimestampWrites {
-                query_set: set,
-                beginning_of_pass_write_index: Some(4),
-                end_of_pass_write_index: Some(5),
-            })
-    }
-
-    /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
-    /// `ground` and the background is the sky), then the quads.
-    pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
-        let draws = self.passes.draw.record(
-            pass,
-            &self.sized.bg_draw[(self.iterations % 2) as usize],
-            match (&self.shadows, &self.host_shadows) {
-                (Some(s), _) => s.receivers(),
-                (None, Some(h)) => h.group(),
-                (None, None) => &self.no_shadows,
-            },
-            &self.sized.args,
-            (ground && self.opts.background == Background::Sky).then_some(&self.scene.terrain),
-            self.options.far_nearest && self.options.far_composite,
-            self.drawn_options().opaque_pass(),
-            crate::passes::draw::Measured {
-                statistics: self.counting().map(|q| &q.set),
-                counted: self
-                    .counting_draw
-                    .as_ref()
-                    .zip(self.fragment_counts.as_ref()),
-            },
-        );
-        self.recorded.1.store(draws, Ordering::Relaxed);
-    }
-
-    /// Resolve the frame's pass times (after the render pass that used
-    /// [`Self::draw_timestamps`]).
-    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let Some((set, resolve)) = &self.queries {
-            encoder.resolve_query_set(set, 0..6, resolve, 0);
-        }
-        if let Some(q) = self.counting() {
-            q.resolve(encoder);
-        }
-    }
-
     fn decode(
         &self,
         state: &[u8],
@@ -1161,7 +913,7 @@ impl QuadStream {
                 dispatches: self.recorded.0.load(Ordering::Relaxed),
                 draws: self.recorded.1.load(Ordering::Relaxed),
                 passes: statistics
-                    .filter(|_| self.count_work)
+                    .filter(|_| self.inputs.gathers_statistics())
                     .and_then(crate::work::decode),
                 bytes: self.scene.bytes
                     + self.sized.view_bytes
@@ -1215,5 +967,88 @@ impl QuadStream {
             .filter(|(_, b)| b.usage().contains(wgpu::BufferUsages::COPY_DST))
             .map(|(l, _)| *l)
             .collect()
+    }
+}
+
+/// The quad stream's passes behind the frame API ([`crate::view::ForestView`]): cull, refine,
+/// and the draw, which draws the quads back to front, blended, depth-tested, no depth written,
+/// after the opaque pass ([`StreamOptions::opaque_first`], on by default), which writes depth
+/// where the trees' fronts are opaque, a slab's thickness behind them (so a host's depth
+/// attachment must be writable while it runs).
+impl crate::view::Form for QuadStream {
+    fn inputs(&self) -> &crate::view::FrameInputs {
+        &self.inputs
+    }
+
+    fn inputs_mut(&mut self) -> &mut crate::view::FrameInputs {
+        &mut self.inputs
+    }
+
+    fn write_frame(&mut self, queue: &wgpu::Queue, g: GpuCamera) {
+        self.write_camera(queue, g);
+    }
+
+    fn park_own_shadows(&mut self, _device: &wgpu::Device) {
+        self.shadows = None;
+    }
+
+    /// The compute passes of a frame: the sun's shadow maps when shadows are on (each
+    /// cascade's cull, refine and casting pass, [`crate::shadow_maps::ShadowMaps::encode`]),
+    /// then the view's cull and refine.
+    fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.encode_shadows(encoder, true, None);
+        self.encode_view_compute(encoder);
+    }
+
+    /// The counting pipelines, built at the first counter and kept.
+    fn build_counting(&mut self, device: &wgpu::Device) {
+        if self.counting_draw.is_none() {
+            self.counting_draw = Some(self.passes.draw.counting(device, &self.opts));
+        }
+    }
+
+    /// Timestamp writes for the render pass that draws the stream (its draw time).
+    fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.queries
+            .as_ref()
+            .map(|(set, _)| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(4),
+                end_of_pass_write_index: Some(5),
+            })
+    }
+
+    /// Record the draw into a render pass after [`Self::encode_compute`]: the ground (when
+    /// `ground` and the background is the sky), then the quads.
+    fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
+        let draws = self.passes.draw.record(
+            pass,
+            &self.sized.bg_draw[(self.iterations % 2) as usize],
+            self.inputs
+                .receivers(self.shadows.as_ref().map(|s| s.receivers())),
+            &self.sized.args,
+            (ground && self.inputs.background() == Background::Sky).then_some(&self.scene.terrain),
+            self.options.far_nearest && self.options.far_composite,
+            self.drawn_options().opaque_pass(),
+            crate::passes::draw::Measured {
+                statistics: self.counting().map(|q| &q.set),
+                counted: self
+                    .counting_draw
+                    .as_ref()
+                    .zip(self.inputs.fragment_counts()),
+            },
+        );
+        self.recorded.1.store(draws, Ordering::Relaxed);
+    }
+
+    /// Resolve the frame's pass times (all six: the draw's are stale when its pass was not
+    /// timed) and counters.
+    fn resolve_queries(&self, encoder: &mut wgpu::CommandEncoder, _draw_timed: bool) {
+        if let Some((set, resolve)) = &self.queries {
+            encoder.resolve_query_set(set, 0..6, resolve, 0);
+        }
+        if let Some(q) = self.counting() {
+            q.resolve(encoder);
+        }
     }
 }

@@ -1,7 +1,10 @@
 //! An offscreen colour + depth target and its read-back, for headless rendering.
 
 use crate::context::GpuContext;
-use crate::passes::draw::DEPTH_FORMAT;
+
+/// Depth format of the targets the crate's own front ends draw into ([`crate::target`]);
+/// a host chooses its own in [`crate::options::RendererOptions`].
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Colour (`Rgba8UnormSrgb` unless made [`Target::with_format`]) and depth textures of one
 /// size.

@@ -107,11 +107,42 @@ impl GpuTerrain {
 /// The bind-group layout entry of the terrain's heights (binding 13, read in the vertex
 /// stage), in every draw group that draws the ground.
 pub fn heights_entry() -> wgpu::BindGroupLayoutEntry {
-    crate::passes::draw::vertex_storage_entry(HEIGHTS_BINDING)
+    crate::bindings::vertex_storage_entry(HEIGHTS_BINDING)
 }
 
 /// Binding of the terrain's heights in the draw groups (`shaders/environment.wgsl`).
 pub const HEIGHTS_BINDING: u32 = 13;
+
+/// The environment uniform: ground colour, sky, sun disc, haze and the terrain's grid (see
+/// `shaders/environment.wgsl`).
+pub fn environment_uniform(
+    atmosphere: &crate::options::Atmosphere,
+    terrain: &TerrainGrid,
+) -> crate::gpu_types::GpuEnvironment {
+    let g = crate::options::GROUND_MOSS;
+    let [hr, hg, hb] = atmosphere.horizon;
+    let [zr, zg, zb] = atmosphere.zenith;
+    // A cosine above 1 draws no disc.
+    let disc = if atmosphere.sun_disc {
+        crate::options::SUN_DISC_DEGREES.to_radians().cos()
+    } else {
+        2.0
+    };
+    crate::gpu_types::GpuEnvironment {
+        ground: [g.x, g.y, g.z, 0.0],
+        horizon: [hr, hg, hb, atmosphere.haze_density()],
+        zenith: [zr, zg, zb, atmosphere.haze_falloff()],
+        sun: [disc, 0.0, 0.0, 0.0],
+        albedo: crate::options::GROUND_ALBEDO.extend(0.0).to_array(),
+        terrain: [
+            terrain.origin[0],
+            terrain.origin[1],
+            terrain.spacing,
+            if terrain.present() { 1.0 } else { 0.0 },
+        ],
+        terrain_size: [terrain.size[0], terrain.size[1], 0, 0],
+    }
+}
 
 #[cfg(test)]
 mod tests {

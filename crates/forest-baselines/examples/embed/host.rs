@@ -14,6 +14,7 @@
 //! host's ground reads it, and the forest's trees receive it (`receive_host_shadows`,
 //! `set_host_cascades`).
 
+use forest_render::ForestView;
 use std::sync::Arc;
 
 use forest_baselines::{ForestRenderer, GeometryRenderer, Hybrid, Method, PreparedGeometry};

@@ -4,8 +4,6 @@
 
 use forest_format::forest::Forest;
 use forest_format::model::BANDS;
-use forest_render::Targets;
-use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::gpu_types::GpuCamera;
 use forest_render::options::RendererOptions;
@@ -13,8 +11,8 @@ use forest_render::options::{Atmosphere, Background};
 use forest_render::passes::draw::draw_pipeline;
 use forest_render::shadow_maps::{Caster, ShadowTargets};
 use forest_render::stats::PassTimes;
-use forest_render::target::Target;
 use forest_render::work::{self, FrameWork, StatisticsQueries};
+use forest_render::{Form, FrameInputs};
 use std::sync::atomic::AtomicU32;
 use wgpu::util::DeviceExt;
 
@@ -30,12 +28,9 @@ pub const RESET_WG: u32 = 64;
 
 /// The geometry-based renderer of one forest.
 pub struct GeometryRenderer {
-    camera: wgpu::Buffer,
+    inputs: FrameInputs,
     method_buf: wgpu::Buffer,
     method: MeshMethod,
-    forms: [f32; 4],
-    light: forest_format::shading::Lighting,
-    writes: (u64, u64),
     ring: forest_render::stats::StatsRing,
     reset: wgpu::ComputePipeline,
     classify: wgpu::ComputePipeline,
@@ -52,33 +47,23 @@ pub struct GeometryRenderer {
     /// The counting geometry and billboard pipelines, built at the first attached counter
     /// and kept.
     counting_draw: Option<[wgpu::RenderPipeline; 2]>,
-    /// The attached counters' bind group, while counting fragments.
-    fragment_counts: Option<wgpu::BindGroup>,
     atmosphere: Atmosphere,
     compute_bg: wgpu::BindGroup,
     draw_bg: wgpu::BindGroup,
     args: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, f64)>,
     statistics: Option<StatisticsQueries>,
-    /// Whether frames gather pipeline statistics.
-    count_work: bool,
     /// Draws recorded by the last [`Self::record_draw`].
     draws: AtomicU32,
-    background: Background,
-    depth_clear: f32,
     /// Bytes of GPU memory the renderer allocated (buffers and textures), the models it
     /// shares included.
     pub gpu_bytes: u64,
     /// Layout of the draw's group 2, the sun's shadow maps.
     shadow_layout: wgpu::BindGroupLayout,
-    /// The receivers' group while shadows are off.
-    no_shadows: wgpu::BindGroup,
     /// The light views and the maps' receivers' group while shadows are on.
     shadows: Option<super::light::LightViews>,
     /// The last light views switched off, kept for switching them on again.
     parked: Option<super::light::LightViews>,
-    /// A host's shadow maps the trees receive instead ([`Self::receive_host_shadows`]).
-    host_shadows: Option<forest_render::shadow_maps::HostShadows>,
     /// What every view of the renderer binds (its own lists aside).
     shared: Shared,
 }
@@ -258,7 +243,6 @@ impl GeometryRenderer {
         models: Arc<GpuModels>,
         opts: &RendererOptions,
     ) -> Result<Self, RenderError> {
-        let background = opts.background;
         opts.atmosphere.validate().map_err(RenderError::Parameter)?;
         require_indirect_first_instance(ctx)?;
         let device = &ctx.device;
@@ -346,7 +330,7 @@ impl GeometryRenderer {
             render_pipeline("vs_terrain", "fs_terrain", T::TriangleList, &draw_pl);
         let environment_buf = init(
             "geometry environment",
-            bytemuck::bytes_of(&forest_render::options::environment_uniform(
+            bytemuck::bytes_of(&forest_render::terrain::environment_uniform(
                 &opts.atmosphere,
                 &models.terrain.grid,
             )),
@@ -382,14 +366,17 @@ impl GeometryRenderer {
             sources.push((q.resolve.clone(), work::STATISTICS_BYTES));
         }
         let ring = forest_render::stats::StatsRing::new(device, sources);
-        let no_shadows = forest_render::shadow_maps::no_shadows(device, &shadow_layout);
+        let inputs = FrameInputs::new(
+            device,
+            view.camera,
+            shadow_layout.clone(),
+            forest_render::forms::FORMS_GEOMETRY,
+            opts,
+        );
         Ok(Self {
-            camera: view.camera,
+            inputs,
             method_buf,
             method,
-            forms: forest_render::forms::FORMS_GEOMETRY,
-            light: opts.lighting,
-            writes: (0, 0),
             ring,
             reset: cpl("geo_reset"),
             classify: cpl("geo_classify"),
@@ -402,23 +389,17 @@ impl GeometryRenderer {
             draw_layout,
             targets: opts.clone(),
             counting_draw: None,
-            fragment_counts: None,
             atmosphere: opts.atmosphere,
             compute_bg: view.compute_bg,
             draw_bg: view.draw_bg,
             args: view.args,
             shadow_layout,
-            no_shadows,
             shadows: None,
             parked: None,
-            host_shadows: None,
             shared,
             queries,
             statistics,
-            count_work: false,
             draws: AtomicU32::new(0),
-            background,
-            depth_clear: opts.depth_clear(),
             gpu_bytes: gpu_bytes.get() + models.bytes(),
         })
     }
@@ -442,15 +423,11 @@ impl GeometryRenderer {
         self.method
     }
 
-    /// Gather pipeline statistics from the next frame on (see
-    /// `QuadStream::set_pipeline_statistics`; off by default).
-    pub fn set_pipeline_statistics(&mut self, on: bool) {
-        self.count_work = on;
-    }
-
     /// The statistics queries when frames gather them.
     fn counting(&self) -> Option<&StatisticsQueries> {
-        self.statistics.as_ref().filter(|_| self.count_work)
+        self.statistics
+            .as_ref()
+            .filter(|_| self.inputs.gathers_statistics())
     }
 
     /// The sky and haze, fixed when the renderer was built.
@@ -458,92 +435,14 @@ impl GeometryRenderer {
         self.atmosphere
     }
 
-    /// Draw over `background` from the next frame on (the clear colour, the sky and ground).
-    pub fn set_background(&mut self, background: Background) {
-        self.background = background;
-    }
-
-    /// Which trees the renderer draws from the next camera write on (the camera's `forms`, see
-    /// [`forest_render::forms`]); [`forest_render::forms::FORMS_GEOMETRY`], every tree, unless the
-    /// hybrid method set it.
-    pub fn set_forms(&mut self, forms: [f32; 4]) {
-        self.forms = forms;
-    }
-
-    /// Write the camera and record the frame: classify, arguments, scatter, then draw the
-    /// bands nearest first into `colour` and `depth`.
-    pub fn encode(
-        &mut self,
-        ctx: &GpuContext,
-        camera: &Camera,
-        encoder: &mut wgpu::CommandEncoder,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-    ) -> Result<(), CameraError> {
-        self.set_camera(ctx, camera)?;
-        self.encode_shadows(encoder);
-        self.encode_compute(encoder);
-        {
-            let targets = Targets::cleared(
-                colour,
-                depth,
-                self.background.clear_colour(),
-                self.depth_clear,
-            );
-            let mut pass = targets.begin(
-                encoder,
-                "geometry draw",
-                self.queries
-                    .as_ref()
-                    .map(|(query_set, _, _)| wgpu::RenderPassTimestampWrites {
-                        query_set,
-                        beginning_of_pass_write_index: Some(2),
-                        end_of_pass_write_index: Some(3),
-                    }),
-            );
-            self.record_draw(&mut pass, true);
-        }
-        self.resolve_times(encoder, true);
-        Ok(())
-    }
-
-    /// Write the camera (with the renderer's `forms`): the one upload of a frame.
-    pub fn set_camera(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), CameraError> {
-        camera.validate()?;
-        self.write_camera(&ctx.queue, camera.to_gpu());
-        Ok(())
-    }
-
-    /// The light of the frames written from the next [`Self::set_camera`] on (a
-    /// [`Self::prepare`] takes its frame's own light). Refused when a value is out of range.
-    pub fn set_light(
-        &mut self,
-        light: forest_format::shading::Lighting,
-    ) -> Result<(), RenderError> {
-        light.validate().map_err(RenderError::Parameter)?;
-        self.light = light;
-        Ok(())
-    }
-
-    /// Write a camera uniform with the renderer's `forms` and light, and each shadow
-    /// cascade's light camera after it while shadows are on (one write).
-    fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
-        g.forms = self.forms;
-        g.set_light(&self.light);
-        if let Some(h) = &self.host_shadows {
-            h.write(&mut g);
-        }
-        let cameras = match &self.shadows {
-            Some(lv) => forest_render::shadow::cameras(
-                &g,
-                &self.light,
-                lv.targets.options(),
-                Default::default(),
-                lv.targets.band(),
-            ),
-            None => vec![g],
-        };
-        forest_render::camera::upload_all(queue, &self.camera, &cameras, &mut self.writes);
+    /// Write a camera uniform with the renderer's own fields (none: its inputs and its light
+    /// views' cameras while shadows are on).
+    fn write_camera(&mut self, queue: &wgpu::Queue, g: GpuCamera) {
+        let own = self
+            .shadows
+            .as_ref()
+            .map(|lv| (lv.targets.options(), Default::default(), lv.targets.band()));
+        self.inputs.upload(queue, g, own);
     }
 
     /// Cast and receive the sun's shadows with `opts` from the next frame on, in maps of the
@@ -584,7 +483,7 @@ impl GeometryRenderer {
                 .is_some_and(|s| std::sync::Arc::ptr_eq(&s.targets, t))
         };
         if targets.is_some() {
-            self.host_shadows = None;
+            self.inputs.drop_host_shadows();
         }
         match targets {
             None => {
@@ -600,41 +499,6 @@ impl GeometryRenderer {
                 self.parked = self.shadows.take();
                 self.shadows = Some(super::light::LightViews::new(device, &self.shared, t));
             }
-        }
-    }
-
-    /// Receive a host's sun shadows (as `QuadStream::receive_host_shadows`): `maps` is the
-    /// host's depth array (a layer per cascade, `resolution`² texels, standard depth or
-    /// reverse-Z); `None` stops. Each frame's cascades come from [`Self::set_host_cascades`].
-    /// The renderer's own (or shared) shadows are switched off.
-    pub fn receive_host_shadows(
-        &mut self,
-        device: &wgpu::Device,
-        maps: Option<(&wgpu::TextureView, u32, bool)>,
-    ) {
-        self.host_shadows = maps.map(|(view, resolution, reverse_z)| {
-            self.share_shadows(device, None);
-            forest_render::shadow_maps::HostShadows::new(
-                device,
-                &self.shadow_layout,
-                view,
-                resolution,
-                reverse_z,
-            )
-        });
-    }
-
-    /// The host's cascades for the next frames' receivers (see
-    /// [`Self::receive_host_shadows`]; checked as `QuadStream::set_host_cascades`).
-    pub fn set_host_cascades(
-        &mut self,
-        cascades: &[forest_render::shadow::Cascade],
-    ) -> Result<(), RenderError> {
-        match &mut self.host_shadows {
-            Some(h) => h.set_cascades(cascades),
-            None => Err(RenderError::Parameter(
-                "host cascades without host shadow maps: call receive_host_shadows first".into(),
-            )),
         }
     }
 
@@ -655,27 +519,9 @@ impl GeometryRenderer {
         }
     }
 
-    /// Write the camera from the host's matrices (as `QuadStream::prepare`); then
-    /// [`Self::encode_compute`] and [`Self::record_draw`] into the host's pass.
-    pub fn prepare(
-        &mut self,
-        queue: &wgpu::Queue,
-        frame: &forest_render::FrameParams,
-    ) -> Result<(), RenderError> {
-        frame.validate()?;
-        self.light = frame.light;
-        self.write_camera(queue, frame.to_gpu());
-        Ok(())
-    }
-
-    /// Camera writes made by this renderer since it was created: (count, bytes). The method
-    /// uniform is written only by [`Self::set_method`].
-    pub fn uploads(&self) -> (u64, u64) {
-        self.writes
-    }
-
-    /// The compute pass of a frame: classify, arguments, scatter (after [`Self::set_camera`]).
-    pub fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+    /// The view's compute pass alone: classify, arguments, scatter (after a camera was
+    /// written), without the shadow maps' passes (the hybrid's stream casts for both forms).
+    pub fn encode_view_compute(&self, encoder: &mut wgpu::CommandEncoder) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("geometry cull"),
             timestamp_writes: self.queries.as_ref().map(|(query_set, _, _)| {
@@ -728,92 +574,6 @@ impl GeometryRenderer {
         );
     }
 
-    /// Count the trees' fragments into `counter` from the next frame on
-    /// (`forest_render::fragments`), or stop counting (`None`). The counting pipelines are
-    /// built at the first counter and kept; the frame's own pipelines are untouched.
-    pub fn set_fragment_counter(
-        &mut self,
-        device: &wgpu::Device,
-        counter: Option<&forest_render::fragments::FragmentCounter>,
-    ) {
-        if counter.is_some() && self.counting_draw.is_none() {
-            let counts = forest_render::fragments::bind_layout(device);
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("counted geometry draw"),
-                bind_group_layouts: &[
-                    Some(&self.draw_layout),
-                    Some(&counts),
-                    Some(&self.shadow_layout),
-                ],
-                immediate_size: 0,
-            });
-            let source =
-                forest_render::passes::counting_source(&crate::shaders::GEOMETRY_DRAW_WGSL);
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("counted geometry draw"),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
-            let pipeline = |entries| {
-                draw_pipeline(
-                    device,
-                    &self.targets,
-                    &layout,
-                    &module,
-                    wgpu::PrimitiveTopology::TriangleList,
-                    entries,
-                    None,
-                    true,
-                )
-            };
-            self.counting_draw = Some([
-                pipeline(["vs_geo", "fs_geo"]),
-                pipeline(["vs_billboard", "fs_billboard"]),
-            ]);
-        }
-        self.fragment_counts = counter.map(|c| c.bind_group().clone());
-    }
-
-    /// Record the draw into a render pass after [`Self::encode_compute`]: the environment (sky
-    /// and ground, when `ground` and the background is the sky), then the bands nearest first.
-    pub fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
-        let ground = ground && self.background == Background::Sky;
-        pass.set_bind_group(0, &self.draw_bg, &[]);
-        let receivers = match (&self.shadows, &self.host_shadows) {
-            (Some(s), _) => s.targets.receivers(),
-            (None, Some(h)) => h.group(),
-            (None, None) => &self.no_shadows,
-        };
-        pass.set_bind_group(2, receivers, &[]);
-        let environment = if ground {
-            self.shared.models.terrain.record_ground(
-                pass,
-                &self.environment,
-                &self.terrain_pipeline,
-            )
-        } else {
-            0
-        };
-        // The statistics are the trees' alone (the environment is outside the query).
-        if let Some(q) = self.counting() {
-            pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
-        }
-        let [draw, billboard] = match (&self.counting_draw, &self.fragment_counts) {
-            (Some([draw, billboard]), Some(counts)) => {
-                pass.set_bind_group(1, counts, &[]);
-                [draw, billboard]
-            }
-            _ => [&self.draw, &self.billboard],
-        };
-        self.record_bands(pass, &self.args, [draw, billboard]);
-        if self.counting().is_some() {
-            pass.end_pipeline_statistics_query();
-        }
-        self.draws.store(
-            BANDS * self.shared.models.species_count + environment,
-            std::sync::atomic::Ordering::Relaxed,
-        );
-    }
-
     /// Draw every band × species segment of a view's `args`, nearest band first, meshes with
     /// `pipelines[0]` and billboards with `pipelines[1]`.
     fn record_bands(
@@ -837,36 +597,6 @@ impl GeometryRenderer {
                 );
             }
         }
-    }
-
-    /// Resolve the frame's pass times: the cull pass's, and the draw pass's when `draw` (the
-    /// render pass carried this renderer's timestamps).
-    pub fn resolve_times(&self, encoder: &mut wgpu::CommandEncoder, draw: bool) {
-        if let Some((set, resolve, _)) = &self.queries {
-            encoder.resolve_query_set(set, 0..if draw { 4 } else { 2 }, resolve, 0);
-        }
-        if let Some(q) = self.counting() {
-            q.resolve(encoder);
-        }
-    }
-
-    /// Write the camera, record the frame into `target`, and submit.
-    pub fn render_frame(
-        &mut self,
-        ctx: &GpuContext,
-        camera: &Camera,
-        target: &Target,
-    ) -> Result<(), CameraError> {
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        self.encode(
-            ctx,
-            camera,
-            &mut enc,
-            &target.colour_view,
-            &target.depth_view,
-        )?;
-        ctx.queue.submit([enc.finish()]);
-        Ok(())
     }
 
     /// Visible trees per segment (`band · species + s`) of the last submitted frame; waits.
@@ -940,7 +670,7 @@ impl GeometryRenderer {
             dispatches: 4,
             draws: self.draws.load(std::sync::atomic::Ordering::Relaxed),
             passes: statistics
-                .filter(|_| self.count_work)
+                .filter(|_| self.inputs.gathers_statistics())
                 .and_then(work::decode),
             bytes: self.gpu_bytes + self.shadows.as_ref().map_or(0, |s| s.bytes()),
         };
@@ -954,7 +684,13 @@ impl forest_render::shadow_maps::Caster for GeometryRenderer {
         let Some(lv) = &self.shadows else { return };
         let size = std::mem::size_of::<GpuCamera>() as u64;
         let view = &lv.views[k];
-        encoder.copy_buffer_to_buffer(&self.camera, size * (k as u64 + 1), &view.camera, 0, size);
+        encoder.copy_buffer_to_buffer(
+            self.inputs.camera(),
+            size * (k as u64 + 1),
+            &view.camera,
+            0,
+            size,
+        );
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("geometry light view"),
             timestamp_writes: None,
@@ -969,5 +705,130 @@ impl forest_render::shadow_maps::Caster for GeometryRenderer {
         pass.set_bind_group(0, &view.draw_bg, &[]);
         let [a, b] = &lv.cast;
         self.record_bands(pass, &view.args, [a, b]);
+    }
+}
+
+/// The geometry renderer's passes behind the frame API ([`forest_render::ForestView`]).
+impl Form for GeometryRenderer {
+    fn inputs(&self) -> &FrameInputs {
+        &self.inputs
+    }
+
+    fn inputs_mut(&mut self) -> &mut FrameInputs {
+        &mut self.inputs
+    }
+
+    fn write_frame(&mut self, queue: &wgpu::Queue, g: GpuCamera) {
+        self.write_camera(queue, g);
+    }
+
+    fn park_own_shadows(&mut self, device: &wgpu::Device) {
+        self.share_shadows(device, None);
+    }
+
+    /// The shadow maps' passes when the renderer casts its own (or shares the stream's and
+    /// draws a method alone), then classify, arguments, scatter.
+    fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.encode_shadows(encoder);
+        self.encode_view_compute(encoder);
+    }
+
+    fn draw_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.queries
+            .as_ref()
+            .map(|(query_set, _, _)| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(2),
+                end_of_pass_write_index: Some(3),
+            })
+    }
+
+    /// The counting pipelines, built at the first counter and kept; the frame's own
+    /// pipelines are untouched.
+    fn build_counting(&mut self, device: &wgpu::Device) {
+        if self.counting_draw.is_none() {
+            let counts = forest_render::fragments::bind_layout(device);
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("counted geometry draw"),
+                bind_group_layouts: &[
+                    Some(&self.draw_layout),
+                    Some(&counts),
+                    Some(&self.shadow_layout),
+                ],
+                immediate_size: 0,
+            });
+            let source =
+                forest_render::passes::counting_source(&crate::shaders::GEOMETRY_DRAW_WGSL);
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("counted geometry draw"),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            let pipeline = |entries| {
+                draw_pipeline(
+                    device,
+                    &self.targets,
+                    &layout,
+                    &module,
+                    wgpu::PrimitiveTopology::TriangleList,
+                    entries,
+                    None,
+                    true,
+                )
+            };
+            self.counting_draw = Some([
+                pipeline(["vs_geo", "fs_geo"]),
+                pipeline(["vs_billboard", "fs_billboard"]),
+            ]);
+        }
+    }
+
+    /// Record the draw into a render pass after [`Self::encode_compute`]: the environment (sky
+    /// and ground, when `ground` and the background is the sky), then the bands nearest first.
+    fn record_draw(&self, pass: &mut wgpu::RenderPass, ground: bool) {
+        let ground = ground && self.inputs.background() == Background::Sky;
+        pass.set_bind_group(0, &self.draw_bg, &[]);
+        let receivers = self
+            .inputs
+            .receivers(self.shadows.as_ref().map(|s| s.targets.receivers()));
+        pass.set_bind_group(2, receivers, &[]);
+        let environment = if ground {
+            self.shared.models.terrain.record_ground(
+                pass,
+                &self.environment,
+                &self.terrain_pipeline,
+            )
+        } else {
+            0
+        };
+        // The statistics are the trees' alone (the environment is outside the query).
+        if let Some(q) = self.counting() {
+            pass.begin_pipeline_statistics_query(&q.set, work::DRAW);
+        }
+        let [draw, billboard] = match (&self.counting_draw, self.inputs.fragment_counts()) {
+            (Some([draw, billboard]), Some(counts)) => {
+                pass.set_bind_group(1, counts, &[]);
+                [draw, billboard]
+            }
+            _ => [&self.draw, &self.billboard],
+        };
+        self.record_bands(pass, &self.args, [draw, billboard]);
+        if self.counting().is_some() {
+            pass.end_pipeline_statistics_query();
+        }
+        self.draws.store(
+            BANDS * self.shared.models.species_count + environment,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+    }
+
+    /// Resolve the frame's pass times: the cull pass's, and the draw pass's when `draw` (the
+    /// render pass carried this renderer's timestamps).
+    fn resolve_queries(&self, encoder: &mut wgpu::CommandEncoder, draw: bool) {
+        if let Some((set, resolve, _)) = &self.queries {
+            encoder.resolve_query_set(set, 0..if draw { 4 } else { 2 }, resolve, 0);
+        }
+        if let Some(q) = self.counting() {
+            q.resolve(encoder);
+        }
     }
 }

@@ -9,6 +9,7 @@ use forest_format::forest::Forest;
 use forest_format::generate::SplitMix64;
 use forest_format::shading::Lighting;
 use forest_render::Camera;
+use forest_render::ForestView;
 use forest_render::options::Background;
 use forest_render::target::Target;
 use glam::Vec3;

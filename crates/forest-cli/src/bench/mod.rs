@@ -15,6 +15,7 @@ mod stability;
 mod storage;
 mod table1;
 
+use forest_render::ForestView;
 use std::cell::OnceCell;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -6,6 +6,7 @@
 
 use anyhow::Result;
 use forest_baselines::methods::{ForestRenderer, Method};
+use forest_render::ForestView;
 use forest_render::options::Background;
 use forest_render::shadow::ShadowOptions;
 use forest_render::target::Target;

@@ -1,6 +1,7 @@
 //! One frame of the viewer: step the camera, record the forest into the surface texture, the
 //! HUD over it, present, and poll the counters (never waiting for the GPU).
 
+use forest_render::ForestView;
 use std::time::Instant;
 
 use anyhow::Result;
@@ -75,17 +76,19 @@ impl Viewer {
                 let o = g.overdraw.as_ref().expect("made above");
                 o.counter.begin(&g.ctx);
                 let mut first = g.ctx.device.create_command_encoder(&Default::default());
-                g.renderer
-                    .encode(&g.ctx, &cam, &mut first, &view, &g.depth)?;
+                g.renderer.set_camera(&g.ctx, &cam)?;
+                g.renderer.encode_frame(&mut first, &view, &g.depth);
                 g.ctx.queue.submit([first.finish()]);
                 let o = g.overdraw.as_ref().expect("made above");
                 o.counter
                     .set_phase(&g.ctx.queue, forest_render::fragments::Phase::Hidden);
-                g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
+                g.renderer.set_camera(&g.ctx, &cam)?;
+                g.renderer.encode_frame(&mut enc, &view, &g.depth);
                 let o = g.overdraw.as_ref().expect("made above");
                 o.pass.encode(&mut enc, &view, &o.binding);
             } else {
-                g.renderer.encode(&g.ctx, &cam, &mut enc, &view, &g.depth)?;
+                g.renderer.set_camera(&g.ctx, &cam)?;
+                g.renderer.encode_frame(&mut enc, &view, &g.depth);
             }
             let raw = g.egui_state.take_egui_input(&g.window);
             let ui_ctx = g.egui.clone();

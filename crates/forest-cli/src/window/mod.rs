@@ -17,6 +17,7 @@ mod walker;
 
 pub use walker::Walker;
 
+use forest_render::ForestView;
 use std::collections::HashSet;
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -3,6 +3,7 @@
 
 use anyhow::Result;
 use forest_format::camera_path::CameraPath;
+use forest_render::ForestView;
 
 use super::Viewer;
 

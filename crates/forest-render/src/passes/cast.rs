@@ -3,8 +3,7 @@
 
 use super::draw::bind_entries;
 
-/// Depth format of the shadow maps.
-pub const SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub use crate::receivers::SHADOW_FORMAT;
 
 /// A casting pipeline: `entries` (vertex, fragment) of `module` drawing depth only into a
 /// shadow map ([`SHADOW_FORMAT`], nearest wins), no face culling. The quad stream's and the

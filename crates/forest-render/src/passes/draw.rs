@@ -1,26 +1,10 @@
 //! Pass 3, draw (`shaders/draw.wgsl`): the environment (sky and ground), then the final stream as
 //! an indirect, instanced triangle strip per quad, blended back to front.
 
+pub use crate::bindings::vertex_storage_entry;
+pub use crate::target::DEPTH_FORMAT;
+
 use super::{args, draw_source};
-
-/// Depth format of the targets the crate's own front ends draw into ([`crate::target`]);
-/// a host chooses its own in [`crate::options::RendererOptions`].
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-
-/// A read-only storage buffer at `binding`, read in the vertex stage (the scene tables, the
-/// stream and the terrain's heights).
-pub fn vertex_storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
 
 /// Layout of the draw group (checked against naga's reflection of `shaders/draw.wgsl` by a
 /// test): camera, instances, species, frames, final stream, nodes, colour layers, sampler,
@@ -91,7 +75,7 @@ pub const OPACITY_BINDING: u32 = 14;
 pub struct DrawPass {
     /// Bind-group layout (camera, scene tables, final stream, textures, environment).
     pub bind_layout: wgpu::BindGroupLayout,
-    /// Layout of group 2, the sun's shadow maps ([`crate::shadow_maps::receiver_layout`]).
+    /// Layout of group 2, the sun's shadow maps ([`crate::receivers::receiver_layout`]).
     pub shadow_layout: wgpu::BindGroupLayout,
     environment: wgpu::RenderPipeline,
     terrain: wgpu::RenderPipeline,
@@ -126,7 +110,7 @@ impl DrawPass {
             label: Some("draw"),
             entries: &bind_entries(),
         });
-        let shadow_layout = crate::shadow_maps::receiver_layout(device);
+        let shadow_layout = crate::receivers::receiver_layout(device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("draw"),
             bind_group_layouts: &[Some(&bind_layout), None, Some(&shadow_layout)],
