@@ -11,6 +11,7 @@
 //! the atlases hold).
 //! Bevy's camera draws one sample per pixel, as `forest-render`'s frame does.
 
+use forest_render::ForestView;
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -6,6 +6,7 @@ use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderContext, ViewQuery};
 use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
+use forest_render::ForestView;
 
 /// Core3d, after Bevy's shadow passes and before the main pass: each forest's casting stream
 /// of this view culled and refined from the light, and drawn depth-only into its cascade's

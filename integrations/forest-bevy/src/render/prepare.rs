@@ -15,7 +15,7 @@ use bevy::render::renderer::{RenderAdapterInfo, RenderDevice, RenderQueue};
 use bevy::render::view::{ExtractedView, Msaa, ViewDepthStencilTexture, ViewTarget};
 use forest_baselines::{ForestRenderer, GeometryRenderer, GpuModels, PreparedGeometry};
 use forest_format::forest::Forest;
-use forest_render::{FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
+use forest_render::{ForestView, FrameParams, GpuContext, GpuScene, QuadStream, RendererOptions};
 
 use super::extract::Extracted;
 use crate::assets::ForestAsset;

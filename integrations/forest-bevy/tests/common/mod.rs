@@ -3,6 +3,7 @@
 //! alone (what `forest render` runs).
 #![allow(dead_code)]
 
+use forest_render::ForestView;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
