@@ -65,6 +65,7 @@ pub mod shadow;
 pub mod shadow_maps;
 pub mod stats;
 pub mod stream;
+mod stream_buffers;
 pub mod target;
 pub mod terrain;
 pub mod view;

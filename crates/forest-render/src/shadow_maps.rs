@@ -17,10 +17,8 @@ pub use crate::receivers::{
     HostShadows, no_shadows, receiver_entries, receiver_layout, receivers_of,
 };
 use crate::receivers::{depth_array, receiver_group};
-use crate::scene::GpuScene;
 use crate::shadow::ShadowOptions;
 use crate::stats::FrameStats;
-use crate::stream::QuadStream;
 
 /// Mean quad layers per texel a light-view stream is first sized for (it grows to what
 /// frames need, [`ShadowMaps::fit`]): a shadow map sees the canopy's top, far fewer layers
@@ -154,31 +152,63 @@ pub fn depth_pass<'e>(
 }
 
 /// The shadow maps of one view and the light-view streams that fill them.
-pub struct ShadowMaps {
+pub struct ShadowMaps<V> {
     targets: Arc<ShadowTargets>,
-    streams: Vec<QuadStream>,
+    streams: Vec<V>,
     cast: CastPass,
 }
 
-impl ShadowMaps {
-    /// The maps and light-view streams of `opts` over `scene`; `layout` is the receivers'
-    /// layout of the stream that will read them. Sizes are checked against the device
-    /// before anything is allocated.
+/// What the maps need of a cascade's light view (the quad stream of the light, which
+/// `crate::stream` makes and implements this for).
+pub trait LightView {
+    /// The view's camera uniform, into which the cascade's light camera is copied.
+    fn camera_buffer(&self) -> &wgpu::Buffer;
+    /// The view's cull and refine.
+    fn encode_view_compute(&self, encoder: &mut wgpu::CommandEncoder);
+    /// Timestamp writes of the casting pass.
+    fn cast_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>>;
+    /// What the casting pass draws from: the final stream's draw group and the arguments.
+    fn cast_parts(&self) -> (&wgpu::BindGroup, &wgpu::Buffer);
+    /// Resolve the frame's queries.
+    fn resolve_cast(&self, encoder: &mut wgpu::CommandEncoder);
+    /// Refine (the quad stream) or not (static impostors).
+    fn set_refine(&mut self, refine: bool);
+    /// Counters of the last submitted frame (waits for the GPU).
+    fn read_stats(&self, ctx: &crate::GpuContext) -> FrameStats;
+    /// Counters of a recent frame without waiting.
+    fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<FrameStats>;
+    /// Grow after a frame that overflowed; whether the buffers were rebuilt.
+    fn fit(&mut self, device: &wgpu::Device, stats: &FrameStats) -> Result<bool, RenderError>;
+    /// Bytes of the view's own buffers.
+    fn view_bytes(&self) -> u64;
+}
+
+/// The options a cascade's light-view stream is built with for maps of `opts`: the map's
+/// side as its viewport, the light views' ε, and a small first overdraw.
+pub fn light_view_options(opts: &ShadowOptions) -> RendererOptions {
+    RendererOptions {
+        viewport: (opts.resolution, opts.resolution),
+        min_epsilon: opts.epsilon,
+        overdraw: LIGHT_OVERDRAW,
+        ..Default::default()
+    }
+}
+
+impl<V: LightView> ShadowMaps<V> {
+    /// The maps of `opts` (`layout`: the receivers' layout of the view that reads them; `band`
+    /// the scene's receivers), cast by `streams`, one light view per cascade
+    /// ([`light_view_options`]). Sizes are checked against the device before anything is
+    /// allocated.
     pub fn new(
         device: &wgpu::Device,
-        scene: Arc<GpuScene>,
         opts: &ShadowOptions,
         layout: &wgpu::BindGroupLayout,
+        band: crate::shadow::ReceiverBand,
+        streams: impl FnMut() -> Result<V, RenderError>,
     ) -> Result<Self, RenderError> {
-        let targets = Arc::new(ShadowTargets::new(device, opts, layout, scene.band)?);
-        let stream_opts = RendererOptions {
-            viewport: (opts.resolution, opts.resolution),
-            min_epsilon: opts.epsilon,
-            overdraw: LIGHT_OVERDRAW,
-            ..Default::default()
-        };
-        let streams = (0..opts.cascades)
-            .map(|_| QuadStream::new(device, scene.clone(), &stream_opts))
+        let targets = Arc::new(ShadowTargets::new(device, opts, layout, band)?);
+        let streams = std::iter::repeat_with(streams)
+            .take(opts.cascades as usize)
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             targets,
@@ -203,7 +233,7 @@ impl ShadowMaps {
     }
 
     /// The light-view streams, one per cascade (their counters: [`Self::stats`]).
-    pub fn streams(&self) -> &[QuadStream] {
+    pub fn streams(&self) -> &[V] {
         &self.streams
     }
 
@@ -244,7 +274,7 @@ impl ShadowMaps {
                 c.encode_light(encoder, k);
             }
             let ts = if quads {
-                crate::view::Form::draw_timestamps(stream)
+                stream.cast_timestamps()
             } else {
                 None
             };
@@ -258,7 +288,7 @@ impl ShadowMaps {
             }
             drop(pass);
             if quads {
-                crate::view::ForestView::resolve_times(stream, encoder);
+                stream.resolve_cast(encoder);
             }
         }
     }
@@ -295,7 +325,7 @@ impl ShadowMaps {
             .collect()
     }
 
-    /// Grow every light-view stream whose last frame overflowed (see [`QuadStream::fit`]);
+    /// Grow every light-view stream whose last frame overflowed (see [`LightView::fit`]);
     /// whether any grew (the frame should then be drawn again).
     pub fn fit(&mut self, ctx: &crate::GpuContext) -> Result<bool, RenderError> {
         let mut grew = false;

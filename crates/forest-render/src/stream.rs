@@ -15,62 +15,20 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use wgpu::util::DeviceExt;
 
 use crate::camera::Camera;
-use crate::capacity::{Capacity, CapacityInput};
+use crate::capacity::Capacity;
 use crate::context::{GpuContext, RenderError};
 use crate::frame::Targets;
-use crate::gpu_types::{GpuArgs, GpuCamera, GpuState, Quad, SceneConsts};
+use crate::gpu_types::{GpuCamera, GpuState, Quad};
 use crate::options::{Atmosphere, Background, DebugView, RendererOptions, StreamOptions};
 use crate::passes::ComputeShared;
 use crate::passes::cull::CullPass;
 use crate::passes::draw::DrawPass;
 use crate::passes::refine::RefinePass;
 use crate::scene::GpuScene;
-use crate::stats::{FrameStats, PassTimes, StatsRing};
+use crate::stats::FrameStats;
+use crate::stream_buffers::{CAMERA_BYTES, Passes, Sized, buffer, capacity, readback};
 use crate::view::{ForestView, Form};
 use crate::work::{CountingPass, FrameWork, StatisticsQueries};
-
-/// Bytes of the resolved timestamps (six queries).
-const TIMESTAMP_BYTES: u64 = 48;
-
-/// The pipelines (built once per stream).
-struct Passes {
-    shared: ComputeShared,
-    cull: CullPass,
-    refine: RefinePass,
-    draw: DrawPass,
-}
-
-/// Everything whose size follows the capacity: rebuilt by [`QuadStream::resize`].
-struct Sized {
-    state: wgpu::Buffer,
-    args: wgpu::Buffer,
-    quads: [wgpu::Buffer; 2],
-    bg_cull: wgpu::BindGroup,
-    bg_ab: wgpu::BindGroup,
-    bg_ba: wgpu::BindGroup,
-    bg_draw: [wgpu::BindGroup; 2],
-    args_group: wgpu::BindGroup,
-    ring: StatsRing,
-    owned: Vec<(&'static str, wgpu::Buffer)>,
-    /// Bytes of the view's own buffers (the scene's are in `GpuScene::bytes`).
-    view_bytes: u64,
-}
-
-/// The query results read back with the counters, in this order: timestamps, then pipeline
-/// statistics, each where the device has them.
-fn readback<'a>(
-    times: Option<&'a (wgpu::QuerySet, wgpu::Buffer)>,
-    statistics: Option<&'a StatisticsQueries>,
-) -> Vec<(&'a wgpu::Buffer, u64)> {
-    let mut out = Vec::new();
-    if let Some((_, b)) = times {
-        out.push((b, TIMESTAMP_BYTES));
-    }
-    if let Some(q) = statistics {
-        out.push((&q.resolve, crate::work::STATISTICS_BYTES));
-    }
-    out
-}
 
 /// The quad stream of one view over a shared scene.
 pub struct QuadStream {
@@ -100,45 +58,11 @@ pub struct QuadStream {
     /// Replaces `options.opaque_first` in the frames drawn ([`Self::set_opaque_override`]).
     opaque_override: Option<bool>,
     /// The sun's shadow maps, when on ([`Self::set_shadows`]).
-    shadows: Option<crate::shadow_maps::ShadowMaps>,
+    shadows: Option<crate::shadow_maps::ShadowMaps<QuadStream>>,
     /// The last maps switched off, kept for switching them on again.
-    parked: Option<crate::shadow_maps::ShadowMaps>,
+    parked: Option<crate::shadow_maps::ShadowMaps<QuadStream>>,
     /// The casting pipeline into a host's map ([`Self::prepare_light`]).
     host_cast: Option<crate::passes::cast::CastPass>,
-}
-
-/// Bytes of the camera buffer: the view's camera, then a light-view camera per cascade
-/// (written together, the frame's one upload; see [`crate::shadow_maps`]).
-const CAMERA_BYTES: usize =
-    std::mem::size_of::<GpuCamera>() * (1 + crate::shadow::MAX_CASCADES as usize);
-
-fn buffer(
-    device: &wgpu::Device,
-    label: &str,
-    size: u64,
-    usage: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size.max(16),
-        usage,
-        mapped_at_creation: false,
-    })
-}
-
-/// The capacity of `opts`, and at least `grown` quads (what [`QuadStream::fit`] found frames
-/// need) unless the options fix it.
-fn capacity(scene: &GpuScene, opts: &RendererOptions, grown: u32) -> Capacity {
-    let t = &scene.tables;
-    Capacity::new(&CapacityInput {
-        instances: t.instances.len() as u32,
-        quads_per_tree: t.quads_per_tree.max(1),
-        viewport: opts.viewport,
-        min_epsilon: opts.min_epsilon,
-        overdraw: opts.overdraw,
-        max_quads: opts.max_quads,
-        grown,
-    })
 }
 
 impl QuadStream {
@@ -201,13 +125,13 @@ impl QuadStream {
                 let resolve = buffer(
                     device,
                     "timestamps",
-                    TIMESTAMP_BYTES,
+                    crate::stream_buffers::TIMESTAMP_BYTES,
                     U::QUERY_RESOLVE | U::COPY_SRC,
                 );
                 (set, resolve)
             });
         let statistics = StatisticsQueries::new(device);
-        let sized = Self::build_sized(
+        let sized = crate::stream_buffers::build_sized(
             device,
             &scene,
             &passes,
@@ -284,7 +208,7 @@ impl QuadStream {
     /// after [`Self::prepare_light`] and [`Self::encode_compute`].
     pub fn render_depth(&self, pass: &mut wgpu::RenderPass) {
         if let Some(cast) = &self.host_cast {
-            let (group, args) = self.cast_parts();
+            let (group, args) = crate::shadow_maps::LightView::cast_parts(self);
             cast.record(pass, group, args);
         }
     }
@@ -318,11 +242,13 @@ impl QuadStream {
                     self.parked = self.shadows.take();
                     self.shadows = maps;
                 } else {
+                    let light = crate::shadow_maps::light_view_options(&o);
                     let mut maps = crate::shadow_maps::ShadowMaps::new(
                         device,
-                        self.scene.clone(),
                         &o,
                         &self.passes.draw.shadow_layout,
+                        self.scene.band,
+                        || QuadStream::new(device, self.scene.clone(), &light),
                     )?;
                     maps.set_refine(self.iterations > 0);
                     self.shadows = Some(maps);
@@ -342,252 +268,18 @@ impl QuadStream {
     }
 
     /// The shadow maps, when shadows are on.
-    pub fn shadows(&self) -> Option<&crate::shadow_maps::ShadowMaps> {
+    pub fn shadows(&self) -> Option<&crate::shadow_maps::ShadowMaps<QuadStream>> {
         self.shadows.as_ref()
     }
 
     /// The shadow maps, when shadows are on (to poll and grow their light views).
-    pub fn shadows_mut(&mut self) -> Option<&mut crate::shadow_maps::ShadowMaps> {
+    pub fn shadows_mut(&mut self) -> Option<&mut crate::shadow_maps::ShadowMaps<QuadStream>> {
         self.shadows.as_mut()
-    }
-
-    /// The camera buffer (a light-view stream's is filled by copies, see
-    /// [`crate::shadow_maps`]).
-    pub(crate) fn camera_buffer(&self) -> &wgpu::Buffer {
-        self.inputs.camera()
-    }
-
-    /// What the casting pass draws from: the final stream's draw group and the indirect
-    /// arguments.
-    pub(crate) fn cast_parts(&self) -> (&wgpu::BindGroup, &wgpu::Buffer) {
-        (
-            &self.sized.bg_draw[(self.iterations % 2) as usize],
-            &self.sized.args,
-        )
     }
 
     /// Bytes of the view's own buffers (not the scene's).
     pub fn view_bytes(&self) -> u64 {
         self.sized.view_bytes
-    }
-
-    /// The per-view buffers and bind groups for `capacity`, checked against the device's
-    /// limits before anything is allocated.
-    fn build_sized(
-        device: &wgpu::Device,
-        scene: &GpuScene,
-        passes: &Passes,
-        camera: &wgpu::Buffer,
-        environment: &wgpu::Buffer,
-        capacity: &Capacity,
-        readback: &[(&wgpu::Buffer, u64)],
-    ) -> Result<Sized, RenderError> {
-        let limit = crate::error::storage_limit(&device.limits());
-        let quad_bytes = u64::from(capacity.quads) * std::mem::size_of::<Quad>() as u64;
-        crate::error::within_limit(
-            || format!("a stream of {} quads (bytes per buffer)", capacity.quads),
-            quad_bytes,
-            limit,
-            ": lower the viewport or raise the minimum epsilon",
-        )?;
-        let t = &scene.tables;
-        use wgpu::BufferUsages as U;
-        let consts = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene constants"),
-            contents: bytemuck::bytes_of(&SceneConsts {
-                instances: t.instances.len() as u32,
-                presort_dirs: t.presort_dirs.len() as u32,
-                capacity: capacity.quads,
-                species: t.species.len() as u32,
-            }),
-            usage: U::UNIFORM,
-        });
-        let state = buffer(
-            device,
-            "state",
-            std::mem::size_of::<GpuState>() as u64,
-            U::STORAGE | U::COPY_SRC,
-        );
-        let args = buffer(
-            device,
-            "args",
-            std::mem::size_of::<GpuArgs>() as u64,
-            U::STORAGE | U::INDIRECT,
-        );
-        let args_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("indirect arguments"),
-            layout: &passes.shared.args_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: args.as_entire_binding(),
-            }],
-        });
-        // Scan data of the current step and the next one: `data[0]` holds the cull's tree
-        // counts (instances) and the wishes of every other step, `data[1]` the others'.
-        let data = [
-            buffer(
-                device,
-                "scan data A",
-                u64::from(capacity.items) * 4,
-                U::STORAGE,
-            ),
-            buffer(
-                device,
-                "scan data B",
-                u64::from(capacity.quads) * 4,
-                U::STORAGE,
-            ),
-        ];
-        let sums = buffer(
-            device,
-            "block sums",
-            u64::from(capacity.sums) * 4,
-            U::STORAGE,
-        );
-        let quads = [0, 1].map(|k| {
-            buffer(
-                device,
-                if k == 0 { "stream A" } else { "stream B" },
-                quad_bytes,
-                U::STORAGE | U::COPY_SRC,
-            )
-        });
-        let presort_view = scene.presort.create_view(&Default::default());
-        let nodes_view = scene.nodes.create_view(&Default::default());
-        let compute_bg = |label: &str, (d_in, d_out): (usize, usize), q: (usize, usize)| {
-            let res: [wgpu::BindingResource; 16] = [
-                camera.as_entire_binding(),
-                consts.as_entire_binding(),
-                scene.instances.as_entire_binding(),
-                scene.species.as_entire_binding(),
-                scene.frames.as_entire_binding(),
-                scene.tris.as_entire_binding(),
-                scene.roots.as_entire_binding(),
-                scene.presort_dirs.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&presort_view),
-                wgpu::BindingResource::TextureView(&nodes_view),
-                state.as_entire_binding(),
-                data[d_out].as_entire_binding(),
-                data[d_in].as_entire_binding(),
-                sums.as_entire_binding(),
-                quads[q.0].as_entire_binding(),
-                quads[q.1].as_entire_binding(),
-            ];
-            let entries = crate::passes::numbered(res.into());
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout: &passes.shared.bind_layout,
-                entries: &entries,
-            })
-        };
-        // (data in, data out), (quads in, quads out): the cull reads tree counts from data A
-        // and writes stream A with its wishes in data B; the steps then alternate.
-        let bg_cull = compute_bg("cull", (0, 1), (1, 0));
-        let bg_ab = compute_bg("refine A->B", (1, 0), (0, 1));
-        let bg_ba = compute_bg("refine B->A", (0, 1), (1, 0));
-        let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let surface_view = scene.surface.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let opacity_view = scene.opacity.create_view(&Default::default());
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("colour"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
-        // One draw group per stream buffer: the final stream is A after an even number of
-        // refinement iterations, B after an odd one (refinement can be switched at run time).
-        let bg_draw = [&quads[0], &quads[1]].map(|final_quads| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("draw"),
-                layout: &passes.draw.bind_layout,
-                entries: &[
-                    crate::passes::numbered(vec![
-                        camera.as_entire_binding(),
-                        scene.instances.as_entire_binding(),
-                        scene.species.as_entire_binding(),
-                        scene.frames.as_entire_binding(),
-                        final_quads.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&nodes_view),
-                        wgpu::BindingResource::TextureView(&colour_view),
-                        wgpu::BindingResource::Sampler(&sampler),
-                        environment.as_entire_binding(),
-                        scene.roots.as_entire_binding(),
-                        state.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&surface_view),
-                    ]),
-                    vec![
-                        wgpu::BindGroupEntry {
-                            binding: crate::terrain::HEIGHTS_BINDING,
-                            resource: scene.terrain.heights.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: crate::passes::draw::OPACITY_BINDING,
-                            resource: wgpu::BindingResource::TextureView(&opacity_view),
-                        },
-                    ],
-                ]
-                .concat(),
-            })
-        });
-        let mut sources = vec![(state.clone(), std::mem::size_of::<GpuState>() as u64)];
-        sources.extend(readback.iter().map(|(b, n)| ((*b).clone(), *n)));
-        let ring = StatsRing::new(device, sources);
-        let view_bytes = [
-            camera,
-            &consts,
-            environment,
-            &state,
-            &args,
-            &data[0],
-            &data[1],
-            &sums,
-            &quads[0],
-            &quads[1],
-        ]
-        .iter()
-        .map(|b| b.size())
-        .sum::<u64>();
-        let owned: Vec<(&'static str, wgpu::Buffer)> = [
-            ("camera", camera),
-            ("scene constants", &consts),
-            ("environment", environment),
-            ("state", &state),
-            ("args", &args),
-            ("scan data A", &data[0]),
-            ("scan data B", &data[1]),
-            ("block sums", &sums),
-            ("stream A", &quads[0]),
-            ("stream B", &quads[1]),
-            ("instances", &scene.instances),
-            ("species", &scene.species),
-            ("frames", &scene.frames),
-            ("direction triangles", &scene.tris),
-            ("roots", &scene.roots),
-            ("presort directions", &scene.presort_dirs),
-        ]
-        .into_iter()
-        .map(|(l, b)| (l, b.clone()))
-        .collect();
-        Ok(Sized {
-            state,
-            args,
-            quads,
-            bg_cull,
-            bg_ab,
-            bg_ba,
-            bg_draw,
-            args_group,
-            ring,
-            owned,
-            view_bytes,
-        })
     }
 
     /// Resize for a new largest viewport: the stream, scan and counter buffers are rebuilt
@@ -623,7 +315,7 @@ impl QuadStream {
 
     /// The view's own buffers rebuilt for `capacity` (the scene is kept).
     fn rebuild(&mut self, device: &wgpu::Device, capacity: Capacity) -> Result<(), RenderError> {
-        self.sized = Self::build_sized(
+        self.sized = crate::stream_buffers::build_sized(
             device,
             &self.scene,
             &self.passes,
@@ -881,45 +573,17 @@ impl QuadStream {
         statistics: Option<&[u8]>,
         period: f32,
     ) -> FrameStats {
-        let mut s = GpuState::default();
-        let n = state.len().min(std::mem::size_of::<GpuState>());
-        bytemuck::bytes_of_mut(&mut s)[..n].copy_from_slice(&state[..n]);
-        let levels = self
-            .scene
-            .tables
-            .max_levels
-            .clamp(1, s.per_level.len() as u32) as usize;
-        let times = times
-            .filter(|t| t.len() >= TIMESTAMP_BYTES as usize)
-            .map(|t| {
-                let t: Vec<u64> = bytemuck::pod_collect_to_vec(&t[..TIMESTAMP_BYTES as usize]);
-                let ms = |a: usize| t[a + 1].saturating_sub(t[a]) as f64 * f64::from(period) / 1e6;
-                PassTimes {
-                    cull_ms: ms(0),
-                    refine_ms: ms(2),
-                    draw_ms: ms(4),
-                }
-            });
-        FrameStats {
-            presort: s.presort,
-            visible_trees: s.visible,
-            quads: s.quads,
-            composites: crate::gpu_types::kept_composites(s.composites, s.overflow_cull),
-            per_level: s.per_level[..levels].to_vec(),
-            overflow_cull: s.overflow_cull,
-            overflow_refine: s.overflow_refine,
-            times,
-            work: FrameWork {
-                dispatches: self.recorded.0.load(Ordering::Relaxed),
-                draws: self.recorded.1.load(Ordering::Relaxed),
-                passes: statistics
-                    .filter(|_| self.inputs.gathers_statistics())
-                    .and_then(crate::work::decode),
-                bytes: self.scene.bytes
-                    + self.sized.view_bytes
-                    + self.shadows.as_ref().map_or(0, |s| s.bytes()),
-            },
-        }
+        let work = FrameWork {
+            dispatches: self.recorded.0.load(Ordering::Relaxed),
+            draws: self.recorded.1.load(Ordering::Relaxed),
+            passes: statistics
+                .filter(|_| self.inputs.gathers_statistics())
+                .and_then(crate::work::decode),
+            bytes: self.scene.bytes
+                + self.sized.view_bytes
+                + self.shadows.as_ref().map_or(0, |s| s.bytes()),
+        };
+        crate::stream_buffers::frame_stats(state, times, self.scene.tables.max_levels, period, work)
     }
 
     /// Counters (and pass times) of the last submitted frame; waits for the GPU (tests,
@@ -929,7 +593,7 @@ impl QuadStream {
         let times = self
             .queries
             .as_ref()
-            .map(|(_, resolve)| ctx.read_buffer(resolve, TIMESTAMP_BYTES));
+            .map(|(_, resolve)| ctx.read_buffer(resolve, crate::stream_buffers::TIMESTAMP_BYTES));
         let statistics = self
             .statistics
             .as_ref()
@@ -1050,5 +714,51 @@ impl crate::view::Form for QuadStream {
         if let Some(q) = self.counting() {
             q.resolve(encoder);
         }
+    }
+}
+
+/// A quad stream casting one cascade of another view's shadow maps.
+impl crate::shadow_maps::LightView for QuadStream {
+    fn camera_buffer(&self) -> &wgpu::Buffer {
+        self.inputs.camera()
+    }
+
+    fn encode_view_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        QuadStream::encode_view_compute(self, encoder);
+    }
+
+    fn cast_timestamps(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        Form::draw_timestamps(self)
+    }
+
+    fn cast_parts(&self) -> (&wgpu::BindGroup, &wgpu::Buffer) {
+        (
+            &self.sized.bg_draw[(self.iterations % 2) as usize],
+            &self.sized.args,
+        )
+    }
+
+    fn resolve_cast(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.resolve_times(encoder);
+    }
+
+    fn set_refine(&mut self, refine: bool) {
+        QuadStream::set_refine(self, refine);
+    }
+
+    fn read_stats(&self, ctx: &GpuContext) -> FrameStats {
+        QuadStream::read_stats(self, ctx)
+    }
+
+    fn poll_stats(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<FrameStats> {
+        QuadStream::poll_stats(self, device, queue)
+    }
+
+    fn fit(&mut self, device: &wgpu::Device, stats: &FrameStats) -> Result<bool, RenderError> {
+        QuadStream::fit(self, device, stats)
+    }
+
+    fn view_bytes(&self) -> u64 {
+        QuadStream::view_bytes(self)
     }
 }
