@@ -38,6 +38,7 @@ pub mod mesh;
 pub mod model;
 pub mod opacity;
 pub mod quadtree;
+mod sampling;
 pub mod shadowing;
 pub mod sky;
 pub mod texture;

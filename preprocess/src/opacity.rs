@@ -14,8 +14,8 @@ use rayon::prelude::*;
 use forest_format::opacity::{LEAF_PROJECTION, OpacityVolume};
 use forest_format::slab::Sphere;
 
-use crate::ldi::stratified_barycentric;
 use crate::mesh::Mesh;
+use crate::sampling::stratified_barycentric;
 
 /// Sample points per voxel face of triangle area.
 pub const POINTS_PER_VOXEL_AREA: f32 = 16.0;

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use forest_format::slab::Sphere;
 
-use crate::ldi::{hash, stratified_barycentric, unit};
+use crate::sampling::{hash, stratified_barycentric, unit};
 use crate::trace::Scene;
 
 /// Points per triangle.

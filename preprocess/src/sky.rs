@@ -12,7 +12,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::ldi::{hash, unit};
+use crate::sampling::{hash, unit};
 use crate::trace::Scene;
 
 /// Points per side of the stratification grid: `SIDE²` rays per triangle side.

@@ -90,9 +90,7 @@ impl Presort {
     }
 }
 
-/// Largest coordinate of a tree (metres from the origin on any axis): far enough for any
-/// forest, near enough that far planes and camera matrices stay finite in single precision.
-pub const MAX_COORDINATE: f32 = 1.0e7;
+pub use crate::limits::MAX_COORDINATE;
 
 /// Smallest instance scale: a model shrunk more than this many times is no tree.
 pub const MIN_SCALE: f32 = 1e-4;

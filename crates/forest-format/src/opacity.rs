@@ -232,7 +232,7 @@ impl OpacityVolume {
     /// `k·resolution ..`.
     pub fn encode_png(&self) -> Vec<u8> {
         let r = self.resolution;
-        crate::atlas::encode_png(r, r * r, &self.codes, image::ExtendedColorType::L8)
+        crate::atlas::codecs::encode_png(r, r * r, &self.codes, image::ExtendedColorType::L8)
     }
 
     /// Decode [`Self::encode_png`]'s bytes (`file` names them in errors) of a volume with

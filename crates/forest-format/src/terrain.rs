@@ -14,12 +14,12 @@
 use std::path::Path;
 
 use crate::error::FormatError;
-use crate::generate::value_noise;
+use crate::noise::value_noise;
 
 /// Most samples along either side of a height field (4097 × 4097 heights are 64 MiB).
 pub const MAX_SIDE: u32 = 4097;
 /// Largest height magnitude (metres): higher than any mountain, low enough that every
-/// coordinate stays within [`crate::forest::MAX_COORDINATE`].
+/// coordinate stays within [`crate::limits::MAX_COORDINATE`].
 pub const MAX_HEIGHT: f32 = 20_000.0;
 
 /// A height field: see the module documentation.
@@ -102,10 +102,10 @@ impl Terrain {
             .iter()
             .map(|&(o, n)| o.abs().max((o + self.spacing * (n - 1) as f32).abs()))
             .fold(0.0, f32::max);
-        if far.is_nan() || far > crate::forest::MAX_COORDINATE {
+        if far.is_nan() || far > crate::limits::MAX_COORDINATE {
             return Err(format!(
                 "the height field reaches {far} m from the origin, farther than {} m",
-                crate::forest::MAX_COORDINATE
+                crate::limits::MAX_COORDINATE
             ));
         }
         if let Some(k) = self

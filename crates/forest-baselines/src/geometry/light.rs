@@ -9,7 +9,7 @@ use std::sync::Arc;
 use forest_render::passes::cast::cast_pipeline;
 use forest_render::shadow_maps::ShadowTargets;
 
-use super::renderer::{Shared, View};
+use super::views::{Shared, View};
 
 /// The light views of every cascade and the maps they cast into.
 pub(super) struct LightViews {

@@ -23,6 +23,7 @@ mod params;
 mod prepare;
 mod renderer;
 mod textures;
+mod views;
 
 pub use forest_format::model::BILLBOARD_RESOLUTION;
 pub use layout::{COMPUTE_SLOTS, compute_entries, draw_entries};

@@ -167,7 +167,7 @@ impl GpuModels {
                 what: "models",
             });
         }
-        super::renderer::require_indirect_first_instance(ctx)?;
+        require_indirect_first_instance(ctx)?;
         let device = &ctx.device;
         check_limits(&device.limits(), prepared, forest.instances.len())?;
         let capacity = GeometryCapacity::new(
@@ -317,5 +317,22 @@ impl GpuModels {
     /// Per-species figures, in the forest's species order.
     pub fn figures(&self) -> &[SpeciesFigures] {
         &self.figures
+    }
+}
+
+/// The geometry renderer draws each segment with an indirect draw whose first instance is
+/// the segment's offset in the visible list.
+pub(super) fn require_indirect_first_instance(ctx: &GpuContext) -> Result<(), RenderError> {
+    if ctx
+        .device
+        .features()
+        .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
+    {
+        Ok(())
+    } else {
+        Err(RenderError::MissingFeature {
+            method: "the geometry renderer",
+            feature: "indirect draws with a first instance (INDIRECT_FIRST_INSTANCE)",
+        })
     }
 }

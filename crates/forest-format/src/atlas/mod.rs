@@ -19,7 +19,7 @@
 //! [`Atlas::save`] writes to a temporary folder and renames it into place, so a reader never
 //! sees half an atlas; [`Atlas::load`] checks the version and every size and count.
 
-mod codecs;
+pub(crate) mod codecs;
 mod manifest;
 mod params;
 mod surface;
