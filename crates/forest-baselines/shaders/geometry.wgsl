@@ -128,7 +128,7 @@ fn geo_scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     let inst = instances[i];
     let sp = geo_species[inst.species];
     let centre = to_world(inst, sp.sphere.xyz);
-    let bin = order_bin(to_object_dir(inst, centre - camera.eye.xyz));
+    let bin = order_bin(to_object_dir(inst, centre - camera.eye));
     let entry = i | (bin << VISIBLE_ID_BITS);
     visible_list[atomicAdd(&cursor[key], 1u)] = entry;
     // A tree in a crossfade between mesh LODs: its other LODs' segments.

@@ -128,7 +128,7 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
     out.world = w;
     out.uv = v.uv;
     out.normal = to_world_dir(inst, v.normal);
-    out.to_eye = camera.eye.xyz - w;
+    out.to_eye = camera.eye - w;
     out.sky = vec2<f32>(v.sky_front, v.sky_back);
     out.material = v.material;
     out.contrast = contrast;
@@ -138,7 +138,7 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
     out.sun_vis = 1.0;
     if (shaded) {
         out.sun_vis = sun_transmittance(opacity, opacity_sampler, inst.species, sp.sphere,
-                                        sp.opacity_depth, p, to_object_dir(inst, camera.sun.xyz));
+                                        sp.opacity_depth, p, to_object_dir(inst, camera.sun));
     }
     return out;
 }
@@ -208,7 +208,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     let sp = geo_species[inst.species];
     let c = to_world(inst, sp.sphere.xyz);
     let r = sp.sphere.w * inst.scale;
-    let f = normalize(c - camera.eye.xyz);
+    let f = normalize(c - camera.eye);
     var right = cross(f, vec3<f32>(0.0, 1.0, 0.0));
     if (dot(right, right) < 1e-8) { right = vec3<f32>(1.0, 0.0, 0.0); }
     right = normalize(right);
@@ -232,7 +232,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.obj = to_object_point(inst, out.world);
     out.sphere = sp.sphere;
     out.species = inst.species;
-    out.sun_obj = vec4<f32>(to_object_dir(inst, camera.sun.xyz), sp.opacity_depth);
+    out.sun_obj = vec4<f32>(to_object_dir(inst, camera.sun), sp.opacity_depth);
     out.view_obj = to_object_dir(inst, f);
     out.tree = vec4<f32>(c, r);
     return out;

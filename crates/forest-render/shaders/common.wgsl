@@ -3,16 +3,22 @@
 
 struct Camera {
     view_proj: mat4x4<f32>,
-    // xyz: eye position (world, metres); w: epsilon, the refinement threshold in pixels.
-    eye: vec4<f32>,
-    // xyz: unit view direction (world); w: the far span K, in units of ε: a tree narrower
-    // than K·ε pixels whose nearest aspect's parallax stays within ε is a far tree
-    // (StreamOptions::far_span, tree_class in cull.wgsl).
-    forward: vec4<f32>,
-    // x, y: viewport size in pixels; z: debug view of the draw pass (0 off, 1 levels,
-    // 2 blend weights, 3 wireframe; see renderer::DebugView); w: stream flags (FLAG_*, see
-    // renderer::StreamOptions).
-    viewport: vec4<f32>,
+    // Eye position (world, metres).
+    eye: vec3<f32>,
+    // The refinement threshold ε, in pixels.
+    epsilon: f32,
+    // Unit view direction (world).
+    forward: vec3<f32>,
+    // The far span K, in units of ε: a tree narrower than K·ε pixels whose nearest aspect's
+    // parallax stays within ε is a far tree (StreamOptions::far_span, tree_class in cull.wgsl).
+    far_span: f32,
+    // Viewport size in pixels.
+    viewport: vec2<f32>,
+    // Debug view of the draw pass (0 off, 1 levels, 2 blend weights, 3 wireframe; see
+    // forest_render::options::DebugView).
+    debug_view: f32,
+    // Stream flags (FLAG_*, see forest_render::options::StreamOptions).
+    stream_flags: f32,
     // Frustum planes (xyz·p + w >= 0 inside), world space, normals unit length.
     planes: array<vec4<f32>, 6>,
     // Which form draws each tree (the hybrid method, see quad_share): x metres + y focal
@@ -20,9 +26,10 @@ struct Camera {
     // fraction of it; w: the per-instance jitter of the band's start, a fraction of the switch
     // distance. (0, 0, ·, ·): every tree is drawn as quads; x ≥ 3e38: every tree as geometry.
     forms: vec4<f32>,
-    // The light (forest_format::shading::Lighting), world space, linear RGB. xyz: unit
-    // direction towards the sun; w: exposure.
-    sun: vec4<f32>,
+    // The light (forest_format::shading::Lighting), world space, linear RGB: the unit
+    // direction towards the sun, and the exposure every radiance is scaled by.
+    sun: vec3<f32>,
+    exposure: f32,
     // xyz: sun irradiance; w unused.
     sun_colour: vec4<f32>,
     // xyz: sky irradiance on a surface facing up; w unused.
@@ -36,9 +43,12 @@ struct Camera {
     shadow_splits: vec4<f32>,
     shadow_texel: vec4<f32>,
     shadow_bias: vec4<f32>,
-    // x: cascades in use (0: no shadows); y: the map's side (texels); z: the receivers'
-    // offset (texels); w: 1 for reverse-Z maps (a host's), else 0.
-    shadow_params: vec4<f32>,
+    // Cascades in use (0: no shadows), the maps' side (texels), the receivers' offset
+    // (texels), and 1 for reverse-Z maps (a host's), else 0.
+    shadow_cascades: f32,
+    shadow_side: f32,
+    shadow_offset: f32,
+    shadow_reverse_z: f32,
     // xyz: the eye whose distances choose each tree's form and level of detail (eye, except in
     // a light view: the eye of the view it casts for); w unused.
     form_eye: vec4<f32>,
@@ -55,7 +65,7 @@ struct Camera {
 // inside every plane; each plane's test is offset by the sweep's reach across it. A view
 // camera's zero planes pass every tree (forest_render::shadow::casts_into is the CPU mirror).
 fn casts_into(c: vec3<f32>, r: f32) -> bool {
-    let sun = camera.sun.xyz;
+    let sun = camera.sun;
     var sweep = camera.caster_floor.y;
     if (sun.y > 1e-3) { sweep = min(sweep, max(c.y + r - camera.caster_floor.x, 0.0) / sun.y); }
     for (var k = 0u; k < 6u; k++) {
@@ -69,11 +79,11 @@ fn casts_into(c: vec3<f32>, r: f32) -> bool {
 // `a`, unit world normal `n` facing the viewer, sun visibility `v`, sky visibility `s`,
 // translucency `tau`, under the frame's light; linear RGB, exposure applied.
 fn shade_light(a: vec3<f32>, n: vec3<f32>, v: f32, s: f32, tau: f32) -> vec3<f32> {
-    let ndl = dot(n, camera.sun.xyz);
+    let ndl = dot(n, camera.sun);
     let direct = max(ndl, 0.0) + tau * max(-ndl, 0.0);
     let hemi = 0.5 + 0.5 * n.y;
     let ambient = (camera.sky_light.rgb * hemi + camera.ground_light.rgb * (1.0 - hemi)) * s;
-    return a * (ambient + camera.sun_colour.rgb * (v * direct)) * camera.sun.w;
+    return a * (ambient + camera.sun_colour.rgb * (v * direct)) * camera.exposure;
 }
 
 // The march towards the sun through a tree's opacity volume (mirrors
@@ -297,7 +307,7 @@ struct Args {
 
 const WG: u32 = 256u;
 const WEIGHT_ONE: u32 = 4095u;
-// Stream flags in camera.viewport.w; mirror renderer::FLAG_*.
+// Stream flags in camera.stream_flags; mirror forest_render::options::FLAG_*.
 const FLAG_DITHER: u32 = 1u;
 const FLAG_NEAREST: u32 = 2u;
 const FLAG_DEPTH_ERROR: u32 = 4u;
@@ -334,7 +344,7 @@ fn quad_dir(q: Quad) -> u32 { return q.dir_weight & 255u; }
 fn quad_lo(q: Quad) -> u32 { return (q.dir_weight >> 8u) & 4095u; }
 fn quad_hi(q: Quad) -> u32 { return q.dir_weight >> 20u; }
 fn pack_dir(dir: u32, lo: u32, hi: u32) -> u32 { return dir | (lo << 8u) | (hi << 20u); }
-fn stream_flags(c: Camera) -> u32 { return u32(c.viewport.w); }
+fn stream_flags(c: Camera) -> u32 { return u32(c.stream_flags); }
 
 // Slab-relative depth error bound of a node's 4-bit code (forest_format::node::ERROR_BOUNDS).
 fn node_error(node: vec2<u32>) -> f32 {

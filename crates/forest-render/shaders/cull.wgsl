@@ -128,8 +128,8 @@ fn tree_class(c: vec3<f32>, r: f32, v: vec3<f32>, nd: vec3<f32>) -> u32 {
     let fy = m[0].y * m[0].y + m[1].y * m[1].y + m[2].y * m[2].y;
     let half = camera.viewport.y * 0.5;
     let d = 2.0 * r * half;
-    let e = camera.eye.w * w;
-    let span = camera.forward.w * e;
+    let e = camera.epsilon * w;
+    let span = camera.far_span * e;
     let s2 = d * d * fy;
     let reach = f32((stream_flags(camera) >> REACH_SHIFT) & REACH_MASK);
     if (s2 < span * span) {
@@ -218,7 +218,7 @@ fn tree_quads(inst_id: u32, emit: bool, out: u32, skip: u32, front: u32, last: b
                    inst_id) == 0u) {
         return 0u;
     }
-    let eye_obj = to_object_dir(inst, camera.eye.xyz - centre);
+    let eye_obj = to_object_dir(inst, camera.eye - centre);
     let bl = blend(sp, eye_obj);
     let q = quantise(bl.w);
     let nearest_dir = frames[sp.dir_base + bl.idx[largest(q)]].dir.xyz;
@@ -273,7 +273,7 @@ fn frame_setup(@builtin(local_invocation_index) t: u32) {
     for (var i = t; i < arrayLength(&sums); i = i + WG) { atomicStore(&sums[i], 0u); }
     if (t != 0u) { return; }
     // Presort direction nearest the direction towards the viewer (first on ties).
-    let towards = -camera.forward.xyz;
+    let towards = -camera.forward;
     var best = 0u;
     var best_c = -3.4e38;
     for (var k = 0u; k < scene.presort_dirs; k++) {

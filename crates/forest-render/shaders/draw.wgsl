@@ -234,7 +234,7 @@ fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u
     let q = quads[i];
     var out: QuadOut;
     out.clip = vec4<f32>(2.0, 2.0, 0.5, 1.0);
-    if (quad_slab(q) != 0u || quad_lo(q) != 0u || camera.viewport.z != 0.0) { return out; }
+    if (quad_slab(q) != 0u || quad_lo(q) != 0u || camera.debug_view != 0.0) { return out; }
     // Only nodes mostly opaque: the rest of its fragments the blended draw shades again.
     let share = textureLoad(nodes, vec2<u32>(q.node % NODE_TEX_WIDTH, q.node / NODE_TEX_WIDTH), 0).w;
     if (share < OPAQUE_SHARE_MIN) { return out; }
@@ -244,9 +244,9 @@ fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u
     // eye, at most doubling the distance, keeps every point on its pixel and the
     // interpolation unchanged.
     let slabs = species[instances[q.instance].species].slabs;
-    let reach = distance(v.tree.xyz, camera.eye.xyz);
+    let reach = distance(v.tree.xyz, camera.eye);
     let push = 2.0 * v.tree.w / f32(max(slabs, 1u));
-    let p = camera.eye.xyz + (v.world - camera.eye.xyz) * (1.0 + push / max(reach, push));
+    let p = camera.eye + (v.world - camera.eye) * (1.0 + push / max(reach, push));
     return QuadOut(camera.view_proj * vec4<f32>(p, 1.0), v.uv, v.ids, v.alpha, v.share, v.world,
                    v.frame_right, v.frame_up, v.sun_vis, v.tree);
 }
@@ -285,7 +285,7 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
         // The view ray from the eye through the tree's centre in the direction's frame (the
         // tree spans less than ε pixels: one ray stands for all): moving one unit of
         // slab-relative depth (2r along −dir) shifts uv by (−a/c, b/c) (v runs down).
-        let ray = to_object_dir(inst, to_world(inst, sp.sphere.xyz) - camera.eye.xyz);
+        let ray = to_object_dir(inst, to_world(inst, sp.sphere.xyz) - camera.eye);
         let c = min(dot(ray, f.dir.xyz), -0.2 * length(ray));
         parallax = vec2<f32>(-dot(ray, f.right.xyz) / c, dot(ray, f.up.xyz) / c);
         // All the slabs on the plane through the tree's centre (slab-relative depth of slab
@@ -373,7 +373,7 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
     out.share = vec4<u32>(lo, hi, q.instance, form);
     out.frame_right = to_world_dir(inst, f.right.xyz);
     out.frame_up = to_world_dir(inst, f.up.xyz);
-    let sun_obj = to_object_dir(inst, camera.sun.xyz);
+    let sun_obj = to_object_dir(inst, camera.sun);
     // Stack depth d lies (1 − 2d)·r along the direction from the centre (slab_point); the
     // quad's plane is at d = ½.
     let to_slab = f.dir.xyz * (2.0 * sp.sphere.w);
@@ -419,13 +419,13 @@ fn lit_texel(in: Fragment, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(shade_light(c.rgb * inv, n, in.sun_vis, sky, tau) * c.a, c.a);
 }
 
-// Debug views (camera.viewport.z, see renderer::DebugView): 0 off, 1 levels, 2 blend weights,
+// Debug views (camera.debug_view, see forest_render::options::DebugView): 0 off, 1 levels, 2 blend weights,
 // 3 wireframe.
 const DEBUG_LEVELS: u32 = 1u;
 const DEBUG_WEIGHTS: u32 = 2u;
 const DEBUG_WIREFRAME: u32 = 3u;
 
-// Colour of a hierarchy level; mirrors renderer::LEVEL_COLOURS.
+// Colour of a hierarchy level; mirrors forest_render::options::LEVEL_COLOURS.
 fn level_colour(level: u32) -> vec3<f32> {
     var c = array<vec3<f32>, 8>(
         vec3<f32>(0.9, 0.1, 0.1), vec3<f32>(0.95, 0.55, 0.05), vec3<f32>(0.9, 0.9, 0.1),
@@ -546,7 +546,7 @@ fn shade(in: Fragment, c: vec4<f32>) -> vec4<f32> {
     // Position inside the quad in quad widths and its screen derivative (before any branch).
     let g = in.uv * f32(1u << in.ids.y);
     let px = max(fwidth(g), vec2<f32>(1e-6));
-    let mode = u32(camera.viewport.z);
+    let mode = u32(camera.debug_view);
     if (masked(in.clip.xy, in.share)) { discard; }
     if (mode == DEBUG_LEVELS) {
         return vec4<f32>(level_colour(in.ids.y) * c.a, c.a) * in.alpha;

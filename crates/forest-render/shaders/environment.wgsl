@@ -31,7 +31,7 @@ struct Environment {
 // The haze's optical depth from the eye to `p`: extinction σ₀·exp(−k·y) integrated along the
 // segment (mirrors options::Atmosphere::optical_depth).
 fn optical_depth(p: vec3<f32>) -> f32 {
-    let eye = camera.eye.xyz;
+    let eye = camera.eye;
     let k = env.zenith.w;
     let x = k * (p.y - eye.y);
     var f = exp(-k * eye.y) * (1.0 - 0.5 * x);
@@ -78,7 +78,7 @@ fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
 fn sky(d: vec3<f32>) -> vec3<f32> {
     let up = clamp(d.y, 0.0, 1.0);
     var c = mix(env.horizon.rgb, env.zenith.rgb, sqrt(up)) * sky_tint();
-    let s = dot(d, camera.sun.xyz);
+    let s = dot(d, camera.sun);
     if (env.sun.x <= 1.0) {
         c = c + camera.sun_colour.rgb * (0.25 * pow(max(s, 0.0), 256.0));
         if (s >= env.sun.x) { c = camera.sun_colour.rgb * 1.5; }
@@ -104,7 +104,7 @@ fn vs_environment(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32
 @fragment
 fn fs_environment(@builtin(position) frag: vec4<f32>) -> EnvironmentOut {
     let d = normalize(view_ray(frag.xy));
-    let eye = camera.eye.xyz;
+    let eye = camera.eye;
     var out: EnvironmentOut;
     let t = -eye.y / d.y;
     if (d.y != 0.0 && t > 0.0 && !under_terrain(eye + d * t)) {

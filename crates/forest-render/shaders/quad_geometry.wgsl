@@ -17,7 +17,7 @@ fn edge_long(a: vec4<f32>, b: vec4<f32>) -> bool {
     let sy = camera.viewport.y * 0.5;
     let dx = (a.x * b.w - b.x * a.w) * sx;
     let dy = (a.y * b.w - b.y * a.w) * sy;
-    let lim = camera.eye.w * a.w * b.w;
+    let lim = camera.epsilon * a.w * b.w;
     return dx * dx + dy * dy > lim * lim;
 }
 

@@ -152,10 +152,11 @@ pub(crate) fn gpu_camera(
 ) -> GpuCamera {
     let mut g = GpuCamera {
         view_proj: m.to_cols_array_2d(),
-        eye: eye.extend(epsilon).to_array(),
+        eye: eye.to_array(),
+        epsilon,
         form_eye: eye.extend(0.0).to_array(),
-        forward: forward.extend(0.0).to_array(),
-        viewport: [viewport.0 as f32, viewport.1 as f32, 0.0, 0.0],
+        forward: forward.to_array(),
+        viewport: [viewport.0 as f32, viewport.1 as f32],
         planes: frustum_planes(m),
         forms: crate::forms::FORMS_QUADS,
         ..Default::default()
@@ -193,9 +194,10 @@ pub fn frustum_planes(m: Mat4) -> [[f32; 4]; 6] {
 pub(crate) fn nothing_visible() -> GpuCamera {
     GpuCamera {
         view_proj: Mat4::IDENTITY.to_cols_array_2d(),
-        eye: [0.0, 0.0, 0.0, 1.0],
-        forward: [0.0, 0.0, -1.0, 0.0],
-        viewport: [1.0, 1.0, 0.0, 0.0],
+        eye: [0.0; 3],
+        epsilon: 1.0,
+        forward: [0.0, 0.0, -1.0],
+        viewport: [1.0, 1.0],
         planes: [[0.0, 0.0, 0.0, -3.0e38]; 6],
         forms: crate::forms::FORMS_QUADS,
         ..Default::default()

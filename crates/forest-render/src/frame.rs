@@ -280,8 +280,8 @@ mod tests {
         f.light = forest_format::shading::Lighting::with_sun(90.0, 0.0);
         f.light.exposure = 2.0;
         let g = f.to_gpu();
-        assert!((Vec3::from_slice(&g.sun[..3]) - Vec3::X).length() < 1e-6);
-        assert_eq!(g.sun[3], 2.0);
+        assert!((Vec3::from_slice(&g.sun[..]) - Vec3::X).length() < 1e-6);
+        assert_eq!(g.exposure, 2.0);
         assert_eq!(g.sky_light[..3], f.light.sky.to_array());
         assert_eq!(g.ground_light[..3], f.light.ground.to_array());
         assert_eq!(g.sun_colour[..3], f.light.sun.to_array());

@@ -11,22 +11,30 @@ use bytemuck::{Pod, Zeroable};
 pub struct GpuCamera {
     /// Projection × view, column-major.
     pub view_proj: [[f32; 4]; 4],
-    /// Eye position (world, metres) and, in `w`, ε in pixels.
-    pub eye: [f32; 4],
-    /// Unit view direction (world); in `w`, the quad stream's far span in units of ε
+    /// Eye position (world, metres).
+    pub eye: [f32; 3],
+    /// The refinement threshold ε (pixels).
+    pub epsilon: f32,
+    /// Unit view direction (world).
+    pub forward: [f32; 3],
+    /// The quad stream's far span, in units of ε
     /// ([`crate::options::StreamOptions::far_span`]).
-    pub forward: [f32; 4],
-    /// Viewport width and height in pixels; `z`: the draw pass's debug view
-    /// ([`crate::options::DebugView`] as a number, 0 = off); `w`: the quad stream's flags
-    /// ([`crate::options::StreamOptions::flags`]).
-    pub viewport: [f32; 4],
+    pub far_span: f32,
+    /// Viewport width and height in pixels.
+    pub viewport: [f32; 2],
+    /// The draw pass's debug view ([`crate::options::DebugView`] as a number, 0 = off).
+    pub debug_view: f32,
+    /// The quad stream's flags ([`crate::options::StreamOptions::flags`]).
+    pub stream_flags: f32,
     /// Frustum planes `n·p + d ≥ 0` inside, unit normals: left, right, bottom, top, near, far.
     pub planes: [[f32; 4]; 6],
     /// Which form draws each tree (see [`crate::forms::quad_share`]): metres, focal pixels
     /// (times each tree's switch unit), band fraction, jitter fraction.
     pub forms: [f32; 4],
-    /// Unit direction towards the sun (world) and, in `w`, the exposure.
-    pub sun: [f32; 4],
+    /// Unit direction towards the sun (world).
+    pub sun: [f32; 3],
+    /// Scale of every outgoing radiance ([`forest_format::shading::Lighting::exposure`]).
+    pub exposure: f32,
     /// Sun irradiance, linear RGB (`w` unused).
     pub sun_colour: [f32; 4],
     /// Sky irradiance on a surface facing up, linear RGB (`w` unused).
@@ -34,7 +42,7 @@ pub struct GpuCamera {
     /// Ground-bounce irradiance on a surface facing down, linear RGB (`w` unused).
     pub ground_light: [f32; 4],
     /// World → shadow clip of each sun cascade (orthographic, depth 0 towards the sun, 1
-    /// away), column-major; the first `shadow_params.x` are used.
+    /// away), column-major; the first `shadow_cascades` are used.
     pub shadow: [[[f32; 4]; 4]; 4],
     /// Where each cascade ends: view depth along `forward` (metres) of its far split.
     pub shadow_splits: [f32; 4],
@@ -42,10 +50,14 @@ pub struct GpuCamera {
     pub shadow_texel: [f32; 4],
     /// Each cascade's depth bias (shadow-clip depth units, subtracted from a receiver's).
     pub shadow_bias: [f32; 4],
-    /// `x`: cascades in use (0: no shadows); `y`: the map's side in texels; `z`: the
-    /// receivers' offset towards the sun and along their normal, in texels; `w`: 1 when the
-    /// maps are reverse-Z (a host's), else 0.
-    pub shadow_params: [f32; 4],
+    /// Shadow cascades in use (0: no shadows).
+    pub shadow_cascades: f32,
+    /// The shadow maps' side in texels.
+    pub shadow_side: f32,
+    /// The receivers' offset towards the sun and along their normal, in texels.
+    pub shadow_offset: f32,
+    /// 1 when the maps are reverse-Z (a host's), else 0.
+    pub shadow_reverse_z: f32,
     /// The eye (world) whose distances choose each tree's form and level of detail: the
     /// view's own eye, and in a light view the eye of the view it casts for, so that every
     /// tree casts with the form it is drawn in ([`crate::shadow::light_camera`]); `w` unused.
@@ -65,7 +77,8 @@ impl GpuCamera {
     /// Write the frame's light into the camera.
     pub fn set_light(&mut self, l: &forest_format::shading::Lighting) {
         let d = l.sun_dir.normalize_or(glam::Vec3::Y);
-        self.sun = [d.x, d.y, d.z, l.exposure];
+        self.sun = d.to_array();
+        self.exposure = l.exposure;
         self.sun_colour = l.sun.extend(0.0).to_array();
         self.sky_light = l.sky.extend(0.0).to_array();
         self.ground_light = l.ground.extend(0.0).to_array();

@@ -307,8 +307,8 @@ impl StreamOptions {
     /// `forward.w` (what the stream does with every camera it is given; the CPU reference
     /// reads them from there too).
     pub fn apply(self, g: &mut crate::gpu_types::GpuCamera) {
-        g.viewport[3] = self.flags() as f32;
-        g.forward[3] = self.far_span as f32;
+        g.stream_flags = self.flags() as f32;
+        g.far_span = self.far_span as f32;
     }
 
     /// Refuse options out of their ranges, naming the option.
@@ -744,8 +744,8 @@ mod tests {
             o.validate().unwrap();
             let mut g = crate::gpu_types::GpuCamera::default();
             o.apply(&mut g);
-            assert_eq!(g.forward[3], good as f32);
-            assert_eq!(g.viewport[3] as u32, o.flags());
+            assert_eq!(g.far_span, good as f32);
+            assert_eq!(g.stream_flags as u32, o.flags());
             assert_eq!(o.flags() & 0xff, FLAG_NEAREST);
         }
         // A camera made without a stream carries the default options, as a stream would write.
@@ -759,8 +759,8 @@ mod tests {
             epsilon: 4.0,
         };
         let mut g = cam.to_gpu();
-        assert_eq!(g.forward[3], FAR_SPAN_DEFAULT as f32);
-        assert_eq!(g.viewport[3] as u32, StreamOptions::default().flags());
+        assert_eq!(g.far_span, FAR_SPAN_DEFAULT as f32);
+        assert_eq!(g.stream_flags as u32, StreamOptions::default().flags());
         StreamOptions::default().apply(&mut g);
         assert_eq!(g, cam.to_gpu());
     }

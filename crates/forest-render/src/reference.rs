@@ -64,7 +64,7 @@ fn unorm12(x: f32) -> u32 {
 
 /// The camera's stream flags (`viewport.w`, see [`crate::options::StreamOptions::flags`]).
 fn flags(cam: &GpuCamera) -> u32 {
-    cam.viewport[3] as u32
+    cam.stream_flags as u32
 }
 
 /// A blend's weights rounded to units of 1/[`WEIGHT_ONE`] (see `quantise` in
@@ -135,8 +135,8 @@ fn tree_class(cam: &GpuCamera, c: Vec3, r: f32, v: Vec3, nd: Vec3) -> u32 {
     let fy = m[0][1] * m[0][1] + m[1][1] * m[1][1] + m[2][1] * m[2][1];
     let half = cam.viewport[1] * 0.5;
     let d = 2.0 * r * half;
-    let e = cam.eye[3] * w;
-    let span = cam.forward[3] * e;
+    let e = cam.epsilon * w;
+    let span = cam.far_span * e;
     let s2 = d * d * fy;
     let reach = ((flags(cam) >> REACH_SHIFT) & REACH_MASK) as f32;
     if s2 < span * span {
@@ -202,7 +202,7 @@ fn tree_quads(t: &SceneTables, cam: &GpuCamera, inst_id: u32) -> Vec<Quad> {
     {
         return Vec::new();
     }
-    let eye_obj = to_object_dir(inst, xyz(cam.eye) - centre);
+    let eye_obj = to_object_dir(inst, Vec3::from_array(cam.eye) - centre);
     let base = sp.dir_base as usize;
     let dirs: Vec<Vec3> = t.frames[base..base + sp.directions as usize]
         .iter()
@@ -296,7 +296,7 @@ fn edge_long(cam: &GpuCamera, a: Vec4, b: Vec4) -> bool {
     let sy = cam.viewport[1] * 0.5;
     let dx = (a.x * b.w - b.x * a.w) * sx;
     let dy = (a.y * b.w - b.y * a.w) * sy;
-    let lim = cam.eye[3] * a.w * b.w;
+    let lim = cam.epsilon * a.w * b.w;
     dx * dx + dy * dy > lim * lim
 }
 
@@ -371,7 +371,7 @@ pub fn run(t: &SceneTables, cam: &GpuCamera, capacity: u32) -> Reference {
 
 /// Run pass 1 and `iterations` refinement steps (0: the static impostor).
 pub fn run_with(t: &SceneTables, cam: &GpuCamera, capacity: u32, iterations: u32) -> Reference {
-    let towards = -xyz(cam.forward);
+    let towards = -Vec3::from_array(cam.forward);
     let mut presort = 0usize;
     let mut best = f32::NEG_INFINITY;
     for (k, d) in t.presort_dirs.iter().enumerate() {

@@ -368,12 +368,10 @@ pub fn write_receivers_of(
         // Half a texel of slope at 45° plus the depth quantum: the comparison's own rounding.
         g.shadow_bias[i] = 0.5 * c.texel / c.depth_range + 1e-6;
     }
-    g.shadow_params = [
-        n as f32,
-        resolution as f32,
-        offset_texels,
-        if reverse_z { 1.0 } else { 0.0 },
-    ];
+    g.shadow_cascades = n as f32;
+    g.shadow_side = resolution as f32;
+    g.shadow_offset = offset_texels;
+    g.shadow_reverse_z = if reverse_z { 1.0 } else { 0.0 };
 }
 
 /// A host's light view, for the forest to cast into the host's own shadow map.
@@ -523,8 +521,8 @@ pub fn caster_planes(
     if !opts.cull_casters {
         return Default::default();
     }
-    let eye = Vec3::from_slice(&view.eye[..3]);
-    let forward = Vec3::from_slice(&view.forward[..3]).normalize_or(Vec3::NEG_Z);
+    let eye = Vec3::from_slice(&view.eye[..]);
+    let forward = Vec3::from_slice(&view.forward[..]).normalize_or(Vec3::NEG_Z);
     let margin = 4.0 * c.texel;
     let at = forward.dot(eye);
     let planes = [
@@ -543,7 +541,7 @@ pub fn caster_planes(
 /// region of light camera `cam` (its `casters` and `caster_floor`; every sphere when they are
 /// zero): the CPU mirror of `casts_into` in `shaders/common.wgsl`.
 pub fn casts_into(cam: &GpuCamera, c: Vec3, r: f32) -> bool {
-    let sun = Vec3::from_slice(&cam.sun[..3]);
+    let sun = Vec3::from_slice(&cam.sun[..]);
     let mut sweep = cam.caster_floor[1];
     if sun.y > 1e-3 {
         sweep = sweep.min((c.y + r - cam.caster_floor[0]).max(0.0) / sun.y);
@@ -566,8 +564,8 @@ pub fn cameras(
 ) -> Vec<GpuCamera> {
     let slice = ViewSlice {
         view_proj: Mat4::from_cols_array_2d(&view.view_proj),
-        eye: Vec3::from_slice(&view.eye[..3]),
-        forward: Vec3::from_slice(&view.forward[..3]),
+        eye: Vec3::from_slice(&view.eye[..]),
+        forward: Vec3::from_slice(&view.forward[..]),
     };
     let cascades = fit_cascades(&slice, light.sun_dir, opts, band);
     let floor = band.floor.max(-1e30);
@@ -829,12 +827,12 @@ mod tests {
             ReceiverBand::ANY,
         );
         let g = light_camera(&cascades[0], sun, &opts, Default::default());
-        let eye = Vec3::from_slice(&g.eye[..3]);
+        let eye = Vec3::from_slice(&g.eye[..]);
         assert!((eye - cascades[0].centre).normalize().dot(sun) > 0.999_999);
         assert_eq!(g.viewport[0], opts.resolution as f32);
-        assert_eq!(g.eye[3], opts.epsilon);
+        assert_eq!(g.epsilon, opts.epsilon);
         assert_eq!(
-            g.viewport[3] as u32,
+            g.stream_flags as u32,
             crate::options::StreamOptions::default().flags()
         );
     }

@@ -465,7 +465,7 @@ impl QuadStream {
     }
 
     fn write_camera(&mut self, queue: &wgpu::Queue, mut g: GpuCamera) {
-        g.viewport[2] = self.debug.shader_value() as f32;
+        g.debug_view = self.debug.shader_value() as f32;
         self.drawn_options().apply(&mut g);
         let own = self
             .shadows
