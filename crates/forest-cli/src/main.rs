@@ -11,6 +11,7 @@ mod demo;
 mod guard;
 mod progress;
 mod render;
+mod render_args;
 mod scene;
 mod switch;
 mod view;

@@ -18,7 +18,8 @@ use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
-use crate::render::{MethodArgs, load_scene, models_for, parse_size, prepare_models, write_png};
+use crate::render::{MethodArgs, load_scene, models_for, prepare_models, write_png};
+use crate::render_args::parse_size;
 
 /// Arguments of `forest view`.
 #[derive(Args, Debug)]

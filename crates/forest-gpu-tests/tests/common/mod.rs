@@ -394,3 +394,24 @@ pub fn failure_images(
         .unwrap();
     out
 }
+
+/// A quad stream over `species`' trees of `forest`, 160×120 over a transparent background,
+/// sized for ε down to `min_epsilon`, and its target.
+pub fn transparent_stream(
+    ctx: &forest_render::GpuContext,
+    species: &[forest_render::SpeciesData],
+    forest: &forest_format::forest::Forest,
+    min_epsilon: f32,
+) -> (forest_render::QuadStream, forest_render::target::Target) {
+    let scene = forest_render::GpuScene::new(ctx, species, forest).unwrap();
+    let opts = forest_render::options::RendererOptions {
+        viewport: (160, 120),
+        min_epsilon,
+        background: forest_render::options::Background::Transparent,
+        ..Default::default()
+    };
+    (
+        forest_render::QuadStream::new(&ctx.device, scene, &opts).unwrap(),
+        forest_render::target::Target::new(ctx, 160, 120),
+    )
+}
