@@ -47,6 +47,16 @@ impl Method {
         }
     }
 
+    /// Whether the method draws from the species' prepared models (the geometry renderer).
+    pub fn needs_models(&self) -> bool {
+        matches!(self, Method::Mesh(_) | Method::Hybrid(_))
+    }
+
+    /// Whether the method draws trees as quads (the quad stream).
+    pub fn draws_quads(&self) -> bool {
+        !matches!(self, Method::Mesh(_))
+    }
+
     /// The aspect sharpening the method's quads draw with in place of the stream's own
     /// ([`QuadStream::set_sharpen_override`]): the hybrid's; None for every other method.
     pub fn quad_sharpen(&self) -> Option<u32> {

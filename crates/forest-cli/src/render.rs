@@ -4,9 +4,8 @@ use forest_render::ForestView;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, MeshMethod, PreparedGeometry};
-use forest_baselines::hybrid::Hybrid;
-use forest_baselines::methods::{ForestRenderer, Method};
+use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeometry};
+use forest_baselines::methods::{ForestRenderer, MethodStats};
 use forest_format::forest::Forest;
 use forest_format::views;
 use forest_render::fragments::{FragmentCounter, FragmentCounts, FragmentSummary};
@@ -117,59 +116,106 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let mesh_method = args.m.checked_method(forest.species.len())?;
     args.shadow.options(false)?;
+    let method = args.m.chosen(mesh_method)?;
     let ctx = crate::gpu_context()?;
-    if let Method::Hybrid(h) = args.m.chosen(mesh_method)? {
-        return render_hybrid(args, h, &ctx, &forest, &species, &cameras);
-    }
-    if let Some(m) = mesh_method {
-        return render_geometry(args, m, &ctx, &forest, &species, &cameras);
-    }
-    let mut stream = stream_for(args, &ctx, &species, &forest)?;
-    stream.set_shadows(&ctx.device, args.shadow.options(false)?)?;
-    stream.set_pipeline_statistics(args.json);
+    let geometry = if method.needs_models() {
+        let prepared = args_models(args, &forest, &species)?;
+        let opts = target_options(args);
+        Some(GeometryRenderer::with_targets(
+            &ctx, &prepared, &forest, &opts,
+        )?)
+    } else {
+        None
+    };
+    let stream = stream_for(args, &ctx, &species, &forest, method.draws_quads())?;
+    let mut r = ForestRenderer::new(stream, geometry);
+    r.set_method(&ctx, method)?;
+    r.set_shadows(&ctx.device, args.shadow.options(false)?)?;
+    r.set_pipeline_statistics(args.json);
     render_views(args, &ctx, &cameras, |cam, target| {
-        let stats = stream.render_fitted(&ctx, cam, target)?;
-        let t = stats.times.unwrap_or_default();
+        let stats = r.render_fitted(&ctx, cam, target)?;
+        let (json, line) = report(args, &ctx, &r, &stats);
         let counted = count(
             args,
             &ctx,
             target,
-            &mut stream,
-            QuadStream::set_fragment_counter,
-            |s| s.render_frame(&ctx, cam, target),
+            &mut r,
+            |r, device, counter| r.set_fragment_counter(device, counter),
+            |r| r.render_frame(&ctx, cam, target),
         )?;
         Ok(ViewReport {
             counted,
-            json: serde_json::json!({
-                "visible_trees": stats.visible_trees, "quads": stats.quads,
-                "composited_quads": stats.composites,
-                "per_level": stats.per_level, "overflow_cull": stats.overflow_cull,
-                "overflow_refine": stats.overflow_refine,
-                "capacity_quads": stream.capacity.quads,
-                "shadow_cascades": stream.shadows().map(|s| s.stats(&ctx).iter().map(|c| {
+            json,
+            line,
+        })
+    })
+}
+
+/// A frame's figures for `--json` and its line of text: the counters every method shares,
+/// then those of the quad stream and of the geometry where the method drew them.
+fn report(
+    args: &RenderArgs,
+    ctx: &GpuContext,
+    r: &ForestRenderer,
+    s: &MethodStats,
+) -> (serde_json::Value, String) {
+    let t = s.times.unwrap_or_default();
+    let quads = u64::from(s.stream.quads);
+    let triangles = s.primitives - quads;
+    let mut json = serde_json::json!({
+        "method": args.m.name(),
+        "visible_trees": s.visible_trees, "geometry_trees": s.geometry_trees,
+        "quads": quads, "triangles": triangles, "billboards": s.billboards,
+        "per_level": s.per_level, "overflow": s.overflow,
+        "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
+        "work": work_json(&s.work),
+    });
+    let o = json.as_object_mut().expect("an object");
+    if r.method().draws_quads() {
+        let stream = &r.stream;
+        let cascades = stream.shadows().map(|sh| {
+            sh.stats(ctx)
+                .iter()
+                .map(|c| {
                     let ct = c.times.unwrap_or_default();
                     serde_json::json!({"visible_trees": c.visible_trees, "quads": c.quads,
                         "cull_ms": ct.cull_ms, "refine_ms": ct.refine_ms, "draw_ms": ct.draw_ms,
                         "overflow_cull": c.overflow_cull, "overflow_refine": c.overflow_refine})
-                }).collect::<Vec<_>>()),
-                "stream_bytes": stream.capacity.bytes(),
-                "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
-                "work": work_json(&stats.work),
-            }),
-            line: format!(
-                "{} visible trees, {} quads ({} composited) {:?}, overflow {}/{}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms",
-                stats.visible_trees,
-                stats.quads,
-                stats.composites,
-                stats.per_level,
-                stats.overflow_cull,
-                stats.overflow_refine,
-                t.cull_ms,
-                t.refine_ms,
-                t.draw_ms,
-            ),
-        })
-    })
+                })
+                .collect::<Vec<_>>()
+        });
+        o.extend([
+            ("composited_quads".into(), s.stream.composites.into()),
+            ("overflow_cull".into(), s.stream.overflow_cull.into()),
+            ("overflow_refine".into(), s.stream.overflow_refine.into()),
+            ("capacity_quads".into(), stream.capacity.quads.into()),
+            ("stream_bytes".into(), stream.capacity.bytes().into()),
+            ("shadow_cascades".into(), serde_json::json!(cascades)),
+        ]);
+    }
+    if let Some(g) = r.geometry.as_ref().filter(|_| r.method().needs_models()) {
+        o.insert(
+            "per_band".into(),
+            serde_json::json!(g.read_stats(ctx).per_band),
+        );
+    }
+    let line = format!(
+        "{} ({}x supersampled): {} visible trees, {} as geometry, {quads} quads ({} composited) \
+         {:?}, {triangles} triangles, {} billboards, overflow {}, cull {:.1} ms, refine {:.1} ms, \
+         draw {:.1} ms",
+        args.m.name(),
+        args.supersample,
+        s.visible_trees,
+        s.geometry_trees,
+        s.stream.composites,
+        s.per_level,
+        s.billboards,
+        s.overflow,
+        t.cull_ms,
+        t.refine_ms,
+        t.draw_ms,
+    );
+    (json, line)
 }
 
 /// What one rendered view reports: its figures for `--json` (merged with the view's name,
@@ -315,69 +361,24 @@ fn stream_for(
     ctx: &GpuContext,
     species: &[SpeciesData],
     forest: &Forest,
+    draws: bool,
 ) -> Result<QuadStream> {
     let scene = crate::progress::upload(ctx, species, forest)?;
     let opts = RendererOptions {
         min_epsilon: args.epsilon.min(8.0),
-        viewport: rendered_viewport(args),
+        // A method that draws no quads keeps the stream at the image's own size: its
+        // supersampled target would size the stream for nothing.
+        viewport: if draws {
+            rendered_viewport(args)
+        } else {
+            args.size
+        },
         refine: args.m.name() != "impostor",
         ..target_options(args)
     };
     let mut stream = QuadStream::new(&ctx.device, scene, &opts)?;
     stream.set_options(args.m.stream_options())?;
     Ok(stream)
-}
-
-/// The hybrid: near trees as full geometry, the rest as the quad stream.
-fn render_hybrid(
-    args: &RenderArgs,
-    hybrid: Hybrid,
-    ctx: &GpuContext,
-    forest: &Forest,
-    species: &[SpeciesData],
-    cameras: &[(String, Camera)],
-) -> Result<()> {
-    let prepared = args_models(args, forest, species)?;
-    let geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
-    let mut r = ForestRenderer::new(stream_for(args, ctx, species, forest)?, Some(geo));
-    r.set_method(ctx, Method::Hybrid(hybrid))?;
-    r.set_shadows(&ctx.device, args.shadow.options(false)?)?;
-    r.set_pipeline_statistics(args.json);
-    render_views(args, ctx, cameras, |cam, target| {
-        let stats = r.render_fitted(ctx, cam, target)?;
-        let t = stats.times.unwrap_or_default();
-        let quads: u32 = stats.per_level.iter().sum();
-        let triangles = stats.primitives - u64::from(quads);
-        let counted = count(
-            args,
-            ctx,
-            target,
-            &mut r,
-            ForestRenderer::set_fragment_counter,
-            |r| r.render_frame(ctx, cam, target),
-        )?;
-        Ok(ViewReport {
-            counted,
-            json: serde_json::json!({
-                "method": "hybrid",
-                "visible_trees": stats.visible_trees,
-                "geometry_trees": stats.geometry_trees, "quads": quads,
-                "triangles": triangles,
-                "overflow": stats.overflow,
-                "cull_ms": t.cull_ms, "refine_ms": t.refine_ms, "draw_ms": t.draw_ms,
-                "work": work_json(&stats.work),
-            }),
-            line: format!(
-                "hybrid: {} visible trees, {} as geometry, {quads} quads + {triangles} triangles, overflow {}, cull {:.1} ms, refine {:.1} ms, draw {:.1} ms",
-                stats.visible_trees,
-                stats.geometry_trees,
-                stats.overflow,
-                t.cull_ms,
-                t.refine_ms,
-                t.draw_ms,
-            ),
-        })
-    })
 }
 
 /// What both forms draw into and over: the crate's own targets, the background and the
@@ -553,60 +554,6 @@ pub fn check_model(
     } else {
         bail!("{what} (--allow-other-models draws it anyway)")
     }
-}
-
-/// The geometry-based methods: full geometry (reference / brute force), stochastic
-/// simplification, discrete LODs + billboards.
-fn render_geometry(
-    args: &RenderArgs,
-    method: MeshMethod,
-    ctx: &GpuContext,
-    forest: &Forest,
-    species: &[SpeciesData],
-    cameras: &[(String, Camera)],
-) -> Result<()> {
-    let prepared = args_models(args, forest, species)?;
-    let mut geo = GeometryRenderer::with_targets(ctx, &prepared, forest, &target_options(args))?;
-    geo.set_method(ctx, method)?;
-    // The reference's maps are finer, as in every suite (ForestRenderer::set_shadows).
-    geo.set_shadows(
-        &ctx.device,
-        forest_baselines::methods::shadows_for(Method::Mesh(method), args.shadow.options(false)?),
-    )?;
-    geo.set_pipeline_statistics(args.json);
-    render_views(args, ctx, cameras, |cam, target| {
-        geo.render_frame(ctx, cam, target)?;
-        let stats = geo.read_stats(ctx);
-        let t = stats.times.unwrap_or_default();
-        let counted = count(
-            args,
-            ctx,
-            target,
-            &mut geo,
-            GeometryRenderer::set_fragment_counter,
-            |g| g.render_frame(ctx, cam, target),
-        )?;
-        Ok(ViewReport {
-            counted,
-            json: serde_json::json!({
-                "method": args.m.name(),
-                "visible_trees": stats.visible_trees, "triangles": stats.triangles,
-                "billboards": stats.billboards, "per_band": stats.per_band,
-                "cull_ms": t.cull_ms, "draw_ms": t.draw_ms,
-                "work": work_json(&stats.work),
-            }),
-            line: format!(
-                "{} ({}x supersampled): {} visible trees, {} triangles, {} billboards, cull {:.1} ms, draw {:.1} ms",
-                args.m.name(),
-                args.supersample,
-                stats.visible_trees,
-                stats.triangles,
-                stats.billboards,
-                t.cull_ms,
-                t.draw_ms,
-            ),
-        })
-    })
 }
 
 fn output_for(base: &Path, view: &str, views: usize) -> PathBuf {
