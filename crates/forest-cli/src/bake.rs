@@ -76,7 +76,7 @@ pub struct BakeArgs {
     /// The hybrid switch's tolerance: the quad stream may be up to this fraction less
     /// accurate (mean FLIP) than the model's triangles where the hybrid switches a tree to
     /// it (0: as accurate; 0 to 10).
-    #[arg(long, default_value_t = crate::switch::DEFAULT_TOLERANCE, value_parser = parse_tolerance, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = forest_measure::switch::DEFAULT_TOLERANCE, value_parser = parse_tolerance, allow_negative_numbers = true)]
     pub switch_tolerance: f32,
     /// Do not store the prepared model (model.bin: the model's triangles with their traced
     /// sky visibility, its mesh LODs and billboards) in the atlas. The geometry methods and
@@ -196,7 +196,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let mut need = forest_bake::peak_bytes_estimate(&params, model_bytes, threads);
     if !args.no_hybrid_switch {
         // The atlas stays in memory while the switch is measured.
-        need += crate::switch::peak_bytes_estimate(model_bytes);
+        need += forest_measure::switch::peak_bytes_estimate(model_bytes);
     }
     let limit = match args.memory_limit {
         Some(g) if g.is_finite() && g > 0.0 => Some((g * f64::from(1u32 << 30)) as u64),
@@ -277,9 +277,15 @@ pub fn run(args: &BakeArgs) -> Result<()> {
                 let species =
                     forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
                 let model = model.clone().expect("prepared when the switch is measured");
-                let m =
-                    crate::switch::measure(&ctx, species, model, args.switch_tolerance, &progress)
-                        .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
+                let m = forest_measure::switch::measure(
+                    &ctx,
+                    species,
+                    model,
+                    args.switch_tolerance,
+                    crate::colour_format(),
+                    &progress,
+                )
+                .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
                 bar.finish_and_clear();
                 out.atlas.manifest.hybrid_switch = Some(m.switch);
                 measured = Some(m);
@@ -390,11 +396,14 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         if let Some(measured) = &measured {
             println!(
                 "  hybrid switch: {}",
-                crate::switch::describe_measured(measured)
+                forest_measure::switch::describe_measured(measured)
             );
             println!(
                 "  {}",
-                crate::switch::describe_lods(&measured.ladder, measured.switch.crown_radii)
+                forest_measure::switch::describe_lods(
+                    &measured.ladder,
+                    measured.switch.crown_radii
+                )
             );
         }
         if let Some(p) = &args.contact_sheet {
@@ -501,7 +510,7 @@ pub fn info(args: &InfoArgs) -> Result<()> {
                  hybrid need --models"
             ),
         }
-        println!("  hybrid switch: {}", crate::switch::describe(m));
+        println!("  hybrid switch: {}", forest_measure::switch::describe(m));
     }
     Ok(())
 }

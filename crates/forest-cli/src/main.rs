@@ -13,7 +13,6 @@ mod progress;
 mod render;
 mod render_args;
 mod scene;
-mod switch;
 mod view;
 mod window;
 

@@ -236,7 +236,10 @@ impl Bench {
                 let name = p.file_stem().map_or_else(String::new, |n| {
                     n.to_string_lossy().trim_end_matches(".atlas").to_string()
                 });
-                format!("{name}: {}", crate::switch::describe(&s.atlas.manifest))
+                format!(
+                    "{name}: {}",
+                    forest_measure::switch::describe(&s.atlas.manifest)
+                )
             })
             .collect::<Vec<_>>()
             .join(", ")

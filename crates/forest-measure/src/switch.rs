@@ -351,7 +351,8 @@ pub fn peak_bytes_estimate(model_bytes: u64) -> u64 {
 }
 
 /// Measure the switch of the prepared model `model` of the species baked into `species` at
-/// `tolerance` (see [`HybridSwitch::tolerance`]); `progress(done, total)` counts the views. Each
+/// `tolerance` (see [`HybridSwitch::tolerance`]), its colour layers stored as `colour`;
+/// `progress(done, total)` counts the views. Each
 /// rung also measures the discrete-LOD baseline's mesh LODs 1 and 2 ([`Rung::lods`]), which says
 /// whether they could draw the hybrid's near trees.
 pub fn measure(
@@ -359,6 +360,7 @@ pub fn measure(
     species: SpeciesData,
     model: std::sync::Arc<PreparedModel>,
     tolerance: f32,
+    colour: forest_render::ColourFormat,
     progress: &dyn Fn(u64, u64),
 ) -> Result<Measured> {
     let manifest = species.atlas.manifest.clone();
@@ -381,7 +383,7 @@ pub fn measure(
         background: Background::Transparent,
         ..Default::default()
     };
-    let scene = GpuScene::with_format(ctx, &[species], &forest, crate::colour_format())?;
+    let scene = GpuScene::with_format(ctx, &[species], &forest, colour)?;
     let stream = QuadStream::new(&ctx.device, scene, &opts)?;
     let geometry = GeometryRenderer::with_targets(ctx, &prepared, &forest, &opts)?;
     let mut r = ForestRenderer::new(stream, Some(geometry));
