@@ -46,6 +46,7 @@ use forest_format::shading::LEAF_TRANSLUCENCY;
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::error::BakeError;
+use crate::gltf_checks::{check_glb_header, parse, parse_err};
 use crate::mesh::{FNV_OFFSET, MAX_MODEL_COORDINATE, Material, Mesh, Tri, fnv1a};
 use crate::texture::Texture;
 
@@ -59,14 +60,6 @@ pub fn is_gltf(path: &Path) -> bool {
 /// A world-space triangle before the degenerate test: positions, texture coordinates,
 /// normals (None: the face normal), material.
 type RawTri = ([Vec3; 3], [Vec2; 3], Option<[Vec3; 3]>, u32);
-
-fn parse_err(path: &Path, reason: impl Into<String>) -> BakeError {
-    BakeError::Parse {
-        path: path.into(),
-        what: "glTF",
-        reason: reason.into(),
-    }
-}
 
 /// An external file a URI names, relative to the model's folder, its `%XX` escapes decoded
 /// (a URI reference, as glTF requires; `data:` URIs refused).
@@ -87,29 +80,6 @@ fn external(path: &Path, uri: &str, what: &str) -> Result<PathBuf, BakeError> {
         })?;
     let dir = path.parent().unwrap_or(Path::new("."));
     Ok(dir.join(name.as_ref()))
-}
-
-/// A GLB's header, checked before the gltf crate (1.4.1) reads it: it subtracts the header's
-/// 12 bytes from the length the header states without checking that it is at least that.
-fn check_glb_header(path: &Path, bytes: &[u8]) -> Result<(), BakeError> {
-    if !bytes.starts_with(b"glTF") {
-        return Ok(());
-    }
-    let Some(length) = bytes.get(8..12) else {
-        return Err(parse_err(path, "a GLB shorter than its 12-byte header"));
-    };
-    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
-    if length < 12 || length as usize > bytes.len() {
-        return Err(parse_err(
-            path,
-            format!(
-                "its GLB header says the file is {length} bytes; it is {} (and the header \
-                 alone is 12)",
-                bytes.len()
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// The files a glTF model is read from: itself, and the buffers and images its URIs name.
@@ -151,66 +121,6 @@ fn remap_alpha(a: u8, c: f32) -> u8 {
     } else {
         ((0.5 * x / c * 255.0).round() as u8).min(127)
     }
-}
-
-/// Refuse the extensions the loader cannot honour: any required one, and
-/// `KHR_texture_transform` (it moves texture coordinates).
-fn refuse_extensions(path: &Path, doc: &gltf::Document) -> Result<(), BakeError> {
-    let required: Vec<&str> = doc.extensions_required().collect();
-    if !required.is_empty() {
-        return Err(parse_err(
-            path,
-            format!(
-                "requires the extension(s) {}, which the loader does not support",
-                required.join(", ")
-            ),
-        ));
-    }
-    if doc.extensions_used().any(|e| e == "KHR_texture_transform") {
-        return Err(parse_err(
-            path,
-            "uses KHR_texture_transform, which the loader does not support (it moves texture \
-         coordinates)",
-        ));
-    }
-    Ok(())
-}
-
-/// What the gltf crates (1.4.1) would panic on: a primitive attribute naming an accessor the
-/// file lacks (validation indexes the accessors with POSITION's before checking it), an image
-/// with neither a URI nor a buffer view, or a buffer view without a MIME type
-/// (`Image::source` unwraps both).
-fn check_json(path: &Path, json: &gltf::json::Root) -> Result<(), BakeError> {
-    for (i, image) in json.images.iter().enumerate() {
-        let reason = match (&image.buffer_view, &image.uri, &image.mime_type) {
-            (Some(_), _, None) => "has a buffer view but no mimeType",
-            (None, None, _) => "has neither a uri nor a buffer view",
-            _ => continue,
-        };
-        return Err(parse_err(path, format!("image {i} {reason}")));
-    }
-    let count = json.accessors.len();
-    for (m, mesh) in json.meshes.iter().enumerate() {
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            for (semantic, index) in &primitive.attributes {
-                if index.value() >= count {
-                    let name = match semantic {
-                        gltf::json::validation::Checked::Valid(s) => s.to_string(),
-                        gltf::json::validation::Checked::Invalid => "an unknown attribute".into(),
-                    };
-                    return Err(parse_err(
-                        path,
-                        format!(
-                            "mesh {m}, primitive {p}: {name} names accessor {}, but the file \
-                             has {count}",
-                            index.value()
-                        ),
-                    ));
-                }
-            }
-        }
-    }
-    Ok(())
 }
 
 /// A primitive's vertex data as the file holds it: positions, normals, texture coordinates
@@ -364,22 +274,41 @@ fn node_matrix(node: &gltf::Node) -> Result<Mat4, String> {
 pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     let bytes = bounded::read(path, bounded::limit::DATA)?;
     let mut hash = fnv1a(FNV_OFFSET, &bytes);
-    // Parsed, then checked for what validation would call invalid without naming (an
-    // unsupported required extension) or lets through to a panic in the gltf crates, then
-    // validated.
-    check_glb_header(path, &bytes)?;
-    let parsed = gltf::Gltf::from_slice_without_validation(&bytes)
-        .map_err(|e| parse_err(path, e.to_string()))?;
-    refuse_extensions(path, &parsed)?;
-    check_json(path, parsed.document.as_json())?;
-    let doc = gltf::Gltf {
-        document: gltf::Document::from_json(parsed.document.into_json())
-            .map_err(|e| parse_err(path, e.to_string()))?,
-        blob: parsed.blob,
-    };
+    let doc = parse(path, &bytes)?;
+    let buffers = load_buffers(path, &doc, &mut hash)?;
+    let mut m = read_materials(path, &doc, &buffers, &mut hash)?;
+    // glTF's default material (white, opaque) for primitives that name none: added after
+    // the others when a primitive uses it.
+    let default_material = m.materials.len() as u32;
+    let (raw, coloured) = scene_triangles(path, &doc, &buffers, &m, default_material)?;
+    if raw.iter().any(|t| t.3 == default_material) {
+        m.materials.push(Material {
+            name: "default".into(),
+            kd: Vec3::ONE,
+            colour: None,
+            alpha: None,
+            translucency: 0.0,
+        });
+    }
+    let (tris, degenerate) = checked_triangles(path, raw)?;
+    let notes = notes(&doc, coloured, &m);
+    Ok(Mesh {
+        tris,
+        materials: m.materials,
+        textures: m.textures,
+        degenerate,
+        hash,
+        notes,
+    })
+}
 
-    // Buffers: the GLB's binary chunk (borrowed, not copied), or files; each at least as long
-    // as it says.
+/// The buffers: the GLB's binary chunk (borrowed, not copied), or files; each at least as
+/// long as it says, hashed into `hash`.
+fn load_buffers<'a>(
+    path: &Path,
+    doc: &'a gltf::Gltf,
+    hash: &mut u64,
+) -> Result<Vec<std::borrow::Cow<'a, [u8]>>, BakeError> {
     let mut buffers: Vec<std::borrow::Cow<[u8]>> = Vec::new();
     for b in doc.buffers() {
         let data = match b.source() {
@@ -410,30 +339,49 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 ),
             ));
         }
-        hash = fnv1a(hash, &data);
+        *hash = fnv1a(*hash, &data);
         buffers.push(data);
     }
+    Ok(buffers)
+}
 
-    // Images, decoded on demand, and textures per (image, alpha cutoff).
+/// What the glTF materials become: the bake's materials and textures, and per glTF material
+/// its index among them (None when nothing of it passes) and its texture's wrap modes where
+/// they do not repeat (the bake, repeating every texture, honours them only for coordinates in
+/// [0, 1]); the materials the notes name.
+struct Materials {
+    materials: Vec<Material>,
+    textures: Vec<Texture>,
+    material_of: Vec<Option<u32>>,
+    clamped: Vec<Option<String>>,
+    single_sided: Vec<String>,
+    unused_maps: Vec<String>,
+}
+
+/// Every material with its base colour texture (images decoded once, textures made per
+/// (image, alpha cutoff)); image files are hashed into `hash`.
+fn read_materials(
+    path: &Path,
+    doc: &gltf::Gltf,
+    buffers: &[std::borrow::Cow<[u8]>],
+    hash: &mut u64,
+) -> Result<Materials, BakeError> {
     let mut images: HashMap<usize, image::RgbaImage> = HashMap::new();
-    let mut textures: Vec<Texture> = Vec::new();
     let mut texture_of: HashMap<(usize, Option<u32>), usize> = HashMap::new();
-    let mut materials: Vec<Material> = Vec::new();
-    // For each glTF material: its index in `materials`, or None when nothing of it passes.
-    let mut material_of: Vec<Option<u32>> = Vec::new();
-    // For each glTF material whose base colour texture does not repeat: its sampler's wrap
-    // modes, which the bake (repeating every texture) honours only for coordinates in [0, 1].
-    let mut clamped: Vec<Option<String>> = Vec::new();
-    let mut notes: Vec<String> = Vec::new();
-    let mut single_sided = Vec::new();
-    let mut unused_maps = Vec::new();
-    let mut coloured = 0usize;
-    for m in doc.materials() {
-        let name = m
+    let mut m = Materials {
+        materials: Vec::new(),
+        textures: Vec::new(),
+        material_of: Vec::new(),
+        clamped: Vec::new(),
+        single_sided: Vec::new(),
+        unused_maps: Vec::new(),
+    };
+    for mat in doc.materials() {
+        let name = mat
             .name()
             .map(str::to_owned)
-            .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
-        let pbr = m.pbr_metallic_roughness();
+            .unwrap_or_else(|| format!("material {}", mat.index().unwrap_or(0)));
+        let pbr = mat.pbr_metallic_roughness();
         let factor = pbr.base_color_factor();
         if factor.iter().any(|x| !(0.0..=1.0).contains(x)) {
             return Err(parse_err(
@@ -444,7 +392,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 ),
             ));
         }
-        if let Some(c) = m.alpha_cutoff().filter(|c| !(0.0..=1.0).contains(c)) {
+        if let Some(c) = mat.alpha_cutoff().filter(|c| !(0.0..=1.0).contains(c)) {
             return Err(parse_err(
                 path,
                 format!(
@@ -453,25 +401,25 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 ),
             ));
         }
-        let mode = m.alpha_mode();
+        let mode = mat.alpha_mode();
         // The cutoff on texture alpha (None: opaque).
         let cutoff = match mode {
             gltf::material::AlphaMode::Opaque => None,
-            gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5) / factor[3]),
+            gltf::material::AlphaMode::Mask => Some(mat.alpha_cutoff().unwrap_or(0.5) / factor[3]),
             gltf::material::AlphaMode::Blend => Some(0.5 / factor[3]),
         };
-        if !m.double_sided() {
-            single_sided.push(name.clone());
+        if !mat.double_sided() {
+            m.single_sided.push(name.clone());
         }
-        if m.normal_texture().is_some()
-            || m.occlusion_texture().is_some()
-            || m.emissive_texture().is_some()
+        if mat.normal_texture().is_some()
+            || mat.occlusion_texture().is_some()
+            || mat.emissive_texture().is_some()
             || pbr.metallic_roughness_texture().is_some()
         {
-            unused_maps.push(name.clone());
+            m.unused_maps.push(name.clone());
         }
         use gltf::texture::WrappingMode as W;
-        clamped.push(pbr.base_color_texture().and_then(|info| {
+        m.clamped.push(pbr.base_color_texture().and_then(|info| {
             let sampler = info.texture().sampler();
             let (s, t) = (sampler.wrap_s(), sampler.wrap_t());
             (s != W::Repeat || t != W::Repeat).then(|| format!("wraps {s:?} × {t:?}"))
@@ -492,38 +440,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 let image = info.texture().source();
                 let ii = image.index();
                 if let std::collections::hash_map::Entry::Vacant(slot) = images.entry(ii) {
-                    let err = |texture: PathBuf, reason: String| BakeError::Texture {
-                        path: path.into(),
-                        material: name.clone(),
-                        texture,
-                        reason,
-                    };
-                    let (data, file) = match image.source() {
-                        gltf::image::Source::View { view, .. } => {
-                            let b = &buffers[view.buffer().index()];
-                            let range = view.offset()..view.offset() + view.length();
-                            let data = b.get(range).ok_or_else(|| {
-                                parse_err(
-                                    path,
-                                    format!("image {ii}: its view lies outside its buffer"),
-                                )
-                            })?;
-                            (
-                                std::borrow::Cow::Borrowed(data),
-                                path.join(format!("image {ii}")),
-                            )
-                        }
-                        gltf::image::Source::Uri { uri, .. } => {
-                            let f = external(path, uri, &format!("image {ii}"))?;
-                            let data = bounded::read(&f, bounded::limit::TEXTURE)
-                                .map_err(|e| err(f.clone(), e.to_string()))?;
-                            hash = fnv1a(hash, &data);
-                            (std::borrow::Cow::Owned(data), f)
-                        }
-                    };
-                    let img = crate::texture::decode_rgba(&data, &file)
-                        .map_err(|reason| err(file.clone(), reason))?;
-                    slot.insert(img);
+                    slot.insert(decode_image(path, &image, &name, buffers, hash)?);
                 }
                 Some(ii)
             }
@@ -531,7 +448,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
         // A material with no alpha texture is wholly in or out by its factor.
         let untextured_out = cutoff.is_some_and(|c| colour.is_none() && c > 1.0);
         if untextured_out || cutoff.is_some_and(|c| !c.is_finite()) {
-            material_of.push(None);
+            m.material_of.push(None);
             continue;
         }
         let key = colour.map(|ii| {
@@ -549,16 +466,17 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                         p[3] = remap_alpha(p[3], c);
                     }
                 }
-                textures.push(Texture::new(img.width(), img.height(), rgba));
-                texture_of.insert(k, textures.len() - 1);
-                textures.len() - 1
+                m.textures
+                    .push(Texture::new(img.width(), img.height(), rgba));
+                texture_of.insert(k, m.textures.len() - 1);
+                m.textures.len() - 1
             }
         });
         let alpha = match (cutoff, tex) {
-            (Some(_), Some(t)) if textures[t].has_alpha => Some((t, true)),
+            (Some(_), Some(t)) if m.textures[t].has_alpha => Some((t, true)),
             _ => None,
         };
-        materials.push(Material {
+        m.materials.push(Material {
             name,
             kd: Vec3::new(factor[0], factor[1], factor[2]),
             colour: tex,
@@ -569,13 +487,63 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 0.0
             },
         });
-        material_of.push(Some(materials.len() as u32 - 1));
+        m.material_of.push(Some(m.materials.len() as u32 - 1));
     }
-    // glTF's default material (white, opaque) for primitives that name none: added after
-    // the others when a primitive uses it.
-    let default_material = materials.len() as u32;
+    Ok(m)
+}
 
-    // Triangles in world space.
+/// Image `image` of material `name`, decoded: from a buffer view, or from a file (hashed
+/// into `hash`).
+fn decode_image(
+    path: &Path,
+    image: &gltf::Image,
+    name: &str,
+    buffers: &[std::borrow::Cow<[u8]>],
+    hash: &mut u64,
+) -> Result<image::RgbaImage, BakeError> {
+    let ii = image.index();
+    let err = |texture: PathBuf, reason: String| BakeError::Texture {
+        path: path.into(),
+        material: name.to_owned(),
+        texture,
+        reason,
+    };
+    let (data, file) = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let b = &buffers[view.buffer().index()];
+            let range = view.offset()..view.offset() + view.length();
+            let data = b.get(range).ok_or_else(|| {
+                parse_err(
+                    path,
+                    format!("image {ii}: its view lies outside its buffer"),
+                )
+            })?;
+            (
+                std::borrow::Cow::Borrowed(data),
+                path.join(format!("image {ii}")),
+            )
+        }
+        gltf::image::Source::Uri { uri, .. } => {
+            let f = external(path, uri, &format!("image {ii}"))?;
+            let data = bounded::read(&f, bounded::limit::TEXTURE)
+                .map_err(|e| err(f.clone(), e.to_string()))?;
+            *hash = fnv1a(*hash, &data);
+            (std::borrow::Cow::Owned(data), f)
+        }
+    };
+    crate::texture::decode_rgba(&data, &file).map_err(|reason| err(file.clone(), reason))
+}
+
+/// The scene's triangles in world space, each with its material (`default_material` for
+/// primitives that name none), and how many primitives carry vertex colours.
+fn scene_triangles(
+    path: &Path,
+    doc: &gltf::Gltf,
+    buffers: &[std::borrow::Cow<[u8]>],
+    m: &Materials,
+    default_material: u32,
+) -> Result<(Vec<RawTri>, usize), BakeError> {
+    let mut coloured = 0usize;
     let scene = doc
         .default_scene()
         .or_else(|| doc.scenes().next())
@@ -627,7 +595,7 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             }
             let material = match prim.material().index() {
                 None => default_material,
-                Some(i) => match material_of[i] {
+                Some(i) => match m.material_of[i] {
                     Some(m) => m,
                     None => continue,
                 },
@@ -636,8 +604,8 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
                 coloured += 1;
             }
             let (pos, nrm, uv, idx) =
-                read_primitive(&prim, &buffers, &at()).map_err(|reason| parse_err(path, reason))?;
-            let wrap = prim.material().index().and_then(|i| clamped[i].as_ref());
+                read_primitive(&prim, buffers, &at()).map_err(|reason| parse_err(path, reason))?;
+            let wrap = prim.material().index().and_then(|i| m.clamped[i].as_ref());
             if let (Some(wrap), Some(uv)) = (wrap, &uv) {
                 let outside = uv
                     .iter()
@@ -677,19 +645,15 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             }
         }
     }
-    if raw.iter().any(|t| t.3 == default_material) {
-        materials.push(Material {
-            name: "default".into(),
-            kd: Vec3::ONE,
-            colour: None,
-            alpha: None,
-            translucency: 0.0,
-        });
-    }
     if meshes == 0 {
         return Err(parse_err(path, "the scene has no mesh: nothing to bake"));
     }
+    Ok((raw, coloured))
+}
 
+/// The triangles checked (every coordinate finite and within [`MAX_MODEL_COORDINATE`]) and
+/// made, less the degenerate ones (counted); refused when none is left.
+fn checked_triangles(path: &Path, raw: Vec<RawTri>) -> Result<(Vec<Tri>, u64), BakeError> {
     let mut extent = 0.0f32;
     for (i, (p, ..)) in raw.iter().enumerate() {
         for x in p.iter().flat_map(|v| v.to_array()) {
@@ -718,6 +682,12 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     if tris.is_empty() {
         return Err(crate::mesh::no_triangles(path, degenerate));
     }
+    Ok((tris, degenerate))
+}
+
+/// What the bake ignores of the file, said once each.
+fn notes(doc: &gltf::Gltf, coloured: usize, m: &Materials) -> Vec<String> {
+    let mut notes: Vec<String> = Vec::new();
     let count = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
     if doc.animations().len() > 0 {
         notes.push(format!(
@@ -745,17 +715,17 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
     if doc.cameras().len() > 0 {
         notes.push(format!("{} ignored", count(doc.cameras().len(), "camera")));
     }
-    if !single_sided.is_empty() {
+    if !m.single_sided.is_empty() {
         notes.push(format!(
             "material(s) {} are single-sided in the file; every triangle is baked double-sided",
-            single_sided.join(", ")
+            m.single_sided.join(", ")
         ));
     }
-    if !unused_maps.is_empty() {
+    if !m.unused_maps.is_empty() {
         notes.push(format!(
             "material(s) {}: normal, occlusion, emissive and metal-roughness maps are ignored \
              (the bake shades base colour and alpha)",
-            unused_maps.join(", ")
+            m.unused_maps.join(", ")
         ));
     }
     let other: Vec<&str> = doc.extensions_used().collect();
@@ -765,30 +735,8 @@ pub fn load(path: &Path) -> Result<Mesh, BakeError> {
             other.join(", ")
         ));
     }
-    Ok(Mesh {
-        tris,
-        materials,
-        textures,
-        degenerate,
-        hash,
-        notes,
-    })
+    notes
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn alpha_remap_moves_the_cutoff_to_one_half() {
-        for c in [0.1f32, 0.3, 0.5, 0.7, 0.95] {
-            for a in 0..=255u8 {
-                let passes = f32::from(a) / 255.0 >= c;
-                assert_eq!(remap_alpha(a, c) >= 128, passes, "a {a} cutoff {c}");
-            }
-        }
-        assert_eq!(remap_alpha(0, 0.5), 0);
-        assert_eq!(remap_alpha(255, 0.5), 255);
-        assert_eq!(remap_alpha(10, 0.0), 255);
-    }
-}
+mod tests;

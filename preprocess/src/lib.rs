@@ -31,6 +31,7 @@ pub mod contact_sheet;
 pub mod cutout;
 pub mod error;
 pub mod gltf_accessor;
+mod gltf_checks;
 pub mod gltf_mesh;
 pub mod ldi;
 pub mod lod;
