@@ -34,9 +34,11 @@ pub mod gltf_accessor;
 mod gltf_checks;
 pub mod gltf_mesh;
 pub mod ldi;
+mod load;
 pub mod lod;
 pub mod mesh;
 pub mod model;
+mod obj_mesh;
 pub mod opacity;
 pub mod quadtree;
 mod sampling;
@@ -56,6 +58,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 pub use error::BakeError;
+pub use load::source_files;
 pub use mesh::Mesh;
 
 /// Memory the bake may use for its images before it refuses (bytes).

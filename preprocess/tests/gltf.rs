@@ -176,7 +176,7 @@ fn unsupported_gltf_features_are_named() {
     std::fs::write(&path, text.replace("tri.bin", "tri%20%2B%C3%A9.bin")).unwrap();
     assert_eq!(Mesh::load(&path).unwrap().tris.len(), 1);
     assert!(
-        forest_bake::mesh::source_files(&path)
+        forest_bake::source_files(&path)
             .unwrap()
             .contains(&dir.path().join("tri +é.bin"))
     );
@@ -201,7 +201,7 @@ fn malformed_gltf_is_refused_without_a_panic() {
         std::fs::write(&path, text.replace(from, to)).unwrap();
         let e = Mesh::load(&path).unwrap_err().to_string();
         // The file list the bake checks its output against must not panic either.
-        let _ = forest_bake::mesh::source_files(&path);
+        let _ = forest_bake::source_files(&path);
         e
     };
     let e = refused(r#""POSITION":0"#, r#""POSITION":7"#);
@@ -234,7 +234,7 @@ fn malformed_gltf_is_refused_without_a_panic() {
     std::fs::write(&glb, &bytes).unwrap();
     let e = Mesh::load(&glb).unwrap_err().to_string();
     assert!(e.contains("GLB header says the file is 0 bytes"), "{e}");
-    assert!(forest_bake::mesh::source_files(&glb).is_err());
+    assert!(forest_bake::source_files(&glb).is_err());
 }
 
 #[test]
@@ -331,7 +331,7 @@ fn refused_with(dir: &Path, json: &str, bin: &[u8], causes: &[&str]) {
     for c in causes {
         assert!(e.contains(c), "expected {c:?} in: {e}");
     }
-    let _ = forest_bake::mesh::source_files(&path);
+    let _ = forest_bake::source_files(&path);
     let after = (
         std::fs::read(&path).unwrap(),
         std::fs::read(dir.join("raw.bin")).unwrap(),

@@ -219,7 +219,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     }
     // The model's own files (OBJ, material libraries, textures) are never overwritten, and
     // the outputs never overwrite each other.
-    let inputs = forest_bake::mesh::source_files(&args.model)?;
+    let inputs = forest_bake::source_files(&args.model)?;
     crate::guard::not_an_input(&args.output, "output atlas", &inputs)?;
     if let Some(p) = &args.contact_sheet {
         crate::guard::not_an_input(p, "contact sheet", &inputs)?;

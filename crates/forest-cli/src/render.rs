@@ -88,7 +88,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut inputs = vec![args.forest.clone()];
     inputs.extend(forest.species.iter().map(|s| dir.join(s)));
     for m in &args.m.models {
-        inputs.extend(forest_bake::mesh::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
+        inputs.extend(forest_bake::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
     }
     for (name, _) in &cameras {
         let out = output_for(&args.output, name, cameras.len());

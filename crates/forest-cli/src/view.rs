@@ -154,7 +154,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let mut inputs = vec![forest_file.clone()];
     inputs.extend(args.path.iter().cloned());
     for m in &args_models.models {
-        inputs.extend(forest_bake::mesh::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
+        inputs.extend(forest_bake::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
     }
     crate::guard::not_an_input(&args.record, "--record", &inputs)?;
     crate::guard::not_in_atlas(&args.record, "--record")?;

@@ -147,7 +147,7 @@ fn obj(data: &[u8]) -> bool {
         for (name, bytes) in ["model.obj", "model.mtl", "leaf.png"].iter().zip(&files) {
             std::fs::write(dir.path().join(name), bytes).expect("writing a fuzz input file");
         }
-        let _ = forest_bake::mesh::source_files(&path);
+        let _ = forest_bake::source_files(&path);
         forest_bake::Mesh::load(&path).is_ok()
     })
 }
@@ -167,7 +167,7 @@ fn gltf(data: &[u8]) -> bool {
             }
             dir.path().join("model.gltf")
         };
-        let _ = forest_bake::mesh::source_files(&path);
+        let _ = forest_bake::source_files(&path);
         forest_bake::Mesh::load(&path).is_ok()
     })
 }
