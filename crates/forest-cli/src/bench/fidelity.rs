@@ -326,6 +326,16 @@ fn cell(v: Option<f64>, digits: usize) -> String {
     v.map_or_else(|| "-".into(), |x| format!("{x:.digits$}"))
 }
 
+/// What the variants measured over every species: a row per camera, the atlas GPU bytes per
+/// variant, the variants that could not run, and the resolutions the re-bakes used.
+#[derive(Default)]
+struct Measured {
+    rows: Vec<Row>,
+    gpu_bytes: Vec<u64>,
+    failed: Vec<String>,
+    bake_resolutions: Vec<u32>,
+}
+
 /// Run the suite.
 pub fn run(b: &Bench) -> Result<Section> {
     // The reference needs the models: fail before any work without them.
@@ -337,11 +347,6 @@ pub fn run(b: &Bench) -> Result<Section> {
     let variants = variants(quick);
     let scratch = b.out.join(SCRATCH);
     std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
-    let names: Vec<String> = b
-        .species_paths
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect();
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
     let mut table = Table::new(&[
         "variant",
@@ -357,143 +362,220 @@ pub fn run(b: &Bench) -> Result<Section> {
         "iou",
         "frame_ms",
     ]);
-    let mut rows: Vec<Row> = Vec::new();
-    // Atlas GPU bytes per variant (all species measured), and variants that could not run.
-    let mut gpu_bytes = vec![0u64; variants.len()];
-    let mut failed: Vec<String> = Vec::new();
-    let mut bake_resolutions: Vec<u32> = Vec::new();
+    let mut m = Measured {
+        gpu_bytes: vec![0u64; variants.len()],
+        ..Default::default()
+    };
     let result = (|| -> Result<()> {
         for k in 0..count {
-            let data = &b.species[k];
-            let species = b.species_paths[k]
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| format!("species{k}"));
-            let views = views(data, n, viewport, SEED.wrapping_add(k as u64));
-            let forest = one_tree(names.clone(), k as u32);
-            let mut r0 = b.renderer(&forest, viewport, EPS, true, Background::Transparent)?;
-            eprintln!("fidelity: {species}: {n} references (4x4 supersampled full geometry)");
-            let refs = views
-                .iter()
-                .map(|v| reference(b, &mut r0, &v.cam))
-                .collect::<Result<Vec<_>>>()?;
-            let mut base = data.atlas.manifest.params;
-            if quick {
-                base.resolution = base.resolution.min(QUICK_RESOLUTION);
-                base.min_quad = base.min_quad.min(base.resolution / 2).max(1);
-            }
-            for (vi, v) in variants.iter().enumerate() {
-                let start = std::time::Instant::now();
-                // The renderer of this variant: the one given, or a scratch re-bake.
-                let mut scratch_r;
-                let r = match v.bake {
-                    None => {
-                        if !v.geometry {
-                            gpu_bytes[vi] += data.atlas.manifest.gpu_bytes();
-                        }
-                        &mut r0
-                    }
-                    Some(change) => {
-                        let params = change(base);
-                        eprintln!(
-                            "fidelity: {species} {}: baking ({} px, {} + {} directions, {} \
-                             slabs, min quad {}, {} fit)",
-                            v.name,
-                            params.resolution,
-                            params.directions,
-                            params.below,
-                            params.slabs,
-                            params.min_quad,
-                            params.plane_fit.name()
-                        );
-                        let path = scratch.join(format!("{k}-{vi}.atlas"));
-                        let baked = forest_bake::bake_file(&b.models[k], &params, &|_, _| {})
-                            .map_err(anyhow::Error::from)
-                            .and_then(|out| {
-                                out.atlas.save(&path)?;
-                                scratch_renderer(b, &path, viewport, v.epsilon)
-                            });
-                        match baked {
-                            Ok((r, gpu)) => {
-                                // Rows that do not swap the resolution itself: bake at the
-                                // base's (below the given atlases' in quick mode).
-                                if params.resolution == base.resolution {
-                                    bake_resolutions.push(params.resolution);
-                                }
-                                gpu_bytes[vi] += gpu;
-                                scratch_r = r;
-                                &mut scratch_r
-                            }
-                            Err(e) => {
-                                eprintln!("fidelity: {species} {}: FAILED: {e:#}", v.name);
-                                failed.push(format!("{} ({species}): {e:#}", v.name));
-                                let _ = std::fs::remove_dir_all(&path);
-                                continue;
-                            }
-                        }
-                    }
-                };
-                r.stream.set_options(v.options)?;
-                let mut flips = Vec::new();
-                for (ci, (view, rf)) in views.iter().zip(&refs).enumerate() {
-                    let mut cam = view.cam;
-                    cam.epsilon = v.epsilon;
-                    let method = if v.geometry {
-                        Method::Mesh(MeshMethod::Full { depth_sort: true })
-                    } else {
-                        Method::Quads
-                    };
-                    let (s, frame_ms) = b.measure(r, method, &cam, &target, b.frames)?;
-                    if s.overflow > 0 {
-                        eprintln!(
-                            "fidelity: {species} {} camera {ci}: {} quads overflowed",
-                            v.name, s.overflow
-                        );
-                    }
-                    let m = forest_metrics::compare(rf, &target.read(&b.ctx))?;
-                    flips.push(f64::from(m.flip_mean));
-                    table.push(vec![
-                        v.name.into(),
-                        species.clone(),
-                        ci.to_string(),
-                        format!("{:.3}", view.distance_radii),
-                        format!("{:.2}", view.elevation_deg),
-                        format!("{:.2}", view.azimuth_deg),
-                        view.between.to_string(),
-                        v.epsilon.to_string(),
-                        s.primitives.to_string(),
-                        format!("{:.5}", m.flip_mean),
-                        cell(m.coverage_iou, 4),
-                        ms(frame_ms),
-                    ]);
-                    rows.push(Row {
-                        variant: vi,
-                        distance_radii: view.distance_radii,
-                        elevation_deg: view.elevation_deg,
-                        flip: m.flip_mean,
-                        iou: m.coverage_iou,
-                        frame_ms,
-                    });
-                }
-                r.stream.set_options(StreamOptions::default())?;
-                eprintln!(
-                    "fidelity: {species} {}: mean FLIP {:.4} ({:.1} s)",
-                    v.name,
-                    mean(flips.into_iter()).unwrap_or(f64::NAN),
-                    start.elapsed().as_secs_f64()
-                );
-                if v.bake.is_some() {
-                    let _ = std::fs::remove_dir_all(scratch.join(format!("{k}-{vi}.atlas")));
-                }
-            }
+            measure_species(b, k, n, viewport, &variants, &target, &mut table, &mut m)?;
         }
         Ok(())
     })();
     let _ = std::fs::remove_dir_all(&scratch);
     result?;
     b.write("fidelity.csv", &table.csv())?;
+    let Measured {
+        rows,
+        gpu_bytes,
+        failed,
+        bake_resolutions,
+    } = m;
+    let (summary, ratios) = summarise(&variants, &rows, &gpu_bytes);
+    b.write("fidelity_summary.csv", &summary.csv())?;
+    println!("{}", summary.markdown());
+    let what = format!(
+        "{} species, {n} cameras each, {}x{}",
+        count, viewport.0, viewport.1
+    );
+    charts(b, &variants, &rows, &ratios, &what)?;
+    let text = paragraph(
+        b,
+        &variants,
+        &ratios,
+        &summary,
+        &failed,
+        &bake_resolutions,
+        &what,
+    );
+    Ok(Section {
+        title: "Fidelity around single trees".into(),
+        text,
+        table: summary,
+        charts: vec!["fidelity-distance".into(), "fidelity-elevation".into()],
+    })
+}
 
-    // Summary per variant.
+/// Species `k` seen from `n` seeded cameras by every variant: the references once, then each
+/// variant's frames (a re-baked variant in its scratch atlas), into `table` and `m`.
+#[allow(clippy::too_many_arguments)]
+fn measure_species(
+    b: &Bench,
+    k: usize,
+    n: usize,
+    viewport: (u32, u32),
+    variants: &[Variant],
+    target: &Target,
+    table: &mut Table,
+    m: &mut Measured,
+) -> Result<()> {
+    let quick = b.quick;
+    let scratch = b.out.join(SCRATCH);
+    let names: Vec<String> = b
+        .species_paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let data = &b.species[k];
+    let species = b.species_paths[k]
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| format!("species{k}"));
+    let views = views(data, n, viewport, SEED.wrapping_add(k as u64));
+    let forest = one_tree(names, k as u32);
+    let mut r0 = b.renderer(&forest, viewport, EPS, true, Background::Transparent)?;
+    eprintln!("fidelity: {species}: {n} references (4x4 supersampled full geometry)");
+    let refs = views
+        .iter()
+        .map(|v| reference(b, &mut r0, &v.cam))
+        .collect::<Result<Vec<_>>>()?;
+    let mut base = data.atlas.manifest.params;
+    if quick {
+        base.resolution = base.resolution.min(QUICK_RESOLUTION);
+        base.min_quad = base.min_quad.min(base.resolution / 2).max(1);
+    }
+    for (vi, v) in variants.iter().enumerate() {
+        let start = std::time::Instant::now();
+        // The renderer of this variant: the one given, or a scratch re-bake.
+        let mut scratch_r;
+        let r = match v.bake {
+            None => {
+                if !v.geometry {
+                    m.gpu_bytes[vi] += data.atlas.manifest.gpu_bytes();
+                }
+                &mut r0
+            }
+            Some(change) => {
+                let params = change(base);
+                eprintln!(
+                    "fidelity: {species} {}: baking ({} px, {} + {} directions, {} \
+                     slabs, min quad {}, {} fit)",
+                    v.name,
+                    params.resolution,
+                    params.directions,
+                    params.below,
+                    params.slabs,
+                    params.min_quad,
+                    params.plane_fit.name()
+                );
+                let path = scratch.join(format!("{k}-{vi}.atlas"));
+                let baked = forest_bake::bake_file(&b.models[k], &params, &|_, _| {})
+                    .map_err(anyhow::Error::from)
+                    .and_then(|out| {
+                        out.atlas.save(&path)?;
+                        scratch_renderer(b, &path, viewport, v.epsilon)
+                    });
+                match baked {
+                    Ok((r, gpu)) => {
+                        // Rows that do not swap the resolution itself: bake at the
+                        // base's (below the given atlases' in quick mode).
+                        if params.resolution == base.resolution {
+                            m.bake_resolutions.push(params.resolution);
+                        }
+                        m.gpu_bytes[vi] += gpu;
+                        scratch_r = r;
+                        &mut scratch_r
+                    }
+                    Err(e) => {
+                        eprintln!("fidelity: {species} {}: FAILED: {e:#}", v.name);
+                        m.failed.push(format!("{} ({species}): {e:#}", v.name));
+                        let _ = std::fs::remove_dir_all(&path);
+                        continue;
+                    }
+                }
+            }
+        };
+        r.stream.set_options(v.options)?;
+        let flips = measure_views(b, r, (vi, v), &species, &views, &refs, target, table, m)?;
+        r.stream.set_options(StreamOptions::default())?;
+        eprintln!(
+            "fidelity: {species} {}: mean FLIP {:.4} ({:.1} s)",
+            v.name,
+            mean(flips.into_iter()).unwrap_or(f64::NAN),
+            start.elapsed().as_secs_f64()
+        );
+        if v.bake.is_some() {
+            let _ = std::fs::remove_dir_all(scratch.join(format!("{k}-{vi}.atlas")));
+        }
+    }
+    Ok(())
+}
+
+/// Variant `v` (number `vi`) drawn by `r` from every view, each frame compared with its
+/// reference: a table row and a [`Row`] each; the views' FLIP.
+#[allow(clippy::too_many_arguments)]
+fn measure_views(
+    b: &Bench,
+    r: &mut ForestRenderer,
+    (vi, v): (usize, &Variant),
+    species: &str,
+    views: &[View],
+    refs: &[image::RgbaImage],
+    target: &Target,
+    table: &mut Table,
+    out: &mut Measured,
+) -> Result<Vec<f64>> {
+    let mut flips = Vec::new();
+    for (ci, (view, rf)) in views.iter().zip(refs).enumerate() {
+        let mut cam = view.cam;
+        cam.epsilon = v.epsilon;
+        let method = if v.geometry {
+            Method::Mesh(MeshMethod::Full { depth_sort: true })
+        } else {
+            Method::Quads
+        };
+        let (s, frame_ms) = b.measure(r, method, &cam, target, b.frames)?;
+        if s.overflow > 0 {
+            eprintln!(
+                "fidelity: {species} {} camera {ci}: {} quads overflowed",
+                v.name, s.overflow
+            );
+        }
+        let m = forest_metrics::compare(rf, &target.read(&b.ctx))?;
+        flips.push(f64::from(m.flip_mean));
+        table.push(vec![
+            v.name.into(),
+            species.to_owned(),
+            ci.to_string(),
+            format!("{:.3}", view.distance_radii),
+            format!("{:.2}", view.elevation_deg),
+            format!("{:.2}", view.azimuth_deg),
+            view.between.to_string(),
+            v.epsilon.to_string(),
+            s.primitives.to_string(),
+            format!("{:.5}", m.flip_mean),
+            cell(m.coverage_iou, 4),
+            ms(frame_ms),
+        ]);
+        out.rows.push(Row {
+            variant: vi,
+            distance_radii: view.distance_radii,
+            elevation_deg: view.elevation_deg,
+            flip: m.flip_mean,
+            iou: m.coverage_iou,
+            frame_ms,
+        });
+    }
+    Ok(flips)
+}
+
+/// The summary per variant (rows, mean FLIP overall and per bucket of distance and elevation,
+/// the ratio to the baseline, frame time, atlas bytes), and each variant's (name, FLIP, ratio).
+fn summarise<'a>(
+    variants: &'a [Variant],
+    rows: &[Row],
+    gpu_bytes: &[u64],
+) -> (Table, Vec<(&'a str, f64, f64)>) {
     let stats = |vi: usize, f: &dyn Fn(&Row) -> bool| {
         mean(
             rows.iter()
@@ -545,12 +627,19 @@ pub fn run(b: &Bench) -> Result<Section> {
             },
         ]);
     }
-    b.write("fidelity_summary.csv", &summary.csv())?;
-    println!("{}", summary.markdown());
+    (summary, ratios)
+}
 
-    // Charts: mean FLIP per bin of distance and of elevation, one line per variant drawn
-    // (the baseline, the paper's method, the yardstick, and every row CHART_SHARE or more
-    // away from the baseline; the table has them all).
+/// The charts: mean FLIP per bin of distance and of elevation, one line per variant drawn
+/// (the baseline, the paper's method, the yardstick, and every row [`CHART_SHARE`] or more
+/// away from the baseline; the table has them all).
+fn charts(
+    b: &Bench,
+    variants: &[Variant],
+    rows: &[Row],
+    ratios: &[(&str, f64, f64)],
+    what: &str,
+) -> Result<()> {
     let drawn = |v: &Variant| {
         matches!(v.name, "baseline" | "paper" | GEOMETRY)
             || ratios
@@ -575,10 +664,6 @@ pub fn run(b: &Bench) -> Result<Section> {
             })
             .collect()
     };
-    let what = format!(
-        "{} species, {n} cameras each, {}x{}",
-        count, viewport.0, viewport.1
-    );
     b.chart(
         "fidelity-distance",
         &Chart {
@@ -600,22 +685,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             ..Default::default()
         },
     )?;
-
-    let text = paragraph(
-        b,
-        &variants,
-        &ratios,
-        &summary,
-        &failed,
-        &bake_resolutions,
-        &what,
-    );
-    Ok(Section {
-        title: "Fidelity around single trees".into(),
-        text,
-        table: summary,
-        charts: vec!["fidelity-distance".into(), "fidelity-elevation".into()],
-    })
+    Ok(())
 }
 
 /// Summary rows `a` and `b` compared per bucket of cameras ("LABEL A against B", with the
