@@ -157,86 +157,9 @@ fn peak_resident() -> Option<u64> {
 
 /// Run `forest bake`.
 pub fn run(args: &BakeArgs) -> Result<()> {
-    if let Some(sun) = &args.sun {
-        bail!(
-            "--sun {sun}: atlases store no light since format 3, so the bake takes no sun; \
-             choose it at run time: `forest render --sun AZ,EL`, `forest view --sun AZ,EL`"
-        );
-    }
     let params = args.params();
     params.validate()?;
-    if args.output.exists()
-        && !args
-            .output
-            .join(forest_format::atlas::MANIFEST_FILE)
-            .is_file()
-    {
-        bail!(
-            "{} exists and is not an atlas folder: refusing to overwrite it",
-            args.output.display()
-        );
-    }
-    forest_format::atlas::check_only_atlas_files(&args.output)?;
-    let out_parent = args.output.parent().filter(|p| !p.as_os_str().is_empty());
-    if let Some(p) = out_parent
-        && !p.is_dir()
-    {
-        if p.exists() {
-            bail!(
-                "{} is a file, not a folder: the output atlas {} cannot be made in it",
-                p.display(),
-                args.output.display()
-            );
-        }
-        bail!("output folder {} does not exist", p.display());
-    }
-    // Refuse what cannot fit before tracing for minutes and then failing an allocation.
-    let model_bytes = std::fs::metadata(&args.model).map(|m| m.len()).unwrap_or(0);
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u64);
-    let mut need = forest_bake::peak_bytes_estimate(&params, model_bytes, threads);
-    if !args.no_hybrid_switch {
-        // The atlas stays in memory while the switch is measured.
-        need += forest_measure::switch::peak_bytes_estimate(model_bytes);
-    }
-    let limit = match args.memory_limit {
-        Some(g) if g.is_finite() && g > 0.0 => Some((g * f64::from(1u32 << 30)) as u64),
-        Some(g) => bail!("memory limit {g} GiB must be positive"),
-        None => available_memory(),
-    };
-    if let Some(limit) = limit
-        && need > limit
-    {
-        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
-        bail!(
-            "this bake needs about {:.1} GiB at its peak ({} layers of {}x{} px), more than the \
-             {:.1} GiB available: lower --resolution or --directions/--below/--slabs",
-            gib(need),
-            params.layers(),
-            params.resolution,
-            params.resolution,
-            gib(limit)
-        );
-    }
-    // The model's own files (OBJ, material libraries, textures) are never overwritten, and
-    // the outputs never overwrite each other.
-    let inputs = forest_bake::source_files(&args.model)?;
-    crate::guard::not_an_input(&args.output, "output atlas", &inputs)?;
-    if let Some(p) = &args.contact_sheet {
-        crate::guard::not_an_input(p, "contact sheet", &inputs)?;
-        crate::guard::apart_from(p, "contact sheet", &args.output, "output atlas")?;
-        crate::guard::extension(p, "contact sheet", "PNG", &["png"])?;
-        check_output_file(p, "contact sheet")?;
-    }
-    if let Some(p) = &args.depth_exr {
-        crate::guard::not_an_input(p, "depth EXR", &inputs)?;
-        crate::guard::apart_from(p, "depth EXR", &args.output, "output atlas")?;
-        if let Some(c) = &args.contact_sheet {
-            crate::guard::apart_from(p, "depth EXR", c, "contact sheet")?;
-        }
-        crate::guard::extension(p, "depth EXR", "OpenEXR", &["exr"])?;
-        check_output_file(p, "depth EXR")?;
-    }
-
+    let need = check(args, &params)?;
     let bar = crate::progress::bar(
         format!("tracing {}", args.model.display()),
         "tiles",
@@ -261,45 +184,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         Some(std::sync::Arc::new(forest_bake::model::prepare(&mesh, sky)))
     };
 
-    // Where the hybrid should switch this model to the quad stream, measured before the atlas
-    // is written so that it is written once, whole.
-    let mut measured = None;
-    let mut switch_note = None;
-    if !args.no_hybrid_switch {
-        match crate::gpu_context() {
-            Ok(ctx) => {
-                let bar =
-                    crate::progress::bar("measuring the hybrid switch".into(), "views", args.json);
-                let progress = |done: u64, total: u64| {
-                    bar.set_length(total);
-                    bar.set_position(done);
-                };
-                let species =
-                    forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
-                let model = model.clone().expect("prepared when the switch is measured");
-                let m = forest_measure::switch::measure(
-                    &ctx,
-                    species,
-                    model,
-                    args.switch_tolerance,
-                    crate::colour_format(),
-                    &progress,
-                )
-                .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
-                bar.finish_and_clear();
-                out.atlas.manifest.hybrid_switch = Some(m.switch);
-                measured = Some(m);
-            }
-            Err(e) => {
-                switch_note = Some(format!(
-                    "no GPU adapter ({e}): the hybrid switch was not measured, the hybrid \
-                     switches where the finest quads project to {} px",
-                    forest_render::forms::DEFAULT_SWITCH_PIXELS
-                ));
-            }
-        }
-    }
-
+    let (measured, switch_note) = measure_switch(args, &mut out, model.clone())?;
     let model_file = model.filter(|_| !args.no_model).map(|m| m.encode());
     let disk = out
         .atlas
@@ -359,58 +244,199 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     if args.json {
         println!("{report}");
     } else {
-        let mb = |b: u64| b as f64 / 1e6;
-        println!(
-            "baked {} -> {} in {:.1} s",
-            args.model.display(),
-            args.output.display(),
-            out.seconds
-        );
-        println!(
-            "  {} triangles ({} degenerate skipped), bounding radius {:.2} m",
-            out.triangles, m.source.degenerate_triangles, m.bounding_sphere.radius
-        );
-        println!(
-            "  {} + {} directions (above + below the horizon) x {} slabs of {}² px, {} levels \
-             (smallest quad {} px), {} spp, {} plane fit",
-            params.directions,
-            params.below,
-            params.slabs,
-            params.resolution,
-            m.levels,
-            params.min_quad,
-            params.spp,
-            params.plane_fit.name()
-        );
-        println!(
-            "  nodes per level {:?}, {} in all",
-            m.nodes_per_level, m.node_count
-        );
-        println!(
-            "  disk {:.2} MB ({}), GPU {:.2} MB (BC7 albedo and surface with mips, nodes, \
-             opacity volume)",
-            mb(disk),
-            file_summary(&files),
-            mb(m.gpu_bytes())
-        );
-        if let Some(measured) = &measured {
-            println!(
-                "  hybrid switch: {}",
-                forest_measure::switch::describe_measured(measured)
-            );
-            println!(
-                "  {}",
-                forest_measure::switch::describe_lods(
-                    &measured.ladder,
-                    measured.switch.crown_radii
-                )
-            );
-        }
-        if let Some(p) = &args.contact_sheet {
-            println!("  contact sheet {}", p.display());
-        }
+        summary(args, &out, &params, disk, &files, measured.as_ref());
     }
     Ok(())
+}
+
+/// Refuse what the bake cannot do before tracing: a sun, an output that is not an atlas, a
+/// folder that does not exist, more memory than there is, outputs over the model's own files
+/// or each other. The bake's estimated peak, in bytes.
+fn check(args: &BakeArgs, params: &forest_format::BakeParams) -> Result<u64> {
+    if let Some(sun) = &args.sun {
+        bail!(
+            "--sun {sun}: atlases store no light since format 3, so the bake takes no sun; \
+             choose it at run time: `forest render --sun AZ,EL`, `forest view --sun AZ,EL`"
+        );
+    }
+    if args.output.exists()
+        && !args
+            .output
+            .join(forest_format::atlas::MANIFEST_FILE)
+            .is_file()
+    {
+        bail!(
+            "{} exists and is not an atlas folder: refusing to overwrite it",
+            args.output.display()
+        );
+    }
+    forest_format::atlas::check_only_atlas_files(&args.output)?;
+    let out_parent = args.output.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(p) = out_parent
+        && !p.is_dir()
+    {
+        if p.exists() {
+            bail!(
+                "{} is a file, not a folder: the output atlas {} cannot be made in it",
+                p.display(),
+                args.output.display()
+            );
+        }
+        bail!("output folder {} does not exist", p.display());
+    }
+    // Refuse what cannot fit before tracing for minutes and then failing an allocation.
+    let model_bytes = std::fs::metadata(&args.model).map(|m| m.len()).unwrap_or(0);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u64);
+    let mut need = forest_bake::peak_bytes_estimate(params, model_bytes, threads);
+    if !args.no_hybrid_switch {
+        // The atlas stays in memory while the switch is measured.
+        need += forest_measure::switch::peak_bytes_estimate(model_bytes);
+    }
+    let limit = match args.memory_limit {
+        Some(g) if g.is_finite() && g > 0.0 => Some((g * f64::from(1u32 << 30)) as u64),
+        Some(g) => bail!("memory limit {g} GiB must be positive"),
+        None => available_memory(),
+    };
+    if let Some(limit) = limit
+        && need > limit
+    {
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        bail!(
+            "this bake needs about {:.1} GiB at its peak ({} layers of {}x{} px), more than the \
+             {:.1} GiB available: lower --resolution or --directions/--below/--slabs",
+            gib(need),
+            params.layers(),
+            params.resolution,
+            params.resolution,
+            gib(limit)
+        );
+    }
+    // The model's own files (OBJ, material libraries, textures) are never overwritten, and
+    // the outputs never overwrite each other.
+    let inputs = forest_bake::source_files(&args.model)?;
+    crate::guard::not_an_input(&args.output, "output atlas", &inputs)?;
+    if let Some(p) = &args.contact_sheet {
+        crate::guard::not_an_input(p, "contact sheet", &inputs)?;
+        crate::guard::apart_from(p, "contact sheet", &args.output, "output atlas")?;
+        crate::guard::extension(p, "contact sheet", "PNG", &["png"])?;
+        check_output_file(p, "contact sheet")?;
+    }
+    if let Some(p) = &args.depth_exr {
+        crate::guard::not_an_input(p, "depth EXR", &inputs)?;
+        crate::guard::apart_from(p, "depth EXR", &args.output, "output atlas")?;
+        if let Some(c) = &args.contact_sheet {
+            crate::guard::apart_from(p, "depth EXR", c, "contact sheet")?;
+        }
+        crate::guard::extension(p, "depth EXR", "OpenEXR", &["exr"])?;
+        check_output_file(p, "depth EXR")?;
+    }
+    Ok(need)
+}
+
+/// Where the hybrid should switch this model to the quad stream, measured before the atlas
+/// is written (so that it is written once, whole) and stored in its manifest; a note instead
+/// when there is no GPU.
+fn measure_switch(
+    args: &BakeArgs,
+    out: &mut forest_bake::BakeOutput,
+    model: Option<std::sync::Arc<forest_format::model::PreparedModel>>,
+) -> Result<(Option<forest_measure::switch::Measured>, Option<String>)> {
+    let mut measured = None;
+    let mut switch_note = None;
+    if !args.no_hybrid_switch {
+        match crate::gpu_context() {
+            Ok(ctx) => {
+                let bar =
+                    crate::progress::bar("measuring the hybrid switch".into(), "views", args.json);
+                let progress = |done: u64, total: u64| {
+                    bar.set_length(total);
+                    bar.set_position(done);
+                };
+                let species =
+                    forest_render::scene::SpeciesData::decode(out.atlas.clone(), &args.output)?;
+                let model = model.expect("prepared when the switch is measured");
+                let m = forest_measure::switch::measure(
+                    &ctx,
+                    species,
+                    model,
+                    args.switch_tolerance,
+                    crate::colour_format(),
+                    &progress,
+                )
+                .context("measuring the hybrid switch (skip it with --no-hybrid-switch)")?;
+                bar.finish_and_clear();
+                out.atlas.manifest.hybrid_switch = Some(m.switch);
+                measured = Some(m);
+            }
+            Err(e) => {
+                switch_note = Some(format!(
+                    "no GPU adapter ({e}): the hybrid switch was not measured, the hybrid \
+                     switches where the finest quads project to {} px",
+                    forest_render::forms::DEFAULT_SWITCH_PIXELS
+                ));
+            }
+        }
+    }
+    Ok((measured, switch_note))
+}
+
+/// The bake's summary in words.
+fn summary(
+    args: &BakeArgs,
+    out: &forest_bake::BakeOutput,
+    params: &forest_format::BakeParams,
+    disk: u64,
+    files: &[(&str, u64)],
+    measured: Option<&forest_measure::switch::Measured>,
+) {
+    let m = &out.atlas.manifest;
+    let mb = |b: u64| b as f64 / 1e6;
+    println!(
+        "baked {} -> {} in {:.1} s",
+        args.model.display(),
+        args.output.display(),
+        out.seconds
+    );
+    println!(
+        "  {} triangles ({} degenerate skipped), bounding radius {:.2} m",
+        out.triangles, m.source.degenerate_triangles, m.bounding_sphere.radius
+    );
+    println!(
+        "  {} + {} directions (above + below the horizon) x {} slabs of {}² px, {} levels \
+         (smallest quad {} px), {} spp, {} plane fit",
+        params.directions,
+        params.below,
+        params.slabs,
+        params.resolution,
+        m.levels,
+        params.min_quad,
+        params.spp,
+        params.plane_fit.name()
+    );
+    println!(
+        "  nodes per level {:?}, {} in all",
+        m.nodes_per_level, m.node_count
+    );
+    println!(
+        "  disk {:.2} MB ({}), GPU {:.2} MB (BC7 albedo and surface with mips, nodes, \
+         opacity volume)",
+        mb(disk),
+        file_summary(files),
+        mb(m.gpu_bytes())
+    );
+    if let Some(measured) = measured {
+        println!(
+            "  hybrid switch: {}",
+            forest_measure::switch::describe_measured(measured)
+        );
+        println!(
+            "  {}",
+            forest_measure::switch::describe_lods(&measured.ladder, measured.switch.crown_radii)
+        );
+    }
+    if let Some(p) = &args.contact_sheet {
+        println!("  contact sheet {}", p.display());
+    }
 }
 
 fn parse_tolerance(s: &str) -> Result<f32, String> {
