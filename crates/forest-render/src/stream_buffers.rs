@@ -206,6 +206,88 @@ pub(crate) fn build_sized(
     let bg_cull = compute_bg("cull", (0, 1), (1, 0));
     let bg_ab = compute_bg("refine A->B", (1, 0), (0, 1));
     let bg_ba = compute_bg("refine B->A", (0, 1), (1, 0));
+    let bg_draw = draw_groups(device, scene, passes, [camera, environment, &state], &quads);
+    let mut sources = vec![(state.clone(), std::mem::size_of::<GpuState>() as u64)];
+    sources.extend(readback.iter().map(|(b, n)| ((*b).clone(), *n)));
+    let ring = StatsRing::new(device, sources);
+    let (view_bytes, owned) = view_buffers(
+        scene,
+        [camera, &consts, environment, &state, &args],
+        [&data[0], &data[1], &sums, &quads[0], &quads[1]],
+    );
+    Ok(Sized {
+        state,
+        args,
+        quads,
+        bg_cull,
+        bg_ab,
+        bg_ba,
+        bg_draw,
+        args_group,
+        ring,
+        owned,
+        view_bytes,
+    })
+}
+
+/// The bytes of a view's own buffers, and every buffer its passes bind with its label (the
+/// scene's too): `[camera, scene constants, environment, state, args]` and `[scan data A,
+/// scan data B, block sums, stream A, stream B]`.
+fn view_buffers(
+    scene: &GpuScene,
+    [camera, consts, environment, state, args]: [&wgpu::Buffer; 5],
+    [data_a, data_b, sums, quads_a, quads_b]: [&wgpu::Buffer; 5],
+) -> (u64, Vec<(&'static str, wgpu::Buffer)>) {
+    let view_bytes = [
+        camera,
+        consts,
+        environment,
+        state,
+        args,
+        data_a,
+        data_b,
+        sums,
+        quads_a,
+        quads_b,
+    ]
+    .iter()
+    .map(|b| b.size())
+    .sum::<u64>();
+    let owned: Vec<(&'static str, wgpu::Buffer)> = [
+        ("camera", camera),
+        ("scene constants", consts),
+        ("environment", environment),
+        ("state", state),
+        ("args", args),
+        ("scan data A", data_a),
+        ("scan data B", data_b),
+        ("block sums", sums),
+        ("stream A", quads_a),
+        ("stream B", quads_b),
+        ("instances", &scene.instances),
+        ("species", &scene.species),
+        ("frames", &scene.frames),
+        ("direction triangles", &scene.tris),
+        ("roots", &scene.roots),
+        ("presort directions", &scene.presort_dirs),
+    ]
+    .into_iter()
+    .map(|(l, b)| (l, b.clone()))
+    .collect();
+    (view_bytes, owned)
+}
+
+/// One draw group per stream buffer: the final stream is A after an even number of
+/// refinement iterations, B after an odd one (refinement can be switched at run time).
+/// `[camera, environment, state]` are the view's buffers.
+fn draw_groups(
+    device: &wgpu::Device,
+    scene: &GpuScene,
+    passes: &Passes,
+    [camera, environment, state]: [&wgpu::Buffer; 3],
+    quads: &[wgpu::Buffer; 2],
+) -> [wgpu::BindGroup; 2] {
+    let nodes_view = scene.nodes.create_view(&Default::default());
     let colour_view = scene.colour.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
@@ -222,9 +304,7 @@ pub(crate) fn build_sized(
         mipmap_filter: wgpu::MipmapFilterMode::Linear,
         ..Default::default()
     });
-    // One draw group per stream buffer: the final stream is A after an even number of
-    // refinement iterations, B after an odd one (refinement can be switched at run time).
-    let bg_draw = [&quads[0], &quads[1]].map(|final_quads| {
+    [&quads[0], &quads[1]].map(|final_quads| {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("draw"),
             layout: &passes.draw.bind_layout,
@@ -256,58 +336,6 @@ pub(crate) fn build_sized(
             ]
             .concat(),
         })
-    });
-    let mut sources = vec![(state.clone(), std::mem::size_of::<GpuState>() as u64)];
-    sources.extend(readback.iter().map(|(b, n)| ((*b).clone(), *n)));
-    let ring = StatsRing::new(device, sources);
-    let view_bytes = [
-        camera,
-        &consts,
-        environment,
-        &state,
-        &args,
-        &data[0],
-        &data[1],
-        &sums,
-        &quads[0],
-        &quads[1],
-    ]
-    .iter()
-    .map(|b| b.size())
-    .sum::<u64>();
-    let owned: Vec<(&'static str, wgpu::Buffer)> = [
-        ("camera", camera),
-        ("scene constants", &consts),
-        ("environment", environment),
-        ("state", &state),
-        ("args", &args),
-        ("scan data A", &data[0]),
-        ("scan data B", &data[1]),
-        ("block sums", &sums),
-        ("stream A", &quads[0]),
-        ("stream B", &quads[1]),
-        ("instances", &scene.instances),
-        ("species", &scene.species),
-        ("frames", &scene.frames),
-        ("direction triangles", &scene.tris),
-        ("roots", &scene.roots),
-        ("presort directions", &scene.presort_dirs),
-    ]
-    .into_iter()
-    .map(|(l, b)| (l, b.clone()))
-    .collect();
-    Ok(Sized {
-        state,
-        args,
-        quads,
-        bg_cull,
-        bg_ab,
-        bg_ba,
-        bg_draw,
-        args_group,
-        ring,
-        owned,
-        view_bytes,
     })
 }
 
