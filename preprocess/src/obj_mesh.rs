@@ -85,13 +85,34 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
     let obj_bytes = bounded::read(path, bounded::limit::DATA)?;
     let mut hash = fnv1a(FNV_OFFSET, &obj_bytes);
     let obj_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let (models, materials) = parse(path, &obj_bytes, &obj_dir, &mut hash)?;
+    let (mats, textures) = read_materials(path, &obj_dir, &materials, &mut hash)?;
+    let (tris, degenerate) = triangles(path, &models, mats.len())?;
+    Ok(Mesh {
+        tris,
+        materials: mats,
+        textures,
+        degenerate,
+        hash,
+        notes: Vec::new(),
+    })
+}
+
+/// The OBJ's objects and its libraries' materials (libraries hashed into `hash`), every
+/// `usemtl` naming one of them.
+fn parse(
+    path: &Path,
+    obj_bytes: &[u8],
+    obj_dir: &Path,
+    hash: &mut u64,
+) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>), BakeError> {
     // Material libraries are read bounded (a `mtllib` naming a device or a huge file is
     // refused, not read until memory runs out) and hashed too.
-    let mtl_hash = std::cell::Cell::new(hash);
+    let mtl_hash = std::cell::Cell::new(*hash);
     let mtl_error = std::cell::RefCell::new(None);
-    check_face_indices(path, &obj_bytes)?;
+    check_face_indices(path, obj_bytes)?;
     let loaded = tobj::load_obj_buf(
-        &mut std::io::Cursor::new(&obj_bytes),
+        &mut std::io::Cursor::new(obj_bytes),
         &tobj::GPU_LOAD_OPTIONS,
         |p| {
             let file = obj_dir.join(p);
@@ -114,7 +135,7 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
             }
         },
     );
-    hash = mtl_hash.get();
+    *hash = mtl_hash.get();
     if let Some(e) = mtl_error.into_inner() {
         return Err(e.into());
     }
@@ -130,7 +151,7 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
     })?;
 
     // A `usemtl` naming no material of the libraries is an error, not material 0.
-    for (n, line) in String::from_utf8_lossy(&obj_bytes).lines().enumerate() {
+    for (n, line) in String::from_utf8_lossy(obj_bytes).lines().enumerate() {
         if let Some(name) = line.trim_start().strip_prefix("usemtl") {
             let name = name.trim();
             if !name.is_empty() && !materials.iter().any(|m| m.name == name) {
@@ -147,12 +168,22 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
             }
         }
     }
+    Ok((models, materials))
+}
 
+/// The bake's materials of the libraries' (a grey default when there are none) and their
+/// textures, each read once (hashed into `hash`).
+fn read_materials(
+    path: &Path,
+    obj_dir: &Path,
+    materials: &[tobj::Material],
+    hash: &mut u64,
+) -> Result<(Vec<Material>, Vec<Texture>), BakeError> {
     let mut textures: Vec<Texture> = Vec::new();
     let mut by_path: HashMap<PathBuf, (usize, bool)> = HashMap::new();
     let mut load_texture =
         |material: &str, spec: &str, hash: &mut u64| -> Result<(usize, bool), BakeError> {
-            let file = texture_path(&obj_dir, spec);
+            let file = texture_path(obj_dir, spec);
             if let Some(&i) = by_path.get(&file) {
                 return Ok(i);
             }
@@ -174,17 +205,17 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
         };
 
     let mut mats = Vec::with_capacity(materials.len().max(1));
-    for m in &materials {
+    for m in materials {
         let kd = m
             .diffuse
             .map(|c| Vec3::from_array(c.map(srgb_decode)))
             .unwrap_or(Vec3::ONE);
         let colour = match &m.diffuse_texture {
-            Some(t) => Some(load_texture(&m.name, t, &mut hash)?),
+            Some(t) => Some(load_texture(&m.name, t, hash)?),
             None => None,
         };
         let alpha = match (&m.dissolve_texture, colour) {
-            (Some(t), _) => Some(load_texture(&m.name, t, &mut hash)?),
+            (Some(t), _) => Some(load_texture(&m.name, t, hash)?),
             (None, Some((c, true))) => Some((c, true)),
             _ => None,
         };
@@ -210,11 +241,21 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
             translucency: 0.0,
         });
     }
+    Ok((mats, textures))
+}
 
+/// The objects' triangles (every coordinate finite and within [`MAX_MODEL_COORDINATE`]), less
+/// the degenerate ones (counted); refused when none is left. Faces name materials below
+/// `materials`, else the first.
+fn triangles(
+    path: &Path,
+    models: &[tobj::Model],
+    materials: usize,
+) -> Result<(Vec<Tri>, u64), BakeError> {
     let mut tris = Vec::new();
     let mut degenerate = 0u64;
     let mut extent = 0.0f32;
-    for model in &models {
+    for model in models {
         let mesh = &model.mesh;
         if let Some(i) = mesh
             .positions
@@ -241,7 +282,7 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
     }
     // Zero-area test relative to the model's size.
     let min_area2 = min_area2(extent);
-    for model in &models {
+    for model in models {
         let mesh = &model.mesh;
         let pos = |i: u32| {
             let i = i as usize * 3;
@@ -253,7 +294,7 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
         };
         let has_uv = mesh.texcoords.len() * 3 == mesh.positions.len() * 2;
         let has_n = mesh.normals.len() == mesh.positions.len();
-        let material = mesh.material_id.filter(|&m| m < mats.len()).unwrap_or(0) as u32;
+        let material = mesh.material_id.filter(|&m| m < materials).unwrap_or(0) as u32;
         for f in mesh.indices.chunks_exact(3) {
             let f: [u32; 3] = [f[0], f[1], f[2]];
             let uv = f.map(|i| {
@@ -279,14 +320,7 @@ pub(crate) fn load(path: &Path) -> Result<Mesh, BakeError> {
     if tris.is_empty() {
         return Err(no_triangles(path, degenerate));
     }
-    Ok(Mesh {
-        tris,
-        materials: mats,
-        textures,
-        degenerate,
-        hash,
-        notes: Vec::new(),
-    })
+    Ok((tris, degenerate))
 }
 
 /// The files an OBJ model is read from: the OBJ, its material libraries (`mtllib`) and every
