@@ -130,8 +130,93 @@ pub fn species_height(name: &str) -> Option<(f32, f32)> {
         .map(|&(_, lo, hi)| (lo, hi))
 }
 
+/// The terrain's rules where a forest stands on one: the terrain, its rules, its lowest
+/// height and height range, and each species' preferred altitude.
+type Ground<'a> = (&'a Terrain, GroundRules, f32, f32, Vec<f32>);
+
 /// Generate a forest; the error says which parameter is wrong.
 pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
+    validate(p)?;
+    let side = (p.trees as f32 * p.area_per_tree).sqrt();
+    let ground = ground(p, side)?;
+    let mut rng = SplitMix64(p.seed);
+    let mut instances = Vec::with_capacity(p.trees as usize);
+    let max_attempts = 1000u64 * u64::from(p.trees);
+    let mut attempts = 0u64;
+    // Candidates the clump map kept, and those of them the ground's rules then refused.
+    let (mut clump_kept, mut refused_by_ground) = (0u64, 0u64);
+    while instances.len() < p.trees as usize {
+        attempts += 1;
+        if attempts > max_attempts {
+            return Err(if refused_by_ground * 10 > clump_kept * 9 {
+                "the terrain's rules refuse too many places (steep slopes, ground above the \
+                 treeline, altitudes far from the species' bands): raise --max-slope or \
+                 --treeline, or lower the relief"
+                    .into()
+            } else {
+                "the clump map accepts too few points; raise the clump size".into()
+            });
+        }
+        let x = (rng.next_f32() - 0.5) * side;
+        let z = (rng.next_f32() - 0.5) * side;
+        let t = turbulence(x / p.clump_size, z / p.clump_size, p.seed).powi(3) * 8.0;
+        if rng.next_f32() >= t.min(1.0) {
+            continue;
+        }
+        let patch = value_noise(
+            x / (p.clump_size * 3.0),
+            z / (p.clump_size * 3.0),
+            p.seed ^ 0xabc,
+        );
+        let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
+            .floor()
+            .clamp(0.0, (p.species.len() - 1) as f32) as u32;
+        clump_kept += 1;
+        let mut y = 0.0;
+        if let Some((t, g, low, range, prefs)) = &ground {
+            y = t.height(x, z);
+            let slope = t.slope(x, z).atan().to_degrees();
+            let mut keep = ((g.max_slope_deg - slope) / 10.0).clamp(0.0, 1.0);
+            // Ground within a metre of level has no altitudes to speak of: no treeline, no
+            // bands (every altitude would be 0, and the bands would thin some species only).
+            if *range >= 1.0 {
+                let alt = (y - low) / range;
+                keep *= ((g.treeline - alt) / 0.1).clamp(0.0, 1.0)
+                    * (-((alt - prefs[pick as usize]) / g.band).powi(2)).exp();
+            }
+            // (No draw where every rule keeps the place: level ground generates the same
+            // forest as no terrain, raised to its height.)
+            if keep < 1.0 && rng.next_f32() >= keep {
+                refused_by_ground += 1;
+                continue;
+            }
+        }
+        let (lo, hi) = p
+            .species_scale
+            .get(pick as usize)
+            .copied()
+            .unwrap_or(p.scale);
+        let rotation = rng.next_f32() * std::f32::consts::TAU;
+        let scale = lo + (hi - lo) * rng.next_f32();
+        if let (Some((t, ..)), Some(r)) = (&ground, p.footprint.get(pick as usize)) {
+            y = t.lowest_under(x, z, r * scale);
+        }
+        instances.push(Instance {
+            position: [x, y, z],
+            rotation,
+            scale,
+            species: pick,
+        });
+    }
+    let forest = Forest::new(p.species.clone(), instances, p.presort_directions);
+    Ok(match &p.terrain {
+        Some(t) => forest.with_terrain(t.clone()),
+        None => forest,
+    })
+}
+
+/// Refuse parameters out of range, naming the parameter.
+fn validate(p: &GenerateParams) -> Result<(), String> {
     if p.trees == 0 || p.trees as usize > crate::forest::MAX_INSTANCES {
         return Err(format!(
             "trees = {}: must be 1 to {}",
@@ -206,8 +291,13 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             p.presort_directions
         ));
     }
-    let side = (p.trees as f32 * p.area_per_tree).sqrt();
-    let ground = match &p.terrain {
+    Ok(())
+}
+
+/// The ground the trees of a `side`-metre square stand on, with its rules checked (None
+/// without terrain).
+fn ground(p: &GenerateParams, side: f32) -> Result<Option<Ground<'_>>, String> {
+    Ok(match &p.terrain {
         Some(t) => {
             t.check().map_err(|e| format!("terrain: {e}"))?;
             let half = side / 2.0;
@@ -238,80 +328,6 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
             Some((t, g, lo, hi - lo, prefs))
         }
         None => None,
-    };
-    let mut rng = SplitMix64(p.seed);
-    let mut instances = Vec::with_capacity(p.trees as usize);
-    let max_attempts = 1000u64 * u64::from(p.trees);
-    let mut attempts = 0u64;
-    // Candidates the clump map kept, and those of them the ground's rules then refused.
-    let (mut clump_kept, mut refused_by_ground) = (0u64, 0u64);
-    while instances.len() < p.trees as usize {
-        attempts += 1;
-        if attempts > max_attempts {
-            return Err(if refused_by_ground * 10 > clump_kept * 9 {
-                "the terrain's rules refuse too many places (steep slopes, ground above the \
-                 treeline, altitudes far from the species' bands): raise --max-slope or \
-                 --treeline, or lower the relief"
-                    .into()
-            } else {
-                "the clump map accepts too few points; raise the clump size".into()
-            });
-        }
-        let x = (rng.next_f32() - 0.5) * side;
-        let z = (rng.next_f32() - 0.5) * side;
-        let t = turbulence(x / p.clump_size, z / p.clump_size, p.seed).powi(3) * 8.0;
-        if rng.next_f32() >= t.min(1.0) {
-            continue;
-        }
-        let patch = value_noise(
-            x / (p.clump_size * 3.0),
-            z / (p.clump_size * 3.0),
-            p.seed ^ 0xabc,
-        );
-        let pick = ((patch * 0.5 + 0.5) * p.species.len() as f32 + rng.next_f32() * 0.8 - 0.4)
-            .floor()
-            .clamp(0.0, (p.species.len() - 1) as f32) as u32;
-        clump_kept += 1;
-        let mut y = 0.0;
-        if let Some((t, g, low, range, prefs)) = &ground {
-            y = t.height(x, z);
-            let slope = t.slope(x, z).atan().to_degrees();
-            let mut keep = ((g.max_slope_deg - slope) / 10.0).clamp(0.0, 1.0);
-            // Ground within a metre of level has no altitudes to speak of: no treeline, no
-            // bands (every altitude would be 0, and the bands would thin some species only).
-            if *range >= 1.0 {
-                let alt = (y - low) / range;
-                keep *= ((g.treeline - alt) / 0.1).clamp(0.0, 1.0)
-                    * (-((alt - prefs[pick as usize]) / g.band).powi(2)).exp();
-            }
-            // (No draw where every rule keeps the place: level ground generates the same
-            // forest as no terrain, raised to its height.)
-            if keep < 1.0 && rng.next_f32() >= keep {
-                refused_by_ground += 1;
-                continue;
-            }
-        }
-        let (lo, hi) = p
-            .species_scale
-            .get(pick as usize)
-            .copied()
-            .unwrap_or(p.scale);
-        let rotation = rng.next_f32() * std::f32::consts::TAU;
-        let scale = lo + (hi - lo) * rng.next_f32();
-        if let (Some((t, ..)), Some(r)) = (&ground, p.footprint.get(pick as usize)) {
-            y = t.lowest_under(x, z, r * scale);
-        }
-        instances.push(Instance {
-            position: [x, y, z],
-            rotation,
-            scale,
-            species: pick,
-        });
-    }
-    let forest = Forest::new(p.species.clone(), instances, p.presort_directions);
-    Ok(match &p.terrain {
-        Some(t) => forest.with_terrain(t.clone()),
-        None => forest,
     })
 }
 
