@@ -160,29 +160,8 @@ impl GpuModels {
             draw_order,
             figures,
         } = prepared;
-        if geo_species.len() != forest.species.len() {
-            return Err(RenderError::SpeciesCount {
-                forest: forest.species.len(),
-                given: geo_species.len(),
-                what: "models",
-            });
-        }
-        require_indirect_first_instance(ctx)?;
+        let capacity = checked_capacity(ctx, prepared, forest)?;
         let device = &ctx.device;
-        check_limits(&device.limits(), prepared, forest.instances.len())?;
-        let capacity = GeometryCapacity::new(
-            forest.instances.len() as u32,
-            prepared.geo_species.len() as u32,
-            BANDS,
-            prepared.listings(),
-        )
-        .ok_or_else(|| {
-            RenderError::Parameter(format!(
-                "{} trees listed {} times overflow the geometry methods' visible list",
-                forest.instances.len(),
-                prepared.listings()
-            ))
-        })?;
         let terrain = GpuTerrain::new(device, forest.terrain.as_ref())?;
         let instances = forest_render::scene::gpu_instances(forest);
         let mut bytes = terrain.bytes();
@@ -265,21 +244,7 @@ impl GpuModels {
             &opacity.iter().collect::<Vec<_>>(),
         )?;
         bytes += material_bytes + billboard_bytes + billboard_surface_bytes + opacity_bytes;
-        let opacity_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("opacity"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("material"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let (sampler, opacity_sampler) = samplers(device);
         Ok(Self {
             instances: instance_buf,
             species: species_buf,
@@ -335,4 +300,55 @@ pub(super) fn require_indirect_first_instance(ctx: &GpuContext) -> Result<(), Re
             feature: "indirect draws with a first instance (INDIRECT_FIRST_INSTANCE)",
         })
     }
+}
+
+/// The species counts agree, the device can draw the geometry methods and hold the
+/// prepared geometry ([`check_limits`]): the visible list's capacity.
+fn checked_capacity(
+    ctx: &GpuContext,
+    prepared: &PreparedGeometry,
+    forest: &Forest,
+) -> Result<GeometryCapacity, RenderError> {
+    if prepared.geo_species.len() != forest.species.len() {
+        return Err(RenderError::SpeciesCount {
+            forest: forest.species.len(),
+            given: prepared.geo_species.len(),
+            what: "models",
+        });
+    }
+    require_indirect_first_instance(ctx)?;
+    check_limits(&ctx.device.limits(), prepared, forest.instances.len())?;
+    GeometryCapacity::new(
+        forest.instances.len() as u32,
+        prepared.geo_species.len() as u32,
+        BANDS,
+        prepared.listings(),
+    )
+    .ok_or_else(|| {
+        RenderError::Parameter(format!(
+            "{} trees listed {} times overflow the geometry methods' visible list",
+            forest.instances.len(),
+            prepared.listings()
+        ))
+    })
+}
+
+/// The material textures' sampler (repeating, trilinear) and the opacity volumes'.
+fn samplers(device: &wgpu::Device) -> (wgpu::Sampler, wgpu::Sampler) {
+    let opacity_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("opacity"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("material"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    });
+    (sampler, opacity_sampler)
 }

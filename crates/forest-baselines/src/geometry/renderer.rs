@@ -132,35 +132,11 @@ impl GeometryRenderer {
             U::UNIFORM | U::COPY_DST,
         );
 
-        let compute = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("geometry cull"),
-            source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_CULL_WGSL.concat().into()),
-        });
         let draw_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry draw"),
             source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_DRAW_WGSL.concat().into()),
         });
-        // One explicit layout shared by the four compute entry points (one bind group).
-        let entries = compute_entries();
-        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("geometry cull"),
-            entries: &entries,
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("geometry cull"),
-            bind_group_layouts: &[Some(&compute_layout)],
-            immediate_size: 0,
-        });
-        let cpl = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &compute,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let (compute_layout, [reset, classify, args_pipeline, scatter]) = compute_pipelines(device);
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("geometry draw"),
             entries: &draw_entries(),
@@ -244,10 +220,10 @@ impl GeometryRenderer {
             method_buf,
             method,
             ring,
-            reset: cpl("geo_reset"),
-            classify: cpl("geo_classify"),
-            args_pipeline: cpl("geo_args"),
-            scatter: cpl("geo_scatter"),
+            reset,
+            classify,
+            args_pipeline,
+            scatter,
             draw,
             billboard,
             environment,
@@ -572,6 +548,38 @@ impl forest_render::shadow_maps::Caster for GeometryRenderer {
         let [a, b] = &lv.cast;
         self.record_bands(pass, &view.args, [a, b]);
     }
+}
+
+/// The geometry methods' compute layout and its four entry points, in order: reset,
+/// classify, arguments, scatter (one module, one bind group).
+fn compute_pipelines(device: &wgpu::Device) -> (wgpu::BindGroupLayout, [wgpu::ComputePipeline; 4]) {
+    let compute = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("geometry cull"),
+        source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_CULL_WGSL.concat().into()),
+    });
+    // One explicit layout shared by the four compute entry points (one bind group).
+    let entries = compute_entries();
+    let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("geometry cull"),
+        entries: &entries,
+    });
+    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("geometry cull"),
+        bind_group_layouts: &[Some(&compute_layout)],
+        immediate_size: 0,
+    });
+    let cpl = |entry: &str| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&pl),
+            module: &compute,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let pipelines = ["geo_reset", "geo_classify", "geo_args", "geo_scatter"].map(cpl);
+    (compute_layout, pipelines)
 }
 
 /// The geometry renderer's passes behind the frame API ([`forest_render::ForestView`]).
