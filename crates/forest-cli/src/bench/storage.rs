@@ -48,7 +48,60 @@ const MB: f64 = 1048576.0;
 
 /// Run the suite.
 pub fn run(b: &Bench) -> Result<Section> {
-    // Per species and method.
+    let (table, quad_total, geo_total, files) = per_species(b)?;
+    let viewport = (800, 600);
+    let forest_table = per_forest(b, viewport)?;
+    per_stream(b, viewport)?;
+    // Marginal bytes per instance between the two largest forests.
+    let per_instance = |m: &str| {
+        let rows: Vec<(f64, f64)> = forest_table
+            .rows
+            .iter()
+            .filter(|r| r[0] == m)
+            .map(|r| (r[1].parse().unwrap_or(0.0), r[3].parse().unwrap_or(0.0)))
+            .collect();
+        match rows.as_slice() {
+            [.., a, b] if b.0 > a.0 => format!("{:.1}", (b.1 - a.1) / (b.0 - a.0)),
+            _ => "-".into(),
+        }
+    };
+    let text = format!(
+        "Per species, the quad stream stores its atlas ({:.2} MiB on disk, {:.2} MiB on the GPU \
+         as BC7, all species together) and the geometry methods their models ({:.2} MiB on \
+         disk, {:.2} MiB on the GPU with LODs, leaf tables and billboards). Static impostors \
+         bind the same atlas. Between the two largest forests each added tree costs {} B of GPU \
+         memory with the quad stream (instance, presorted orders, a scan slot) and {} B with \
+         the geometry methods (instance, classification key, visible-list slot): memory grows \
+         with the models, not the instances. The quad-stream buffers start from `Capacity`'s \
+         estimate (the level-0 quads of the visible trees, at most a quarter of the screen's \
+         pixels, plus what refinement can add) and grow when a frame overflows them \
+         (`QuadStream::fit`, to the frame's need plus an eighth); the last chart compares the \
+         allocation after the measured frames with what they needed. An atlas's files (MiB): \
+         the colour mosaic (premultiplied albedo), alpha (coverage), surface (normal, sky \
+         visibility and translucency at half the slab resolution), opacity (the 32³ \
+         self-shadowing volume) and nodes: {}.",
+        quad_total.0 as f64 / MB,
+        quad_total.1 as f64 / MB,
+        geo_total.0 as f64 / MB,
+        geo_total.1 as f64 / MB,
+        per_instance("quads"),
+        per_instance("geometry"),
+        files.join("; "),
+    );
+    let mut all = table;
+    all.rows.sort_by(|a, b| a[0].cmp(&b[0]));
+    Ok(Section {
+        title: "Storage".into(),
+        text,
+        table: all,
+        charts: vec!["storage_forest".into(), "storage_stream".into()],
+    })
+}
+
+/// Per species and method: disk and GPU bytes; the quad stream's and the geometry methods'
+/// totals (disk, GPU), and each atlas's files for the text.
+#[allow(clippy::type_complexity)]
+fn per_species(b: &Bench) -> Result<(Table, (u64, u64), (u64, u64), Vec<String>)> {
     let mut table = Table::new(&["method", "species", "disk_bytes", "gpu_bytes"]);
     let mut quad_total = (0u64, 0u64);
     // Each atlas's files (the channels it stores), for the text.
@@ -96,14 +149,17 @@ pub fn run(b: &Bench) -> Result<Section> {
         }
     }
     b.write("storage.csv", &table.csv())?;
+    Ok((table, quad_total, geo_total, files))
+}
 
-    // Forest memory against instances.
+/// Forest memory against instances: the quad stream's, the geometry methods' and the forest
+/// file's, a row and a chart point per forest size.
+fn per_forest(b: &Bench, viewport: (u32, u32)) -> Result<Table> {
     let counts: Vec<u32> = if b.quick {
         vec![1000, 10_000]
     } else {
         vec![1000, 10_000, 100_000, 1_000_000]
     };
-    let viewport = (800, 600);
     let mut forest_table = Table::new(&["method", "instances", "disk_bytes", "gpu_bytes"]);
     let mut mem = [
         Series {
@@ -167,8 +223,12 @@ pub fn run(b: &Bench) -> Result<Section> {
             series: mem.to_vec(),
         },
     )?;
+    Ok(forest_table)
+}
 
-    // Quad-stream buffers against visible trees.
+/// The quad-stream buffers against visible trees: what the frames needed and what the
+/// capacity formula allocated.
+fn per_stream(b: &Bench, viewport: (u32, u32)) -> Result<()> {
     let sizes: Vec<u32> = if b.quick {
         vec![300, 1000]
     } else {
@@ -236,49 +296,5 @@ pub fn run(b: &Bench) -> Result<Section> {
             series: vec![needed, allocated],
         },
     )?;
-
-    // Marginal bytes per instance between the two largest forests.
-    let per_instance = |m: &str| {
-        let rows: Vec<(f64, f64)> = forest_table
-            .rows
-            .iter()
-            .filter(|r| r[0] == m)
-            .map(|r| (r[1].parse().unwrap_or(0.0), r[3].parse().unwrap_or(0.0)))
-            .collect();
-        match rows.as_slice() {
-            [.., a, b] if b.0 > a.0 => format!("{:.1}", (b.1 - a.1) / (b.0 - a.0)),
-            _ => "-".into(),
-        }
-    };
-    let text = format!(
-        "Per species, the quad stream stores its atlas ({:.2} MiB on disk, {:.2} MiB on the GPU \
-         as BC7, all species together) and the geometry methods their models ({:.2} MiB on \
-         disk, {:.2} MiB on the GPU with LODs, leaf tables and billboards). Static impostors \
-         bind the same atlas. Between the two largest forests each added tree costs {} B of GPU \
-         memory with the quad stream (instance, presorted orders, a scan slot) and {} B with \
-         the geometry methods (instance, classification key, visible-list slot): memory grows \
-         with the models, not the instances. The quad-stream buffers start from `Capacity`'s \
-         estimate (the level-0 quads of the visible trees, at most a quarter of the screen's \
-         pixels, plus what refinement can add) and grow when a frame overflows them \
-         (`QuadStream::fit`, to the frame's need plus an eighth); the last chart compares the \
-         allocation after the measured frames with what they needed. An atlas's files (MiB): \
-         the colour mosaic (premultiplied albedo), alpha (coverage), surface (normal, sky \
-         visibility and translucency at half the slab resolution), opacity (the 32³ \
-         self-shadowing volume) and nodes: {}.",
-        quad_total.0 as f64 / MB,
-        quad_total.1 as f64 / MB,
-        geo_total.0 as f64 / MB,
-        geo_total.1 as f64 / MB,
-        per_instance("quads"),
-        per_instance("geometry"),
-        files.join("; "),
-    );
-    let mut all = table;
-    all.rows.sort_by(|a, b| a[0].cmp(&b[0]));
-    Ok(Section {
-        title: "Storage".into(),
-        text,
-        table: all,
-        charts: vec!["storage_forest".into(), "storage_stream".into()],
-    })
+    Ok(())
 }
