@@ -377,91 +377,7 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
     let mut charts = Vec::new();
     let mut summary = Vec::new();
     for view in &view_names {
-        let mut series: Vec<Series> = Vec::new();
-        for row in table.rows.iter().filter(|r| &r[2] == view) {
-            let point = (cell(row, 3), cell(row, 4));
-            match series.iter_mut().find(|x| x.name == row[0]) {
-                Some(x) => x.points.push(point),
-                None => series.push(Series {
-                    name: row[0].clone(),
-                    points: vec![point],
-                    front: true,
-                    ..Default::default()
-                }),
-            }
-        }
-        // The reading: each method's best FLIP and the fastest setting within 0.005 of the best
-        // overall.
-        let best = series
-            .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.1))
-            .fold(f64::INFINITY, f64::min);
-        for s in &series {
-            let front = pareto_front(&s.points);
-            let good = front.iter().find(|p| p.1 <= best + 0.005);
-            summary.push(format!(
-                "{view}, {}: best FLIP {:.4}{}",
-                s.name,
-                front.last().map(|p| p.1).unwrap_or(f64::NAN),
-                good.map(|p| format!(", within 0.005 of the best at {:.2} ms", p.0))
-                    .unwrap_or_default()
-            ));
-        }
-        let stem = format!("accuracy_{view}");
-        b.chart(
-            &stem,
-            &Chart {
-                title: format!(
-                    "Speed against accuracy: {view} ({}x{})",
-                    viewport.0, viewport.1
-                ),
-                x_label: "GPU ms per frame".into(),
-                y_label: "mean FLIP against the reference".into(),
-                log_x: true,
-                series,
-                ..Default::default()
-            },
-        )?;
-        charts.push(stem);
-        // The same settings by the work they ask of a GPU (shader invocations: vertex,
-        // fragment and compute) instead of lavapipe's time, where the table has the counts.
-        let invocations = |row: &[String]| {
-            let k = COLUMNS.len();
-            let v = [k + 2, k + 4, k + 5].map(|i| row.get(i).and_then(|c| c.parse::<f64>().ok()));
-            Some(v[0]? + v[1]? + v[2]?)
-        };
-        let mut work_series: Vec<Series> = Vec::new();
-        for row in table.rows.iter().filter(|r| &r[2] == view) {
-            let Some(x) = invocations(row) else { continue };
-            let point = (x, cell(row, 4));
-            match work_series.iter_mut().find(|s| s.name == row[0]) {
-                Some(s) => s.points.push(point),
-                None => work_series.push(Series {
-                    name: row[0].clone(),
-                    points: vec![point],
-                    front: true,
-                    ..Default::default()
-                }),
-            }
-        }
-        if !work_series.is_empty() {
-            let stem = format!("accuracy_work_{view}");
-            b.chart(
-                &stem,
-                &Chart {
-                    title: format!(
-                        "Work against accuracy: {view} ({}x{})",
-                        viewport.0, viewport.1
-                    ),
-                    x_label: "shader invocations per frame (vertex + fragment + compute)".into(),
-                    y_label: "mean FLIP against the reference".into(),
-                    log_x: true,
-                    series: work_series,
-                    ..Default::default()
-                },
-            )?;
-            charts.push(stem);
-        }
+        charts.extend(view_charts(b, &table, view, viewport, &mut summary)?);
     }
     // Per walkthrough (model sizes, real sizes): the fragments each method's default setting
     // shades per covered pixel, and the hybrid against the quad stream at the same ε.
@@ -535,6 +451,105 @@ pub fn report(b: &Bench, table: Table) -> Result<Section> {
         table,
         charts,
     })
+}
+
+/// The charts of one view of the table (speed and, where counted, work against accuracy),
+/// each method's reading added to `summary`; the charts' names.
+fn view_charts(
+    b: &Bench,
+    table: &Table,
+    view: &str,
+    viewport: (u32, u32),
+    summary: &mut Vec<String>,
+) -> Result<Vec<String>> {
+    let cell = |row: &[String], k: usize| row[k].parse::<f64>().unwrap_or(f64::NAN);
+    let mut charts = Vec::new();
+    let mut series: Vec<Series> = Vec::new();
+    for row in table.rows.iter().filter(|r| r[2] == view) {
+        let point = (cell(row, 3), cell(row, 4));
+        match series.iter_mut().find(|x| x.name == row[0]) {
+            Some(x) => x.points.push(point),
+            None => series.push(Series {
+                name: row[0].clone(),
+                points: vec![point],
+                front: true,
+                ..Default::default()
+            }),
+        }
+    }
+    // The reading: each method's best FLIP and the fastest setting within 0.005 of the best
+    // overall.
+    let best = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(f64::INFINITY, f64::min);
+    for s in &series {
+        let front = pareto_front(&s.points);
+        let good = front.iter().find(|p| p.1 <= best + 0.005);
+        summary.push(format!(
+            "{view}, {}: best FLIP {:.4}{}",
+            s.name,
+            front.last().map(|p| p.1).unwrap_or(f64::NAN),
+            good.map(|p| format!(", within 0.005 of the best at {:.2} ms", p.0))
+                .unwrap_or_default()
+        ));
+    }
+    let stem = format!("accuracy_{view}");
+    b.chart(
+        &stem,
+        &Chart {
+            title: format!(
+                "Speed against accuracy: {view} ({}x{})",
+                viewport.0, viewport.1
+            ),
+            x_label: "GPU ms per frame".into(),
+            y_label: "mean FLIP against the reference".into(),
+            log_x: true,
+            series,
+            ..Default::default()
+        },
+    )?;
+    charts.push(stem);
+    // The same settings by the work they ask of a GPU (shader invocations: vertex,
+    // fragment and compute) instead of lavapipe's time, where the table has the counts.
+    let invocations = |row: &[String]| {
+        let k = COLUMNS.len();
+        let v = [k + 2, k + 4, k + 5].map(|i| row.get(i).and_then(|c| c.parse::<f64>().ok()));
+        Some(v[0]? + v[1]? + v[2]?)
+    };
+    let mut work_series: Vec<Series> = Vec::new();
+    for row in table.rows.iter().filter(|r| r[2] == view) {
+        let Some(x) = invocations(row) else { continue };
+        let point = (x, cell(row, 4));
+        match work_series.iter_mut().find(|s| s.name == row[0]) {
+            Some(s) => s.points.push(point),
+            None => work_series.push(Series {
+                name: row[0].clone(),
+                points: vec![point],
+                front: true,
+                ..Default::default()
+            }),
+        }
+    }
+    if !work_series.is_empty() {
+        let stem = format!("accuracy_work_{view}");
+        b.chart(
+            &stem,
+            &Chart {
+                title: format!(
+                    "Work against accuracy: {view} ({}x{})",
+                    viewport.0, viewport.1
+                ),
+                x_label: "shader invocations per frame (vertex + fragment + compute)".into(),
+                y_label: "mean FLIP against the reference".into(),
+                log_x: true,
+                series: work_series,
+                ..Default::default()
+            },
+        )?;
+        charts.push(stem);
+    }
+    Ok(charts)
 }
 
 /// The hybrid (`near=auto`) against the quad stream at the same ε, over `rows` of one view.
