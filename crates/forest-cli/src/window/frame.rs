@@ -90,67 +90,14 @@ impl Viewer {
                 g.renderer.set_camera(&g.ctx, &cam)?;
                 g.renderer.encode_frame(&mut enc, &view, &g.depth);
             }
-            let raw = g.egui_state.take_egui_input(&g.window);
-            let ui_ctx = g.egui.clone();
-            let mut choice = (None, None);
-            let mut out = ui_ctx.run_pass(raw, |c| choice = self.hud(c));
+            let (mut choice, extra) = self.draw_hud(&mut g, &mut enc, &view);
             if refused {
                 choice.1 = Some(DebugView::Off);
-            }
-            // egui insists that texture updates are consumed: take them out now.
-            let set: Vec<_> = out.textures_delta.set.drain().collect();
-            let free: Vec<_> = out.textures_delta.free.drain().collect();
-            g.egui_state
-                .handle_platform_output(&g.window, out.platform_output);
-            let jobs = g.egui.tessellate(out.shapes, out.pixels_per_point);
-            let screen = egui_wgpu::ScreenDescriptor {
-                size_in_pixels: [g.config.width, g.config.height],
-                pixels_per_point: out.pixels_per_point,
-            };
-            for (id, deltas) in &set {
-                for delta in deltas {
-                    g.egui_renderer
-                        .update_texture(&g.ctx.device, &g.ctx.queue, *id, delta);
-                }
-            }
-            let extra = g.egui_renderer.update_buffers(
-                &g.ctx.device,
-                &g.ctx.queue,
-                &mut enc,
-                &jobs,
-                &screen,
-            );
-            {
-                let mut pass = forest_render::target::begin_overlay_pass(&mut enc, "hud", &view)
-                    .forget_lifetime();
-                g.egui_renderer.render(&mut pass, &jobs, &screen);
-            }
-            for id in &free {
-                g.egui_renderer.free_texture(id);
             }
             g.ctx.queue.submit(extra.into_iter().chain([enc.finish()]));
             g.window.pre_present_notify();
             g.ctx.queue.present(output);
-            // Statistics arrive a few frames late and errors as wgpu reports them: the frame
-            // loop never waits for the GPU.
-            if let Some(stats) = g.renderer.poll_stats(&g.ctx.device, &g.ctx.queue) {
-                // A view that overflows the stream grows it for the frames after.
-                g.renderer.fit(&g.ctx.device, &stats)?;
-                self.stats = stats;
-            }
-            // The shadow cascades' light views likewise (the HUD shows their work).
-            match g.renderer.stream.shadows_mut() {
-                Some(sh) => {
-                    let polled = sh.poll(&g.ctx.device, &g.ctx.queue)?;
-                    self.shadow_stats.resize(polled.len(), Default::default());
-                    for (k, s) in polled.into_iter().enumerate() {
-                        if let Some(s) = s {
-                            self.shadow_stats[k] = s;
-                        }
-                    }
-                }
-                None => self.shadow_stats.clear(),
-            }
+            self.poll_counters(&mut g)?;
             g.ctx.check_reported_errors()?;
             if self.first_frame {
                 self.first_frame = false;
@@ -172,6 +119,74 @@ impl Viewer {
         }
         if let Some(v) = debug {
             self.set_debug(v);
+        }
+        Ok(())
+    }
+
+    /// Record the HUD over `view`: the choices it returns (a method, a debug view) and the
+    /// command buffers egui's uploads need before the frame's.
+    fn draw_hud(
+        &mut self,
+        g: &mut super::Gfx,
+        enc: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+    ) -> ((Option<usize>, Option<DebugView>), Vec<wgpu::CommandBuffer>) {
+        let raw = g.egui_state.take_egui_input(&g.window);
+        let ui_ctx = g.egui.clone();
+        let mut choice = (None, None);
+        let mut out = ui_ctx.run_pass(raw, |c| choice = self.hud(c));
+        // egui insists that texture updates are consumed: take them out now.
+        let set: Vec<_> = out.textures_delta.set.drain().collect();
+        let free: Vec<_> = out.textures_delta.free.drain().collect();
+        g.egui_state
+            .handle_platform_output(&g.window, out.platform_output);
+        let jobs = g.egui.tessellate(out.shapes, out.pixels_per_point);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [g.config.width, g.config.height],
+            pixels_per_point: out.pixels_per_point,
+        };
+        for (id, deltas) in &set {
+            for delta in deltas {
+                g.egui_renderer
+                    .update_texture(&g.ctx.device, &g.ctx.queue, *id, delta);
+            }
+        }
+        let extra =
+            g.egui_renderer
+                .update_buffers(&g.ctx.device, &g.ctx.queue, enc, &jobs, &screen);
+        {
+            let mut pass =
+                forest_render::target::begin_overlay_pass(enc, "hud", view).forget_lifetime();
+            g.egui_renderer.render(&mut pass, &jobs, &screen);
+        }
+        for id in &free {
+            g.egui_renderer.free_texture(id);
+        }
+        (choice, extra)
+    }
+
+    /// Take the counters of a recent frame, never waiting: grow the stream after one that
+    /// overflowed, and keep the shadow cascades' for the HUD.
+    fn poll_counters(&mut self, g: &mut super::Gfx) -> Result<()> {
+        // Statistics arrive a few frames late and errors as wgpu reports them: the frame
+        // loop never waits for the GPU.
+        if let Some(stats) = g.renderer.poll_stats(&g.ctx.device, &g.ctx.queue) {
+            // A view that overflows the stream grows it for the frames after.
+            g.renderer.fit(&g.ctx.device, &stats)?;
+            self.stats = stats;
+        }
+        // The shadow cascades' light views likewise (the HUD shows their work).
+        match g.renderer.stream.shadows_mut() {
+            Some(sh) => {
+                let polled = sh.poll(&g.ctx.device, &g.ctx.queue)?;
+                self.shadow_stats.resize(polled.len(), Default::default());
+                for (k, s) in polled.into_iter().enumerate() {
+                    if let Some(s) = s {
+                        self.shadow_stats[k] = s;
+                    }
+                }
+            }
+            None => self.shadow_stats.clear(),
         }
         Ok(())
     }
