@@ -258,44 +258,7 @@ impl Host {
         };
         let soil_shadowed = shadowed(forest_render::options::GROUND_ALBEDO);
         let moss_shadowed = shadowed(GROUND_MOSS);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("host ground"),
-            source: wgpu::ShaderSource::Wgsl(
-                [forest_render::passes::GROUND_WGSL, HOST_GROUND_WGSL]
-                    .concat()
-                    .into(),
-            ),
-        });
-        let ground = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("host ground"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleStrip,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let ground = ground_pipeline(device, format);
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("host uniform"),
             contents: bytemuck::bytes_of(&HostUniform {
@@ -450,4 +413,47 @@ impl Host {
         queue.submit([encoder.finish()]);
         Ok(())
     }
+}
+
+/// The host's own ground: a strip over the whole view at the depth convention of its
+/// target, into `format`.
+fn ground_pipeline(device: &wgpu::Device, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host ground"),
+        source: wgpu::ShaderSource::Wgsl(
+            [forest_render::passes::GROUND_WGSL, HOST_GROUND_WGSL]
+                .concat()
+                .into(),
+        ),
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host ground"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleStrip,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
