@@ -2,8 +2,8 @@
 //! bind groups over a shared scene, and the frame function that records the three passes.
 //!
 //! The shape is that of wgpu middleware: build once from the device and the host's target
-//! formats; per frame, [`QuadStream::prepare`] writes the one camera buffer (the only upload),
-//! then [`QuadStream::encode_compute`] records cull and refine and [`QuadStream::render`] draws
+//! formats; per frame, [`ForestView::prepare`] writes the one camera buffer (the only upload),
+//! then [`QuadStream::encode_compute`] records cull and refine and [`ForestView::render`] draws
 //! into the host's render pass, or [`QuadStream::encode_into`] does both into targets with the
 //! host's load operations. The scene is shared ([`Arc<GpuScene>`]): several views (split
 //! screen, shadow maps) are several streams over one upload, and [`QuadStream::resize`]
@@ -68,7 +68,7 @@ pub struct QuadStream {
 impl QuadStream {
     /// Build the stream of one view over `scene` for the host's targets (`opts`: colour and
     /// depth formats, sample count, depth convention, and the largest viewport and smallest ε
-    /// that size the stream). Nothing is drawn until the first [`Self::prepare`].
+    /// that size the stream). Nothing is drawn until the first [`ForestView::prepare`].
     pub fn new(
         device: &wgpu::Device,
         scene: impl Into<Arc<GpuScene>>,
@@ -365,7 +365,7 @@ impl QuadStream {
         self.iterations
     }
 
-    /// Choose what the draw pass shows from the next [`Self::prepare`] on.
+    /// Choose what the draw pass shows from the next [`ForestView::prepare`] on.
     pub fn set_debug_view(&mut self, view: DebugView) {
         self.debug = view;
     }
@@ -392,7 +392,7 @@ impl QuadStream {
         self.debug
     }
 
-    /// Choose the stream's run-time options from the next [`Self::prepare`] on.
+    /// Choose the stream's run-time options from the next [`ForestView::prepare`] on.
     pub fn set_options(&mut self, options: StreamOptions) -> Result<(), RenderError> {
         options.validate()?;
         self.options = options;
@@ -474,7 +474,7 @@ impl QuadStream {
         self.inputs.upload(queue, g, own);
     }
 
-    /// [`Self::render_frame`], drawn again while the frame overflows the stream and
+    /// [`ForestView::render_frame`], drawn again while the frame overflows the stream and
     /// [`Self::fit`] can grow it; the last frame's counters (waits for the GPU: front ends
     /// that draw single frames, benchmarks).
     pub fn render_fitted(

@@ -350,7 +350,7 @@ impl GeometryRenderer {
     }
 
     /// The shadow maps' passes of a frame when shadows are on: each cascade's cull, then its
-    /// trees drawn depth-only into its layer (after [`Self::set_camera`]).
+    /// trees drawn depth-only into its layer (after [`ForestView::set_camera`](forest_render::ForestView::set_camera)).
     pub fn encode_shadows(&self, encoder: &mut wgpu::CommandEncoder) {
         if let Some(lv) = &self.shadows {
             for k in 0..lv.views.len() {
