@@ -11,8 +11,7 @@ use forest_baselines::geometry::MeshMethod;
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::{DEFAULT_PRESORT_DIRECTIONS, Forest, Instance};
 use forest_format::generate::SplitMix64;
-use forest_format::{BakeParams, ColourEncoding, PlaneFit};
-use forest_render::options::{AspectBlend, Background, StreamOptions};
+use forest_render::options::{Background, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuScene, QuadStream, RendererOptions};
@@ -20,15 +19,13 @@ use glam::Vec3;
 
 use super::accuracy::reference;
 use super::chart::{Chart, Series};
+pub use super::fidelity_variants::{EPS, EPS_EXACT};
+use super::fidelity_variants::{GEOMETRY, Variant, variants};
 use super::report::Section;
 use super::{Bench, Table, ms};
 
 /// Seed of the camera draw.
 pub const SEED: u64 = 0x5eed;
-/// ε (pixels) of every variant but `min-quad=1`.
-pub const EPS: f32 = 2.0;
-/// ε of the `min-quad=1` variant (exact per-pixel depth).
-pub const EPS_EXACT: f32 = 1.0;
 /// Lowest eye height (metres): eyes drawn below it slide along their ray towards the crown.
 pub const MIN_EYE_HEIGHT: f32 = 0.3;
 /// Highest elevation drawn (degrees): straight down has no up vector.
@@ -37,144 +34,6 @@ const MAX_ELEVATION: f32 = 89.5;
 const QUICK_RESOLUTION: u32 = 128;
 /// Scratch folder of the re-baked atlases, inside the results folder (removed afterwards).
 pub const SCRATCH: &str = ".fidelity-atlases";
-
-/// A bake change: the parameters of a re-bake from the given atlas's ones.
-type BakeChange = fn(BakeParams) -> BakeParams;
-
-/// One row of the comparison: a bake change (none: the atlas given) and run-time options.
-struct Variant {
-    name: &'static str,
-    bake: Option<BakeChange>,
-    options: StreamOptions,
-    epsilon: f32,
-    /// Not the quad stream: full geometry at 1× (the yardstick of the stream's accuracy).
-    geometry: bool,
-}
-
-/// The yardstick row's name: full geometry at 1×, the same triangles as the reference.
-const GEOMETRY: &str = "full geometry 1x";
-
-fn variants(quick: bool) -> Vec<Variant> {
-    let default = StreamOptions::default();
-    let runtime = |name, options| Variant {
-        name,
-        bake: None,
-        options,
-        epsilon: EPS,
-        geometry: false,
-    };
-    let baked = |name, bake: BakeChange| Variant {
-        name,
-        bake: Some(bake),
-        options: default,
-        epsilon: EPS,
-        geometry: false,
-    };
-    let geometry = Variant {
-        geometry: true,
-        ..runtime(GEOMETRY, default)
-    };
-    let paper = Variant {
-        name: "paper",
-        bake: Some(|p| BakeParams {
-            below: 0,
-            plane_fit: PlaneFit::LeastSquares,
-            ..p
-        }),
-        options: StreamOptions {
-            blend: AspectBlend::Over,
-            depth_error: false,
-            trim: false,
-            far_nearest: false,
-            far_composite: false,
-            far_span: 1,
-            sharpen: 0,
-            sharpen_reach: 1,
-            opaque_first: false,
-        },
-        epsilon: EPS,
-        geometry: false,
-    };
-    let dither = runtime(
-        "blend=dither",
-        StreamOptions {
-            blend: AspectBlend::Dither,
-            ..default
-        },
-    );
-    if quick {
-        return vec![runtime("baseline", default), dither, paper, geometry];
-    }
-    vec![
-        runtime("baseline", default),
-        dither,
-        runtime(
-            "blend=nearest",
-            StreamOptions {
-                blend: AspectBlend::Nearest,
-                ..default
-            },
-        ),
-        runtime(
-            "depth-error refine",
-            StreamOptions {
-                depth_error: true,
-                ..default
-            },
-        ),
-        runtime(
-            "untrimmed",
-            StreamOptions {
-                trim: false,
-                ..default
-            },
-        ),
-        runtime(
-            "far trees blended",
-            StreamOptions {
-                far_nearest: false,
-                ..default
-            },
-        ),
-        runtime(
-            "far slabs apart",
-            StreamOptions {
-                far_composite: false,
-                ..default
-            },
-        ),
-        baked("directions=31", |p| BakeParams {
-            directions: 31,
-            ..p
-        }),
-        baked("slabs=4", |p| BakeParams { slabs: 4, ..p }),
-        // Texels twice and four times as fine (4× and 16× the memory): whether the close-up
-        // error is the slab images' magnification.
-        baked("resolution=1024", |p| BakeParams {
-            resolution: 1024,
-            ..p
-        }),
-        baked("resolution=2048", |p| BakeParams {
-            resolution: 2048,
-            ..p
-        }),
-        baked("lossless", |p| BakeParams {
-            colour: ColourEncoding::Png,
-            ..p
-        }),
-        Variant {
-            epsilon: EPS_EXACT,
-            ..baked("min-quad=1", |p| BakeParams { min_quad: 1, ..p })
-        },
-        baked("below=0", |p| BakeParams { below: 0, ..p }),
-        baked("fit=least-squares", |p| BakeParams {
-            plane_fit: PlaneFit::LeastSquares,
-            ..p
-        }),
-        paper,
-        geometry,
-    ]
-}
 
 /// A drawn camera and what the table records of it.
 struct View {

@@ -6,6 +6,7 @@ mod accuracy;
 mod budget;
 pub mod chart;
 mod fidelity;
+mod fidelity_variants;
 mod lighting;
 mod path;
 mod report;
