@@ -464,19 +464,7 @@ fn view_charts(
 ) -> Result<Vec<String>> {
     let cell = |row: &[String], k: usize| row[k].parse::<f64>().unwrap_or(f64::NAN);
     let mut charts = Vec::new();
-    let mut series: Vec<Series> = Vec::new();
-    for row in table.rows.iter().filter(|r| r[2] == view) {
-        let point = (cell(row, 3), cell(row, 4));
-        match series.iter_mut().find(|x| x.name == row[0]) {
-            Some(x) => x.points.push(point),
-            None => series.push(Series {
-                name: row[0].clone(),
-                points: vec![point],
-                front: true,
-                ..Default::default()
-            }),
-        }
-    }
+    let series = per_method(table, view, |row| Some(cell(row, 3)));
     // The reading: each method's best FLIP and the fastest setting within 0.005 of the best
     // overall.
     let best = series
@@ -517,20 +505,7 @@ fn view_charts(
         let v = [k + 2, k + 4, k + 5].map(|i| row.get(i).and_then(|c| c.parse::<f64>().ok()));
         Some(v[0]? + v[1]? + v[2]?)
     };
-    let mut work_series: Vec<Series> = Vec::new();
-    for row in table.rows.iter().filter(|r| r[2] == view) {
-        let Some(x) = invocations(row) else { continue };
-        let point = (x, cell(row, 4));
-        match work_series.iter_mut().find(|s| s.name == row[0]) {
-            Some(s) => s.points.push(point),
-            None => work_series.push(Series {
-                name: row[0].clone(),
-                points: vec![point],
-                front: true,
-                ..Default::default()
-            }),
-        }
-    }
+    let work_series = per_method(table, view, invocations);
     if !work_series.is_empty() {
         let stem = format!("accuracy_work_{view}");
         b.chart(
@@ -550,6 +525,26 @@ fn view_charts(
         charts.push(stem);
     }
     Ok(charts)
+}
+
+/// One series per method (column 0) of `view`'s rows, each point `(x(row), FLIP)` (rows
+/// without an `x` left out), drawn with its Pareto front.
+fn per_method(table: &Table, view: &str, x: impl Fn(&[String]) -> Option<f64>) -> Vec<Series> {
+    let mut series: Vec<Series> = Vec::new();
+    for row in table.rows.iter().filter(|r| r[2] == view) {
+        let Some(x) = x(row) else { continue };
+        let point = (x, row[4].parse::<f64>().unwrap_or(f64::NAN));
+        match series.iter_mut().find(|s| s.name == row[0]) {
+            Some(s) => s.points.push(point),
+            None => series.push(Series {
+                name: row[0].clone(),
+                points: vec![point],
+                front: true,
+                ..Default::default()
+            }),
+        }
+    }
+    series
 }
 
 /// The hybrid (`near=auto`) against the quad stream at the same ε, over `rows` of one view.
