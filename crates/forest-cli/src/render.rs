@@ -3,11 +3,10 @@
 use forest_render::ForestView;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
-use forest_baselines::geometry::{GeometryRenderer, GeometrySpecies, PreparedGeometry};
+use anyhow::{Result, bail};
+use forest_baselines::geometry::{self, GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::{ForestRenderer, MethodStats};
 use forest_format::forest::Forest;
-use forest_format::views;
 use forest_render::fragments::{FragmentCounter, FragmentCounts, FragmentSummary};
 use forest_render::options::{Atmosphere, RendererOptions};
 use forest_render::passes::overdraw::OverdrawPass;
@@ -18,35 +17,30 @@ use glam::Vec3;
 
 pub use crate::render_args::{LightArgs, MethodArgs, RenderArgs, ShadowArgs};
 
-/// Load a forest and its species' atlases (resolved against the forest's folder).
+/// Load a forest and its species' atlases ([`forest_render::load_scene`]), with a spinner.
 pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
     let spinner = crate::progress::spinner(format!("loading {}", path.display()));
-    let forest = Forest::load(path)?;
-    spinner.set_message(format!(
-        "loading the {} atlases of {}",
-        forest.species.len(),
-        path.display()
-    ));
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let species = forest
-        .species
-        .iter()
-        .map(|s| {
-            let p = dir.join(s);
-            SpeciesData::load(&p).with_context(|| format!("species {s} of {}", path.display()))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let manifests: Vec<_> = species.iter().map(|s| &s.atlas.manifest).collect();
-    forest_format::species::check(&forest, &manifests, path)?;
+    let scene = forest_render::load_scene(path, |n| {
+        spinner.set_message(format!("loading the {n} atlases of {}", path.display()))
+    })?;
     spinner.finish_and_clear();
-    Ok((forest, species))
+    Ok(scene)
 }
 
-/// The named view `name` of a forest ([`forest_render::named_view`]: clear of every tree's
-/// trunk and crown).
-pub fn named_view(name: &str, forest: &Forest, species: &[SpeciesData]) -> Result<(Vec3, Vec3)> {
-    forest_render::named_view(name, forest, species)
-        .ok_or_else(|| anyhow::anyhow!("no view named {name:?}: give one of {:?}", views::NAMES))
+/// The species' models for the geometry-based methods ([`geometry::models_for`]), their notes
+/// said on stderr.
+pub fn models_for(
+    models: &[PathBuf],
+    forest_file: &Path,
+    forest: &Forest,
+    species: &[SpeciesData],
+    allow_other: bool,
+) -> Result<PreparedGeometry> {
+    let sourced = geometry::models_for(models, forest_file, forest, species, allow_other)?;
+    for note in &sourced.notes {
+        eprintln!("forest: note: {note}");
+    }
+    Ok(sourced.geometry)
 }
 
 /// Run `forest render`.
@@ -58,7 +52,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     settled.m.settle(&args.forest, &forest);
     let args = &settled;
     for v in &args.views {
-        let (e, t) = named_view(v, &forest, &species)?;
+        let (e, t) = forest_render::named_view(v, &forest, &species)?;
         views.push((v.clone(), e, t));
     }
     if let (Some(e), Some(t)) = (args.eye, args.target) {
@@ -446,40 +440,6 @@ pub fn write_png(img: &image::RgbaImage, out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The species' models for the geometry-based methods: `models` prepared here when given,
-/// else those the bake stored in each atlas of the forest `forest_file` (model.bin).
-pub fn models_for(
-    models: &[PathBuf],
-    forest_file: &Path,
-    forest: &Forest,
-    species: &[SpeciesData],
-    allow_other: bool,
-) -> Result<PreparedGeometry> {
-    if !models.is_empty() {
-        return prepare_models(models, species, allow_other);
-    }
-    let dir = forest_file.parent().unwrap_or(Path::new("."));
-    let geo_species = forest
-        .species
-        .iter()
-        .zip(species)
-        .map(|(name, s)| {
-            let atlas = dir.join(name);
-            let model = forest_format::model::PreparedModel::load(&atlas)?.ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{} holds no prepared model ({}): bake it again without --no-model, or \
-                     pass the species' models with --models",
-                    atlas.display(),
-                    forest_format::model::MODEL_FILE
-                )
-            })?;
-            model.check_source(&atlas, &s.atlas.manifest.source.hash)?;
-            Ok(GeometrySpecies::new(model.into(), &s.atlas.manifest))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    Ok(PreparedGeometry::new(&geo_species))
-}
-
 /// [`models_for`] the forest and the options of `render`.
 fn args_models(
     args: &RenderArgs,
@@ -493,67 +453,6 @@ fn args_models(
         species,
         args.m.allow_other_models,
     )
-}
-
-/// Load the species' OBJ models and prepare them for the geometry-based methods, lit as their
-/// atlases were baked.
-pub fn prepare_models(
-    models: &[PathBuf],
-    species: &[SpeciesData],
-    allow_other: bool,
-) -> Result<PreparedGeometry> {
-    let geo_species = models
-        .iter()
-        .zip(species)
-        .map(|(m, s)| {
-            let mesh = forest_bake::Mesh::load(m)?;
-            check_model(m, &mesh, &s.atlas.manifest, allow_other)?;
-            let model = forest_bake::model::prepare(&mesh, None);
-            Ok(GeometrySpecies::new(model.into(), &s.atlas.manifest))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    Ok(PreparedGeometry::new(&geo_species))
-}
-
-/// How far (a fraction of the atlas's bounding radius) a model's bounding sphere may lie from
-/// its atlas's for the model to count as the one baked, when its bytes differ (re-exported,
-/// or a texture edited).
-pub const MODEL_SPHERE_TOLERANCE: f32 = 0.01;
-
-/// A model drawn for a species is the one its atlas was baked from: the same bytes (the hash
-/// the bake recorded), or else the same bounding sphere within [`MODEL_SPHERE_TOLERANCE`]
-/// (said on stderr). Anything else is an error naming both, unless `allow_other`.
-pub fn check_model(
-    path: &Path,
-    mesh: &forest_bake::Mesh,
-    manifest: &forest_format::AtlasManifest,
-    allow_other: bool,
-) -> Result<()> {
-    if format!("{:016x}", mesh.hash) == manifest.source.hash {
-        return Ok(());
-    }
-    let baked = manifest.bounding_sphere;
-    let sphere = forest_bake::bounding_sphere(mesh);
-    let off = (sphere.center - baked.center).length() + (sphere.radius - baked.radius).abs();
-    let close = off <= MODEL_SPHERE_TOLERANCE * baked.radius;
-    let what = format!(
-        "model {} is not the file its atlas was baked from ({}): its bytes differ, and its \
-         bounding sphere (centre {:.3}, radius {:.3}) is {} the atlas's (centre {:.3}, radius \
-         {:.3})",
-        path.display(),
-        manifest.source.file,
-        sphere.center,
-        sphere.radius,
-        if close { "within 1 % of" } else { "not" },
-        baked.center,
-        baked.radius
-    );
-    if close || allow_other {
-        eprintln!("forest: note: {what}");
-        Ok(())
-    } else {
-        bail!("{what} (--allow-other-models draws it anyway)")
-    }
 }
 
 fn output_for(base: &Path, view: &str, views: usize) -> PathBuf {

@@ -9,10 +9,10 @@ use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::Method;
 use forest_format::forest::Forest;
-use forest_format::views;
 use forest_render::gpu_types::WEIGHT_ONE;
 use forest_render::options::{AspectBlend, Atmosphere, StreamOptions};
 use forest_render::shadow::ShadowOptions;
+use forest_scene::views;
 use glam::Vec3;
 
 /// Arguments of `forest render`.

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::AtlasManifest;
-use forest_format::generate::{GenerateParams, GroundRules, generate, species_height};
 use forest_format::terrain::{Terrain, TerrainParams};
+use forest_scene::generate::{GenerateParams, GroundRules, generate, species_height};
 
 /// Arguments of `forest scene`.
 #[derive(Args, Debug)]

@@ -18,7 +18,7 @@ use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
-use crate::render::{MethodArgs, load_scene, models_for, prepare_models, write_png};
+use crate::render::{MethodArgs, load_scene, models_for, write_png};
 use crate::render_args::parse_size;
 
 /// Arguments of `forest view`.
@@ -262,7 +262,13 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
             Err(_) => None,
         }
     } else {
-        Some(prepare_models(&m.models, &species, m.allow_other_models)?)
+        Some(models_for(
+            &m.models,
+            forest_file,
+            &forest,
+            &species,
+            m.allow_other_models,
+        )?)
     };
     let path = args.path.as_deref().map(CameraPath::load).transpose()?;
     let chosen = m.chosen(mesh_method)?;
@@ -278,7 +284,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
     let extent = forest.extent();
     let terrain = forest.terrain.clone();
     // Start inside the forest, standing on its ground.
-    let start_view = Some(crate::render::named_view("inside", &forest, &species)?);
+    let start_view = Some(forest_render::named_view("inside", &forest, &species)?);
     let forest = Rc::new(forest);
     let f = forest.clone();
     // The stream's run-time options from the command line (--blend, --far-span, --sharpen…).

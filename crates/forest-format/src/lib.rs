@@ -8,29 +8,18 @@
 //! - [`slab`]: the image-space conventions that map a slab pixel back to object space;
 //! - [`shading`]: the one shading model every renderer of the project uses;
 //! - [`atlas`]: the baked atlas (manifest, colour, nodes), its atomic writer and checked loader;
-//! - [`forest`], [`generate`], [`terrain`]: forest files, the clumped-forest generator and the
-//!   height field the trees stand on;
+//! - [`forest`], [`terrain`]: forest files and the height field the trees stand on (the
+//!   generator and the named views live in `forest-scene`);
 //! - [`camera_path`]: recorded camera paths for the viewer;
-//! - [`views`]: the named views of a forest and the rule that keeps them clear of every tree;
 //! - [`model`]: a species' prepared model for the geometry-based methods and the hybrid.
 //! - [`cutout`]: convex polygons in texture space that trim alpha-tested cards.
 //!
-//! A forest made and checked without a GPU or any file (the species are atlas names; `forest
-//! scene` writes the same with `Forest::save`), lit at eight in the morning:
+//! The one shading model, without a GPU or any file, lit at eight in the morning:
 //!
 //! ```
-//! use forest_format::generate::{GenerateParams, generate};
 //! use forest_format::shading::Lighting;
 //!
-//! let forest = generate(&GenerateParams {
-//!     trees: 200,
-//!     species: vec!["oak.atlas".into(), "pine.atlas".into()],
-//!     area_per_tree: 40.0,
-//!     ..GenerateParams::default()
-//! })?;
-//! assert_eq!(forest.instances.len(), 200);
-//! forest.check(std::path::Path::new("example.forest"))?;
-//! // The one shading model: a leaf facing the morning sun is brighter than one facing away.
+//! // A leaf facing the morning sun is brighter than one facing away.
 //! let light = Lighting::at_hour(8.0, 65.0);
 //! let leaf = glam::Vec3::new(0.2, 0.4, 0.1);
 //! let lit = light.shade(leaf, light.sun_dir, 1.0, 1.0, 0.0);
@@ -49,7 +38,6 @@ pub mod cutout;
 pub mod directions;
 pub mod error;
 pub mod forest;
-pub mod generate;
 pub mod limits;
 pub mod model;
 pub mod node;
@@ -61,7 +49,6 @@ pub mod slab;
 pub mod species;
 pub mod terrain;
 pub mod trim;
-pub mod views;
 
 pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding, PlaneFit};
 pub use error::FormatError;

@@ -3,7 +3,7 @@
 //! Not coverage-guided (that is AFL++'s job in `fuzz/afl`); enough to keep every target
 //! exercised by `cargo test`.
 
-use forest_format::generate::SplitMix64;
+use forest_format::noise::SplitMix64;
 
 /// One to four mutations of `seed`.
 pub fn mutate(seed: &[u8], rng: &mut SplitMix64) -> Vec<u8> {

@@ -3,7 +3,7 @@
 //! millions of executions are `scripts/fuzz.sh`'s; this keeps the targets alive in every
 //! `cargo test`.
 
-use forest_format::generate::SplitMix64;
+use forest_format::noise::SplitMix64;
 use forest_fuzz::{TARGETS, Target, alloc, corpus_dir, mutate::mutate, regressions_dir};
 
 #[global_allocator]

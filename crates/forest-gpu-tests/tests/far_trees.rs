@@ -490,7 +490,7 @@ fn opaque_pass_is_off_under_the_other_blends() {
 /// some pixels and the pass's depth test corrects it.
 #[test]
 fn opaque_pass_rejects_the_trees_behind() {
-    use forest_format::generate::{GenerateParams, generate};
+    use forest_scene::generate::{GenerateParams, generate};
     let forest = generate(&GenerateParams {
         trees: 200,
         species: vec!["bush".into(), "pine".into()],

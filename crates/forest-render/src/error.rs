@@ -68,6 +68,17 @@ pub enum RenderError {
     /// A parameter out of its range; the message names it.
     #[error("{0}")]
     Parameter(String),
+    /// A species' atlas that a forest names could not be loaded.
+    #[error("species {name} of {}", forest.display())]
+    Species {
+        /// The species' name in the forest file.
+        name: String,
+        /// The forest file.
+        forest: std::path::PathBuf,
+        /// Why its atlas could not be loaded.
+        #[source]
+        source: Box<RenderError>,
+    },
     /// A method that needs data the renderer was not given (for example OBJ models).
     #[error("the {method} method needs {needs} (none were loaded)")]
     MissingData {

@@ -3,7 +3,6 @@
 use forest_format::atlas::{Layers, NODE_TEXTURE_WIDTH};
 use forest_format::forest::Forest;
 use forest_format::shading::{srgb_decode_table, srgb_encode};
-use forest_format::views::{self, Clearances, TreeShape};
 use forest_format::{Atlas, QuadNode};
 use wgpu::util::DeviceExt;
 
@@ -26,31 +25,7 @@ pub struct SpeciesData {
     pub opacity: forest_format::opacity::OpacityVolume,
 }
 
-/// The named view `name` of `forest` (eye, target; [`forest_format::views::named`]), every
-/// tree shaped by its species' opacity volume ([`SpeciesData::tree_shape`]; `species` in the
-/// forest's order); None for a name not in [`views::NAMES`].
-pub fn named_view(
-    name: &str,
-    forest: &Forest,
-    species: &[SpeciesData],
-) -> Option<(glam::Vec3, glam::Vec3)> {
-    let shapes: Vec<TreeShape> = species.iter().map(SpeciesData::tree_shape).collect();
-    views::named(name, forest, &Clearances::new(forest, &shapes))
-}
-
-/// The view a viewer or a host opens on ([`views::start`]), as [`named_view`] places it.
-pub fn start_view(forest: &Forest, species: &[SpeciesData]) -> (glam::Vec3, glam::Vec3) {
-    let shapes: Vec<TreeShape> = species.iter().map(SpeciesData::tree_shape).collect();
-    views::start(forest, &Clearances::new(forest, &shapes))
-}
-
 impl SpeciesData {
-    /// Its trunk and crown for placing cameras clear of it: its atlas's bounding sphere
-    /// banded by its opacity volume ([`TreeShape::with_volume`]).
-    pub fn tree_shape(&self) -> TreeShape {
-        TreeShape::with_volume(&self.atlas.manifest, &self.opacity)
-    }
-
     /// Load and decode an atlas folder.
     pub fn load(path: &std::path::Path) -> Result<Self, RenderError> {
         let atlas = Atlas::load(path)?;

@@ -8,7 +8,7 @@
 //! cargo run --release -p forest-baselines --example embed -- out/forest-100k.forest --headless shot.png
 //! ```
 //! Options: `--eye X,Y,Z`, `--target X,Y,Z` (default: the forest's `inside` view,
-//! `forest_format::views::start`, standing clear of every tree), `--size WxH`, `--epsilon PX`.
+//! `forest_scene::views::start`, standing clear of every tree), `--size WxH`, `--epsilon PX`.
 //! The window slowly turns the view around the eye; Escape quits.
 
 mod host;

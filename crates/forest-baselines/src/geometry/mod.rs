@@ -22,6 +22,7 @@ mod order;
 mod params;
 mod prepare;
 mod renderer;
+mod sources;
 mod textures;
 mod views;
 
@@ -34,6 +35,10 @@ pub use order::{
 pub use params::{GeometrySpecies, GeometryStats, Lods, MeshMethod, SpeciesFigures, Stochastic};
 pub use prepare::{Cards, PreparedGeometry};
 pub use renderer::{GeometryRenderer, RESET_WG};
+pub use sources::{
+    MODEL_SPHERE_TOLERANCE, ModelSourceError, SourcedModels, check_model, models_for,
+    prepare_models,
+};
 pub use textures::MATERIAL_TEXTURE_SIZE;
 
 /// Box-filter an image rendered at `factor`× resolution down to its display size (in linear

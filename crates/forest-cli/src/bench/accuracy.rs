@@ -9,7 +9,7 @@ use forest_baselines::geometry::{Lods, MeshMethod, Stochastic, downsample};
 use forest_baselines::hybrid::{Hybrid, Near};
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::Forest;
-use forest_format::generate::SplitMix64;
+use forest_format::noise::SplitMix64;
 use forest_render::Camera;
 use forest_render::ForestView;
 use forest_render::options::Background;

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use forest_baselines::geometry::MeshMethod;
 use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::forest::{DEFAULT_PRESORT_DIRECTIONS, Forest, Instance};
-use forest_format::generate::SplitMix64;
+use forest_format::noise::SplitMix64;
 use forest_render::options::{Background, StreamOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};

@@ -6,7 +6,7 @@
 
 use anyhow::Result;
 use forest_format::forest::Forest;
-use forest_format::generate::SplitMix64;
+use forest_format::noise::SplitMix64;
 use forest_format::shading::Lighting;
 use forest_render::Camera;
 use forest_render::ForestView;

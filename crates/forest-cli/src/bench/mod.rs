@@ -26,7 +26,6 @@ use clap::Args;
 use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::forest::Forest;
-use forest_format::generate::{GenerateParams, generate};
 use forest_render::fragments::{FragmentCounts, FragmentSummary};
 use forest_render::options::{Background, RendererOptions};
 use forest_render::scene::SpeciesData;
@@ -34,6 +33,7 @@ use forest_render::stats::PassTimes;
 use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::work::FrameWork;
 use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
+use forest_scene::generate::{GenerateParams, generate};
 
 /// The suites, in the order `all` runs them.
 pub const SUITES: [&str; 10] = [
@@ -257,8 +257,15 @@ impl Bench {
                  pass --models (none found under assets/trees/)"
             );
         }
-        let p =
-            crate::render::prepare_models(&self.models, &self.species, self.allow_other_models)?;
+        let sourced = forest_baselines::geometry::prepare_models(
+            &self.models,
+            &self.species,
+            self.allow_other_models,
+        )?;
+        for note in &sourced.notes {
+            eprintln!("forest: note: {note}");
+        }
+        let p = sourced.geometry;
         Ok(self.prepared.get_or_init(|| p))
     }
 
@@ -292,7 +299,7 @@ impl Bench {
     }
 
     /// A forest of `trees` trees at real sizes: each species at its mature heights
-    /// ([`forest_format::generate::species_height`], by the atlas folder's name; a species
+    /// ([`forest_scene::generate::species_height`], by the atlas folder's name; a species
     /// not in that table keeps its model's size ×0.8–1.25, as `forest scene` sizes trees by
     /// default), `area_per_tree` m² of ground per tree. Returns the forest and its side
     /// (metres).
@@ -312,7 +319,7 @@ impl Bench {
                     .file_stem()
                     .map(|n| n.to_string_lossy().into_owned())
                     .unwrap_or_default();
-                match forest_format::generate::species_height(&name) {
+                match forest_scene::generate::species_height(&name) {
                     Some((lo, hi)) => {
                         let top = s.atlas.manifest.model_top();
                         (lo / top, hi / top)

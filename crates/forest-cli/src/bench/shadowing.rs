@@ -18,7 +18,7 @@ const SUNS: u32 = 12;
 /// Azimuths are uniform; elevations are uniform in 5°–90° and stratified (sun `k` of `n`
 /// in the `k`-th of `n` equal bands), so that a few suns still span low and high ones.
 pub fn seeded_suns(n: u32, seed: u64) -> Vec<(f32, f32, Vec3)> {
-    let mut rng = forest_format::generate::SplitMix64(seed);
+    let mut rng = forest_format::noise::SplitMix64(seed);
     (0..n)
         .map(|k| {
             let az = 360.0 * rng.next_f32();

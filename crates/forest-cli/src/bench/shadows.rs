@@ -60,7 +60,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     for (name, method) in &methods {
         let mut points = Vec::new();
         for (i, view) in ["inside", "hill", "birds-eye"].iter().enumerate() {
-            let (eye, target) = crate::render::named_view(view, &forest, &b.species)?;
+            let (eye, target) = forest_render::named_view(view, &forest, &b.species)?;
             let cam = super::accuracy::look_at(eye, target, side, viewport, 16.0);
             let tgt = Target::new(&b.ctx, viewport.0, viewport.1);
             r.set_method(&b.ctx, *method)?;

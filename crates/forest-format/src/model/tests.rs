@@ -47,7 +47,7 @@ fn dilate_by_scans(img: &mut image::RgbaImage, min_alpha: u8) {
 
 #[test]
 fn dilation_equals_the_whole_image_scans_and_fills_from_one_texel() {
-    let mut rng = crate::generate::SplitMix64(0x9e37_79b9_7f4a_7c15);
+    let mut rng = crate::noise::SplitMix64(0x9e37_79b9_7f4a_7c15);
     let mut next = move || rng.next_u64();
     for (w, h, density) in [
         (64, 64, 2),

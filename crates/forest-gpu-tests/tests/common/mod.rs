@@ -4,10 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use forest_format::generate::{GenerateParams, generate};
 use forest_format::{Atlas, BakeParams, forest::Forest};
 use forest_render::scene::SpeciesData;
 use forest_render::{Camera, GpuContext};
+use forest_scene::generate::{GenerateParams, generate};
 use glam::Vec3;
 
 /// Small atlases (64 px, 5 directions, 2 slabs): bush and pine.

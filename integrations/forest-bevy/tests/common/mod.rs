@@ -70,7 +70,7 @@ pub fn assets() -> &'static Path {
         out.atlas
             .save_with_model(&dir.join("bush.atlas"), Some(&model.encode()))
             .unwrap();
-        let forest = forest_format::generate::generate(&forest_format::generate::GenerateParams {
+        let forest = forest_scene::generate::generate(&forest_scene::generate::GenerateParams {
             trees: 60,
             species: vec!["bush.atlas".into()],
             area_per_tree: 6.0,

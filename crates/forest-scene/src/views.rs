@@ -13,9 +13,9 @@ use std::collections::HashMap;
 
 use glam::{Quat, Vec3};
 
-use crate::atlas::AtlasManifest;
-use crate::forest::{Forest, Instance};
-use crate::opacity::OpacityVolume;
+use forest_format::atlas::AtlasManifest;
+use forest_format::forest::{Forest, Instance};
+use forest_format::opacity::OpacityVolume;
 
 /// Eye height above the ground of the views that stand on it (metres).
 pub const EYE_HEIGHT: f32 = 1.7;
@@ -415,7 +415,7 @@ fn hill(forest: &Forest) -> (Vec3, Vec3) {
 mod tests {
     use super::*;
     use crate::generate::{GenerateParams, generate};
-    use crate::terrain::{Terrain, TerrainParams};
+    use forest_format::terrain::{Terrain, TerrainParams};
     use proptest::prelude::*;
 
     /// Two species of real size as spheres alone: a broad crown (14 m tall) and a tall

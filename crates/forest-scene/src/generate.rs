@@ -11,10 +11,10 @@
 //! above the treeline, and each species keeps to its altitude band
 //! ([`species_altitude`]: pines on the hilltops, oaks and ashes in the valleys).
 
-use crate::forest::{Forest, Instance};
-use crate::terrain::Terrain;
+use forest_format::forest::{Forest, Instance};
+use forest_format::terrain::Terrain;
 
-pub use crate::noise::{SplitMix64, turbulence, value_noise};
+pub use forest_format::noise::{SplitMix64, turbulence, value_noise};
 
 /// Parameters of [`generate`].
 #[derive(Clone, Debug, PartialEq)]
@@ -34,7 +34,7 @@ pub struct GenerateParams {
     /// ([`species_height`]) and its model's height.
     pub species_scale: Vec<(f32, f32)>,
     /// How far each species' foot reaches from its axis at scale 1, in species order
-    /// ([`crate::model::footprint_radius`], metres; empty: 0 for every species). On a terrain
+    /// ([`forest_format::model::footprint_radius`], metres; empty: 0 for every species). On a terrain
     /// a tree is lowered to the ground's lowest point under its foot scaled by its own scale
     /// ([`Terrain::lowest_under`]), so that its trunk's downhill side does not float.
     pub footprint: Vec<f32>,
@@ -100,7 +100,7 @@ impl Default for GenerateParams {
             species_scale: Vec::new(),
             footprint: Vec::new(),
             seed: 1,
-            presort_directions: crate::forest::DEFAULT_PRESORT_DIRECTIONS,
+            presort_directions: forest_format::forest::DEFAULT_PRESORT_DIRECTIONS,
             terrain: None,
             ground: GroundRules::default(),
         }
@@ -217,11 +217,11 @@ pub fn generate(p: &GenerateParams) -> Result<Forest, String> {
 
 /// Refuse parameters out of range, naming the parameter.
 fn validate(p: &GenerateParams) -> Result<(), String> {
-    if p.trees == 0 || p.trees as usize > crate::forest::MAX_INSTANCES {
+    if p.trees == 0 || p.trees as usize > forest_format::forest::MAX_INSTANCES {
         return Err(format!(
             "trees = {}: must be 1 to {}",
             p.trees,
-            crate::forest::MAX_INSTANCES
+            forest_format::forest::MAX_INSTANCES
         ));
     }
     if p.species.is_empty() {
@@ -234,19 +234,19 @@ fn validate(p: &GenerateParams) -> Result<(), String> {
         ));
     }
     let side = (f64::from(p.trees) * f64::from(p.area_per_tree)).sqrt();
-    if side > 2.0 * f64::from(crate::forest::MAX_COORDINATE) {
+    if side > 2.0 * f64::from(forest_format::forest::MAX_COORDINATE) {
         return Err(format!(
             "area per tree = {}: {} trees would cover a square {side:.3e} m across, more than \
              the {:.0e} m a forest may span",
             p.area_per_tree,
             p.trees,
-            2.0 * crate::forest::MAX_COORDINATE
+            2.0 * forest_format::forest::MAX_COORDINATE
         ));
     }
     if !(p.clump_size.is_finite() && p.clump_size > 0.0) {
         return Err(format!("clump size = {}: must be positive", p.clump_size));
     }
-    use crate::forest::{MAX_SCALE, MIN_SCALE};
+    use forest_format::forest::{MAX_SCALE, MIN_SCALE};
     let good = |(lo, hi): (f32, f32)| lo >= MIN_SCALE && hi >= lo && hi <= MAX_SCALE;
     if !good(p.scale) {
         return Err(format!(
@@ -404,7 +404,7 @@ mod tests {
 
     #[test]
     fn feet_are_planted_on_slopes_and_nothing_else_moves() {
-        use crate::terrain::TerrainParams;
+        use forest_format::terrain::TerrainParams;
         let terrain = Terrain::generate(&TerrainParams {
             half_extent: 300.0,
             spacing: 5.0,
@@ -479,7 +479,7 @@ mod tests {
 
     #[test]
     fn trees_stand_on_the_terrain_and_keep_off_steep_ground_and_hilltops() {
-        use crate::terrain::TerrainParams;
+        use forest_format::terrain::TerrainParams;
         let terrain = Terrain::generate(&TerrainParams {
             half_extent: 600.0,
             spacing: 10.0,
