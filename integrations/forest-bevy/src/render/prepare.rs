@@ -120,6 +120,26 @@ impl ForestRenderState {
     }
 }
 
+/// The queries of Bevy's shadow views that a forest's cascades are read from.
+type LightViews<'w, 's, 'a> = Query<'w, 's, (&'a ShadowView, &'a ExtractedView, &'a LightEntity)>;
+
+/// One camera view as every forest in it is drawn: its settings, size and matrices.
+struct ViewFrame<'a> {
+    /// The camera's main entity.
+    main: Entity,
+    cam: &'a super::extract::ExtractedForestCamera,
+    camera: &'a ExtractedCamera,
+    viewport: (u32, u32),
+    world_from_view: Mat4,
+    clip_from_world: Mat4,
+    /// The view's formats and sample count, as a stream's options take them.
+    format: wgpu::TextureFormat,
+    depth_format: wgpu::TextureFormat,
+    samples: u32,
+    /// Bevy's shadow maps of the view, if any.
+    shadow_maps: Option<(&'a ViewLightEntities, &'a ViewShadowBindings)>,
+}
+
 /// Render/Prepare: build the GPU scenes of newly loaded forests, then per camera view and
 /// forest (re)build the stream for the view's targets and write its camera.
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -139,7 +159,7 @@ pub fn prepare_forests(
         Option<(&ViewLightEntities, &ViewShadowBindings)>,
         Option<&Tonemapping>,
     )>,
-    light_views: Query<(&ShadowView, &ExtractedView, &LightEntity)>,
+    light_views: LightViews,
     directional: Query<&ExtractedDirectionalLight>,
 ) {
     // The renderer starts a few frames after the app.
@@ -147,228 +167,63 @@ pub fn prepare_forests(
         return;
     };
     let state = &mut *state;
-    let queue: &wgpu::Queue = &queue;
-    let ctx = state.ctx.get_or_insert_with(|| {
+    // Taken out for the frame (the state's maps are borrowed beside it), and put back.
+    let ctx = state.ctx.take().unwrap_or_else(|| {
         GpuContext::from_device(
             (**adapter).clone(),
             device.wgpu_device().clone(),
-            queue.clone(),
+            (**queue).clone(),
         )
     });
-    for id in extracted.removed_assets.drain(..) {
-        state.scenes.remove(&id);
-        state.models.remove(&id);
-        state.failed.remove(&id);
-    }
-    for (id, asset) in extracted.new_assets.drain(..) {
-        state.models.insert(
-            id,
-            Models {
-                forest: asset.forest.clone(),
-                absent: asset.geometry.is_err(),
-                prepared: asset.geometry.clone(),
-                gpu: None,
-            },
-        );
-        match GpuScene::new(ctx, &asset.species, &asset.forest) {
-            Ok(scene) => {
-                state.scenes.insert(id, Arc::new(scene));
-                state.failed.remove(&id);
-            }
-            Err(e) => {
-                error!("forest {id:?} cannot be drawn: {e}");
-                // A reload that failed leaves nothing of the old scene to draw.
-                state.scenes.remove(&id);
-                state.failed.insert(id, e.to_string());
-            }
-        }
-        // Streams of the old scene are rebuilt, the casting ones too.
-        state.streams.retain(|_, v| v.asset != id);
-        state.casters.retain(|_, c| c.asset != id);
-    }
+    state.apply_assets(&ctx, &mut extracted);
     let mut stats = shared.0.lock().unwrap_or_else(|e| e.into_inner());
     stats.clear();
     let mut live = HashSet::new();
+    let mut live_casters = HashSet::new();
     for v in state.streams.values_mut() {
         v.prepared = false;
     }
     state.casts.clear();
-    let mut live_casters = HashSet::new();
     for (view, camera, target, depth, msaa, shadow_maps, tonemapping) in &views {
         let r = &view.retained_view_entity;
         if r.auxiliary_entity.is_some() || r.subview_index != 0 {
             continue;
         }
         let main = r.main_entity.id();
-        let Some(cam) = extracted.cameras.get(&main) else {
+        let (Some(cam), Some(size)) = (extracted.cameras.get(&main), camera.physical_viewport_size)
+        else {
             continue;
         };
-        let Some(size) = camera.physical_viewport_size else {
-            continue;
-        };
-        // Bevy tonemaps LDR views inside each material's shader; the forest's shaders do not,
-        // so an LDR view with a tonemapper shows the trees untonemapped (HDR views are
-        // tonemapped by Bevy's pass, the trees with the rest).
-        let untonemapped = !camera.hdr && tonemapping.is_some_and(|t| *t != Tonemapping::None);
-        if untonemapped && state.warned.insert(main) {
-            warn!(
-                "forest-bevy: camera {main} draws an LDR view with {tonemapping:?}: Bevy \
-                 tonemaps LDR views in each material's shader and the forest's are not; add \
-                 `Hdr` to the camera (or use `Tonemapping::None`)"
-            );
-        }
-        let viewport = (size.x.max(1), size.y.max(1));
+        state.warn_untonemapped(main, camera, tonemapping);
         let world_from_view = view.world_from_view.to_matrix();
-        let clip_from_world = view
-            .clip_from_world
-            .unwrap_or(view.clip_from_view * world_from_view.inverse());
-        let atmosphere = light::atmosphere(cam.fog, cam.ambient);
+        let frame = ViewFrame {
+            main,
+            cam,
+            camera,
+            viewport: (size.x.max(1), size.y.max(1)),
+            world_from_view,
+            clip_from_world: view
+                .clip_from_world
+                .unwrap_or(view.clip_from_view * world_from_view.inverse()),
+            format: drawn_format(target.main_texture_format()),
+            depth_format: depth.texture().format(),
+            samples: msaa.samples(),
+            shadow_maps,
+        };
         for forest in &extracted.forests {
-            let key_pair = (main, forest.entity);
-            let mut record = ForestViewStats::default();
-            let Some(scene) = state.scenes.get(&forest.asset) else {
+            let key = (main, forest.entity);
+            let Some(scene) = state.scenes.get(&forest.asset).cloned() else {
                 if let Some(e) = state.failed.get(&forest.asset) {
-                    record.error = Some(e.clone());
-                    stats.insert(key_pair, record);
+                    let record = ForestViewStats {
+                        error: Some(e.clone()),
+                        ..Default::default()
+                    };
+                    stats.insert(key, record);
                 }
                 continue;
             };
-            live.insert(key_pair);
-            let opts = RendererOptions {
-                format: drawn_format(target.main_texture_format()),
-                depth_format: depth.texture().format(),
-                sample_count: msaa.samples(),
-                reverse_z: true,
-                viewport,
-                min_epsilon: cam.settings.epsilon,
-                atmosphere,
-                write_depth: cam.settings.write_depth,
-                ..Default::default()
-            };
-            let mut method = cam.settings.method;
-            // The hybrid (the default) over atlases baked without their models draws the quad
-            // stream, as `forest render` does, and says so; the other model methods report
-            // the missing models as an error.
-            let mut note = None;
-            if method == ForestMethod::Hybrid
-                && let Some(Err(why)) = state
-                    .models
-                    .get(&forest.asset)
-                    .filter(|m| m.absent)
-                    .map(|m| m.prepared.as_ref())
-            {
-                let why = format!("drawing the quad stream, not the hybrid: {why}");
-                if state.warned_fallback.insert(key_pair) {
-                    warn!("forest-bevy: camera {main}: {why}");
-                }
-                note = Some(why);
-                method = ForestMethod::QuadStream;
-            }
-            record.note = note.clone();
-            let models = if method.needs_models() {
-                let Some(models) = state.models.get_mut(&forest.asset) else {
-                    continue;
-                };
-                match models.gpu(ctx) {
-                    Ok(gpu) => Some(gpu),
-                    Err(e) => {
-                        state.streams.remove(&key_pair);
-                        record.error = Some(format!("{}: {e}", method.name()));
-                        stats.insert(key_pair, record);
-                        continue;
-                    }
-                }
-            } else {
-                None
-            };
-            // Rebuilt for another asset or other targets, and when the method needs models
-            // the renderer has not uploaded (a quad-stream view uploads none).
-            let built = state.streams.get(&key_pair);
-            if built.is_none_or(|v| {
-                v.asset != forest.asset
-                    || *v.renderer.stream.options_built() != opts
-                    || (models.is_some() && v.renderer.geometry.is_none())
-            }) {
-                let built = QuadStream::new(&ctx.device, scene.clone(), &opts).and_then(|stream| {
-                    let geometry = models
-                        .as_ref()
-                        .map(|m| GeometryRenderer::with_models(ctx, m.clone(), &opts))
-                        .transpose()?;
-                    Ok(ForestRenderer::new(stream, geometry))
-                });
-                match built {
-                    Ok(renderer) => {
-                        state.streams.insert(
-                            key_pair,
-                            ViewStream {
-                                asset: forest.asset,
-                                renderer,
-                                prepared: false,
-                                receiving: None,
-                                last: None,
-                            },
-                        );
-                    }
-                    Err(e) => {
-                        state.streams.remove(&key_pair);
-                        record.error = Some(e.to_string());
-                        stats.insert(key_pair, record);
-                        continue;
-                    }
-                }
-            }
-            let Some(v) = state.streams.get_mut(&key_pair) else {
-                continue;
-            };
-            let wanted = method.method();
-            if v.renderer.method() != wanted {
-                if let Err(e) = v.renderer.set_method(ctx, wanted) {
-                    record.error = Some(e.to_string());
-                    stats.insert(key_pair, record);
-                    continue;
-                }
-                // The counters read back were of the other method.
-                v.last = None;
-            }
-            // The forest's frame: the camera moved into the forest's space, so that
-            // clip = P·V·M; the sun turned with it.
-            let forest_from_world = forest.world_from_forest.inverse();
-            let sun = extracted.sun.map(|s| light::Sun {
-                to_light: forest_from_world.transform_vector3(s.to_light),
-                ..s
-            });
-            let lighting = light::lighting(sun, cam.ambient, camera.exposure);
-            let view_from_world = world_from_view.inverse();
-            let frame = FrameParams {
-                view: light::mat_to_forest(view_from_world * forest.world_from_forest),
-                proj: light::mat_to_forest(clip_from_world * world_from_view),
-                viewport,
-                epsilon: cam.settings.epsilon,
-                light: lighting,
-            };
-            // Counters of a recent frame; a stream that overflowed grows (the next frames
-            // draw everything).
-            if let Some(s) = v.renderer.poll_stats(&ctx.device, &ctx.queue) {
-                let quads = s.stream.quads;
-                let mut fresh = ForestViewStats {
-                    visible_trees: s.visible_trees,
-                    quads,
-                    triangles: s.primitives.saturating_sub(u64::from(quads)),
-                    geometry_trees: s.geometry_trees,
-                    cast_quads: 0,
-                    gpu_ms: s.times.map(|t| t.total_ms()),
-                    error: None,
-                    note: note.clone(),
-                };
-                if let Err(e) = v.renderer.fit(&ctx.device, &s) {
-                    fresh.error = Some(e.to_string());
-                }
-                v.last = Some(fresh);
-            }
-            if let Some(last) = &v.last {
-                record = last.clone();
-            }
-            // Bevy's shadow cascades for this view: received, and cast into.
+            live.insert(key);
+            // Bevy's shadow cascades for this view, in the forest's frame.
             let scale = forest
                 .world_from_forest
                 .to_scale_rotation_translation()
@@ -383,102 +238,15 @@ pub fn prepare_forests(
                     scale,
                 )
             });
-            // Bevy's map, bound again only when it is another texture or another cascade
-            // count; the cascades' matrices are written every frame.
-            let maps = shadow_maps
-                .filter(|_| !cascades.is_empty())
-                .map(|(_, b)| (&*b.directional_light_depth_texture, cascades.len()));
-            if maps != v.receiving.as_ref().map(|(t, n)| (t, *n)) {
-                match maps {
-                    Some((texture, n)) => {
-                        let array = texture.create_view(&wgpu::TextureViewDescriptor {
-                            dimension: Some(wgpu::TextureViewDimension::D2Array),
-                            base_array_layer: 0,
-                            array_layer_count: Some(n as u32),
-                            ..Default::default()
-                        });
-                        let resolution = cascades[0].resolution;
-                        v.renderer
-                            .receive_host_shadows(&ctx.device, Some((&array, resolution, true)));
-                    }
-                    None => v.renderer.receive_host_shadows(&ctx.device, None),
-                }
-                v.receiving = maps.map(|(t, n)| (t.clone(), n));
-            }
-            if v.receiving.is_some() {
-                let host: Vec<_> = cascades.iter().map(|c| c.cascade).collect();
-                if let Err(e) = v.renderer.set_host_cascades(&host) {
-                    record.error = Some(e.to_string());
-                }
-            }
-            for c in &cascades {
-                let key = (main, forest.entity, c.layer);
-                let opts = RendererOptions {
-                    depth_format: wgpu::TextureFormat::Depth32Float,
-                    reverse_z: true,
-                    viewport: (c.resolution, c.resolution),
-                    min_epsilon: forest_render::shadow::ShadowOptions::default().epsilon,
-                    overdraw: 0.25,
-                    ..Default::default()
-                };
-                let built = state.casters.get(&key);
-                if built
-                    .is_none_or(|k| k.asset != forest.asset || *k.stream.options_built() != opts)
-                {
-                    match QuadStream::new(&ctx.device, scene.clone(), &opts) {
-                        Ok(stream) => {
-                            state.casters.insert(
-                                key,
-                                Caster {
-                                    asset: forest.asset,
-                                    stream,
-                                    quads: 0,
-                                },
-                            );
-                        }
-                        Err(e) => {
-                            state.casters.remove(&key);
-                            record.error = Some(format!("shadow caster: {e}"));
-                            continue;
-                        }
-                    }
-                }
-                let Some(caster) = state.casters.get_mut(&key) else {
-                    continue;
-                };
-                // Cast with the aspect sharpening the view draws its quads with.
-                if let Err(e) = caster.stream.set_sharpen_override(wanted.quad_sharpen()) {
-                    record.error = Some(format!("shadow caster: {e}"));
-                    continue;
-                }
-                if let Some(s) = caster.stream.poll_stats(&ctx.device, &ctx.queue) {
-                    if let Err(e) = caster.stream.fit(&ctx.device, &s) {
-                        record.error = Some(format!("shadow caster: {e}"));
-                    }
-                    caster.quads = s.quads;
-                }
-                record.cast_quads += caster.quads;
-                let light = shadows::light_params(c, lighting.sun_dir, frame.eye());
-                match caster.stream.prepare_light(&ctx.device, &ctx.queue, &light) {
-                    Ok(()) => {
-                        live_casters.insert(key);
-                        state
-                            .casts
-                            .entry(main)
-                            .or_default()
-                            .push((c.light_view, key));
-                    }
-                    Err(e) => record.error = Some(format!("shadow caster: {e}")),
-                }
-            }
-            let Some(v) = state.streams.get_mut(&key_pair) else {
-                continue;
+            let lit = Lit {
+                sun: extracted.sun,
+                cascades: &cascades,
             };
-            match v.renderer.prepare(&ctx.queue, &frame) {
-                Ok(()) => v.prepared = true,
-                Err(e) => record.error = Some(e.to_string()),
+            let record =
+                state.prepare_forest(&ctx, &frame, forest, &scene, &lit, &mut live_casters);
+            if let Some(record) = record {
+                stats.insert(key, record);
             }
-            stats.insert(key_pair, record);
         }
     }
     state.streams.retain(|k, _| live.contains(k));
@@ -487,6 +255,371 @@ pub fn prepare_forests(
     for m in state.models.values_mut() {
         if m.gpu.as_ref().is_some_and(|g| Arc::strong_count(g) == 1) {
             m.gpu = None;
+        }
+    }
+    state.ctx = Some(ctx);
+}
+
+/// A forest's light in a view: the sun, and Bevy's shadow cascades in the forest's frame.
+struct Lit<'a> {
+    sun: Option<light::Sun>,
+    cascades: &'a [shadows::HostCascade],
+}
+
+impl ForestRenderState {
+    /// Scenes of newly loaded assets built, those of removed assets dropped (with the streams
+    /// drawing them, the casting ones too).
+    fn apply_assets(&mut self, ctx: &GpuContext, extracted: &mut Extracted) {
+        for id in extracted.removed_assets.drain(..) {
+            self.scenes.remove(&id);
+            self.models.remove(&id);
+            self.failed.remove(&id);
+        }
+        for (id, asset) in extracted.new_assets.drain(..) {
+            self.models.insert(
+                id,
+                Models {
+                    forest: asset.forest.clone(),
+                    absent: asset.geometry.is_err(),
+                    prepared: asset.geometry.clone(),
+                    gpu: None,
+                },
+            );
+            match GpuScene::new(ctx, &asset.species, &asset.forest) {
+                Ok(scene) => {
+                    self.scenes.insert(id, Arc::new(scene));
+                    self.failed.remove(&id);
+                }
+                Err(e) => {
+                    error!("forest {id:?} cannot be drawn: {e}");
+                    // A reload that failed leaves nothing of the old scene to draw.
+                    self.scenes.remove(&id);
+                    self.failed.insert(id, e.to_string());
+                }
+            }
+            self.streams.retain(|_, v| v.asset != id);
+            self.casters.retain(|_, c| c.asset != id);
+        }
+    }
+
+    /// Bevy tonemaps LDR views inside each material's shader; the forest's shaders do not, so
+    /// an LDR view with a tonemapper shows the trees untonemapped (HDR views are tonemapped by
+    /// Bevy's pass, the trees with the rest). Said once per camera.
+    fn warn_untonemapped(
+        &mut self,
+        main: Entity,
+        camera: &ExtractedCamera,
+        tonemapping: Option<&Tonemapping>,
+    ) {
+        let untonemapped = !camera.hdr && tonemapping.is_some_and(|t| *t != Tonemapping::None);
+        if untonemapped && self.warned.insert(main) {
+            warn!(
+                "forest-bevy: camera {main} draws an LDR view with {tonemapping:?}: Bevy \
+                 tonemaps LDR views in each material's shader and the forest's are not; add \
+                 `Hdr` to the camera (or use `Tonemapping::None`)"
+            );
+        }
+    }
+
+    /// The method a view draws a forest with, and why not the one asked for: the hybrid (the
+    /// default) over atlases baked without their models draws the quad stream, as `forest
+    /// render` does, and says so; the other model methods report the missing models as an
+    /// error.
+    fn drawn_method(
+        &mut self,
+        key: (Entity, Entity),
+        asset: AssetId<ForestAsset>,
+        asked: ForestMethod,
+    ) -> (ForestMethod, Option<String>) {
+        if asked == ForestMethod::Hybrid
+            && let Some(Err(why)) = self
+                .models
+                .get(&asset)
+                .filter(|m| m.absent)
+                .map(|m| m.prepared.as_ref())
+        {
+            let why = format!("drawing the quad stream, not the hybrid: {why}");
+            if self.warned_fallback.insert(key) {
+                warn!("forest-bevy: camera {}: {why}", key.0);
+            }
+            return (ForestMethod::QuadStream, Some(why));
+        }
+        (asked, None)
+    }
+
+    /// The view's renderer of a forest, (re)built for another asset or other targets, and
+    /// when the method needs models the renderer has not uploaded (a quad-stream view uploads
+    /// none), then set to `method`. None (after `record` says why) if it cannot be.
+    #[allow(clippy::too_many_arguments)]
+    fn renderer_for(
+        &mut self,
+        ctx: &GpuContext,
+        key: (Entity, Entity),
+        asset: AssetId<ForestAsset>,
+        scene: &Arc<GpuScene>,
+        opts: &RendererOptions,
+        method: ForestMethod,
+        record: &mut ForestViewStats,
+    ) -> Option<&mut ViewStream> {
+        let models = if method.needs_models() {
+            let models = self.models.get_mut(&asset)?;
+            match models.gpu(ctx) {
+                Ok(gpu) => Some(gpu),
+                Err(e) => {
+                    self.streams.remove(&key);
+                    record.error = Some(format!("{}: {e}", method.name()));
+                    return None;
+                }
+            }
+        } else {
+            None
+        };
+        if self.streams.get(&key).is_none_or(|v| {
+            v.asset != asset
+                || v.renderer.stream.options_built() != opts
+                || (models.is_some() && v.renderer.geometry.is_none())
+        }) {
+            let built = QuadStream::new(&ctx.device, scene.clone(), opts).and_then(|stream| {
+                let geometry = models
+                    .as_ref()
+                    .map(|m| GeometryRenderer::with_models(ctx, m.clone(), opts))
+                    .transpose()?;
+                Ok(ForestRenderer::new(stream, geometry))
+            });
+            match built {
+                Ok(renderer) => {
+                    let view = ViewStream {
+                        asset,
+                        renderer,
+                        prepared: false,
+                        receiving: None,
+                        last: None,
+                    };
+                    self.streams.insert(key, view);
+                }
+                Err(e) => {
+                    self.streams.remove(&key);
+                    record.error = Some(e.to_string());
+                    return None;
+                }
+            }
+        }
+        let v = self.streams.get_mut(&key)?;
+        let wanted = method.method();
+        if v.renderer.method() != wanted {
+            if let Err(e) = v.renderer.set_method(ctx, wanted) {
+                record.error = Some(e.to_string());
+                return None;
+            }
+            // The counters read back were of the other method.
+            v.last = None;
+        }
+        Some(v)
+    }
+
+    /// One forest in one view: its renderer built and set to the view's method, its counters
+    /// polled, Bevy's cascades received and cast into, its camera written. The view's record
+    /// of it, None where a forest is not reported.
+    fn prepare_forest(
+        &mut self,
+        ctx: &GpuContext,
+        view: &ViewFrame,
+        forest: &super::extract::ExtractedForest,
+        scene: &Arc<GpuScene>,
+        lit: &Lit,
+        live_casters: &mut HashSet<CasterId>,
+    ) -> Option<ForestViewStats> {
+        let key = (view.main, forest.entity);
+        let cam = view.cam;
+        let opts = RendererOptions {
+            format: view.format,
+            depth_format: view.depth_format,
+            sample_count: view.samples,
+            reverse_z: true,
+            viewport: view.viewport,
+            min_epsilon: cam.settings.epsilon,
+            atmosphere: light::atmosphere(cam.fog, cam.ambient),
+            write_depth: cam.settings.write_depth,
+            ..Default::default()
+        };
+        let (method, note) = self.drawn_method(key, forest.asset, cam.settings.method);
+        let mut record = ForestViewStats {
+            note: note.clone(),
+            ..Default::default()
+        };
+        if method.needs_models() && !self.models.contains_key(&forest.asset) {
+            return None;
+        }
+        let Some(v) = self.renderer_for(ctx, key, forest.asset, scene, &opts, method, &mut record)
+        else {
+            return Some(record);
+        };
+        // The forest's frame: the camera moved into the forest's space, so that
+        // clip = P·V·M; the sun turned with it.
+        let forest_from_world = forest.world_from_forest.inverse();
+        let sun = lit.sun.map(|s| light::Sun {
+            to_light: forest_from_world.transform_vector3(s.to_light),
+            ..s
+        });
+        let lighting = light::lighting(sun, cam.ambient, view.camera.exposure);
+        let view_from_world = view.world_from_view.inverse();
+        let frame = FrameParams {
+            view: light::mat_to_forest(view_from_world * forest.world_from_forest),
+            proj: light::mat_to_forest(view.clip_from_world * view.world_from_view),
+            viewport: view.viewport,
+            epsilon: cam.settings.epsilon,
+            light: lighting,
+        };
+        poll_counters(ctx, v, note);
+        if let Some(last) = &v.last {
+            record = last.clone();
+        }
+        // Bevy's shadow cascades for this view: received, and cast into.
+        let cascades = lit.cascades;
+        receive_cascades(ctx, v, view.shadow_maps, cascades, &mut record);
+        let sharpen = method.method().quad_sharpen();
+        for c in cascades {
+            let key = (view.main, forest.entity, c.layer);
+            let light = shadows::light_params(c, lighting.sun_dir, frame.eye());
+            let (asset, res) = (forest.asset, c.resolution);
+            if self.cast(ctx, key, asset, scene, res, sharpen, &light, &mut record) {
+                live_casters.insert(key);
+                self.casts
+                    .entry(view.main)
+                    .or_default()
+                    .push((c.light_view, key));
+            }
+        }
+        let v = self.streams.get_mut(&key)?;
+        match v.renderer.prepare(&ctx.queue, &frame) {
+            Ok(()) => v.prepared = true,
+            Err(e) => record.error = Some(e.to_string()),
+        }
+        Some(record)
+    }
+
+    /// The stream casting a forest into one cascade layer (`key`) of a view, (re)built for
+    /// another asset or map size, cast with the aspect sharpening the view draws its quads
+    /// with, its light written. Whether it casts this frame; the quads it cast in a recent
+    /// frame are added to `record`, and what went wrong is said there.
+    #[allow(clippy::too_many_arguments)]
+    fn cast(
+        &mut self,
+        ctx: &GpuContext,
+        key: CasterId,
+        asset: AssetId<ForestAsset>,
+        scene: &Arc<GpuScene>,
+        resolution: u32,
+        sharpen: Option<u32>,
+        light: &forest_render::shadow::LightParams,
+        record: &mut ForestViewStats,
+    ) -> bool {
+        let opts = RendererOptions {
+            depth_format: wgpu::TextureFormat::Depth32Float,
+            reverse_z: true,
+            viewport: (resolution, resolution),
+            min_epsilon: forest_render::shadow::ShadowOptions::default().epsilon,
+            overdraw: 0.25,
+            ..Default::default()
+        };
+        let built = self.casters.get(&key);
+        if built.is_none_or(|k| k.asset != asset || *k.stream.options_built() != opts) {
+            match QuadStream::new(&ctx.device, scene.clone(), &opts) {
+                Ok(stream) => {
+                    let caster = Caster {
+                        asset,
+                        stream,
+                        quads: 0,
+                    };
+                    self.casters.insert(key, caster);
+                }
+                Err(e) => {
+                    self.casters.remove(&key);
+                    record.error = Some(format!("shadow caster: {e}"));
+                    return false;
+                }
+            }
+        }
+        let Some(caster) = self.casters.get_mut(&key) else {
+            return false;
+        };
+        if let Err(e) = caster.stream.set_sharpen_override(sharpen) {
+            record.error = Some(format!("shadow caster: {e}"));
+            return false;
+        }
+        if let Some(s) = caster.stream.poll_stats(&ctx.device, &ctx.queue) {
+            if let Err(e) = caster.stream.fit(&ctx.device, &s) {
+                record.error = Some(format!("shadow caster: {e}"));
+            }
+            caster.quads = s.quads;
+        }
+        record.cast_quads += caster.quads;
+        match caster.stream.prepare_light(&ctx.device, &ctx.queue, light) {
+            Ok(()) => true,
+            Err(e) => {
+                record.error = Some(format!("shadow caster: {e}"));
+                false
+            }
+        }
+    }
+}
+
+/// Counters of a recent frame read into the view's last record; a stream that overflowed
+/// grows (the next frames draw everything).
+fn poll_counters(ctx: &GpuContext, v: &mut ViewStream, note: Option<String>) {
+    let Some(s) = v.renderer.poll_stats(&ctx.device, &ctx.queue) else {
+        return;
+    };
+    let quads = s.stream.quads;
+    let mut fresh = ForestViewStats {
+        visible_trees: s.visible_trees,
+        quads,
+        triangles: s.primitives.saturating_sub(u64::from(quads)),
+        geometry_trees: s.geometry_trees,
+        cast_quads: 0,
+        gpu_ms: s.times.map(|t| t.total_ms()),
+        error: None,
+        note,
+    };
+    if let Err(e) = v.renderer.fit(&ctx.device, &s) {
+        fresh.error = Some(e.to_string());
+    }
+    v.last = Some(fresh);
+}
+
+/// Bevy's map bound again only when it is another texture or another cascade count; the
+/// cascades' matrices are written every frame.
+fn receive_cascades(
+    ctx: &GpuContext,
+    v: &mut ViewStream,
+    shadow_maps: Option<(&ViewLightEntities, &ViewShadowBindings)>,
+    cascades: &[shadows::HostCascade],
+    record: &mut ForestViewStats,
+) {
+    let maps = shadow_maps
+        .filter(|_| !cascades.is_empty())
+        .map(|(_, b)| (&*b.directional_light_depth_texture, cascades.len()));
+    if maps != v.receiving.as_ref().map(|(t, n)| (t, *n)) {
+        match maps {
+            Some((texture, n)) => {
+                let array = texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    base_array_layer: 0,
+                    array_layer_count: Some(n as u32),
+                    ..Default::default()
+                });
+                let resolution = cascades[0].resolution;
+                v.renderer
+                    .receive_host_shadows(&ctx.device, Some((&array, resolution, true)));
+            }
+            None => v.renderer.receive_host_shadows(&ctx.device, None),
+        }
+        v.receiving = maps.map(|(t, n)| (t.clone(), n));
+    }
+    if v.receiving.is_some() {
+        let host: Vec<_> = cascades.iter().map(|c| c.cascade).collect();
+        if let Err(e) = v.renderer.set_host_cascades(&host) {
+            record.error = Some(e.to_string());
         }
     }
 }
