@@ -4,7 +4,9 @@
 // first. In the hybrid method (camera.forms) trees drawn as quads alone get no segment, and
 // a species with mesh-LOD bands lists each near tree once per mesh LOD that draws some of its
 // pixels (tree_keys): once, or twice or three times in a crossfade.
-// Appended after common.wgsl and geometry_types.wgsl.
+
+#import common
+#import geometry_types
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;

@@ -1,10 +1,12 @@
-// The light views' casting pass of the geometry-based methods (appended to the draw module):
+// The light views' casting pass of the geometry-based methods (it imports the draw module):
 // a light view's listed trees, culled by the cascade's box with their forms and levels of
 // detail chosen from the view's eye (camera.form_eye), as depth only into the cascade's layer.
 // Alpha-tested leaves and billboards are kept where the draw keeps them; in the hybrid's
 // transition band each texel belongs to the form that owns it (not_drawn_here), so the two
 // forms never both cast, and in a crossfade between mesh LODs to one of them. No march
 // towards the sun: nothing is shaded.
+
+#import geometry_draw
 
 @vertex
 fn vs_geo_cast(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> GeoOut {

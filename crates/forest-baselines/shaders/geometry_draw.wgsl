@@ -1,6 +1,5 @@
-// Drawing of the geometry-based methods (see geometry.wgsl). Appended after common.wgsl and
-// geometry_types.wgsl; environment.wgsl follows (the sky, the ground
-// and the haze every fragment goes through).
+// Drawing of the geometry-based methods (see geometry.wgsl), with environment.wgsl (the sky,
+// the ground and the haze every fragment goes through).
 //
 // Meshes are shaded with the project's one shading model (shade_light, forest_format::shading)
 // in world space under the frame's light (the camera uniform's): an instance's rotation turns
@@ -12,6 +11,13 @@
 // leaf vertex is moved towards its leaf's centre by the fade × area factor and the leaf's
 // albedo pulled towards the species' mean by √λ; at λ = 1 nothing is touched, so the image is
 // exactly the full geometry's.
+
+#import common
+#import geometry_types
+#import ground
+#import environment
+#import shadow
+#import count
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;

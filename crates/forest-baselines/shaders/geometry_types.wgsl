@@ -5,6 +5,8 @@
 // fade, lambda_band, band_lambda, band_elements), which the tests check against this code's
 // results.
 
+#import common
+
 struct GeoVertex {
     pos: vec3<f32>,
     // Sky visibility of the side `normal` faces (the front) at this corner.

@@ -76,28 +76,18 @@ fn geometry_structs_match_the_host() {
             ],
         ),
     ];
-    check(
-        &forest_baselines::shaders::GEOMETRY_DRAW_WGSL.concat(),
-        &expected,
-    );
-    check(
-        &forest_baselines::shaders::GEOMETRY_CULL_WGSL.concat(),
-        &expected[1..3],
-    );
+    check(&forest_baselines::shaders::draw_source(), &expected);
+    check(&forest_baselines::shaders::cull_source(), &expected[1..3]);
 }
 
 #[test]
 fn shaders_validate() {
-    use forest_baselines::shaders::{GEOMETRY_CULL_WGSL, GEOMETRY_DRAW_WGSL};
+    use forest_baselines::shaders::{cast_source, counting_draw_source, cull_source, draw_source};
     for src in [
-        GEOMETRY_DRAW_WGSL.concat(),
-        [
-            GEOMETRY_DRAW_WGSL.concat().as_str(),
-            forest_baselines::shaders::GEOMETRY_CAST_WGSL,
-        ]
-        .concat(),
-        forest_render::passes::counting_source(&GEOMETRY_DRAW_WGSL),
-        GEOMETRY_CULL_WGSL.concat(),
+        draw_source(),
+        cast_source(),
+        counting_draw_source(),
+        cull_source(),
     ] {
         layout_check::validated(&src);
     }
@@ -106,9 +96,9 @@ fn shaders_validate() {
 #[test]
 fn bind_group_layouts_and_constants_match_the_wgsl() {
     use forest_baselines::geometry::{RESET_WG, compute_entries, draw_entries};
-    use forest_baselines::shaders::{GEOMETRY_CULL_WGSL, GEOMETRY_DRAW_WGSL};
-    let cull = GEOMETRY_CULL_WGSL.concat();
-    let draw = GEOMETRY_DRAW_WGSL.concat();
+    use forest_baselines::shaders::{cast_source, counting_draw_source, cull_source, draw_source};
+    let cull = cull_source();
+    let draw = draw_source();
     assert_eq!(
         layout_check::reflected_bindings(&cull),
         layout_check::layout_bindings(0, &compute_entries())
@@ -123,7 +113,7 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
     layout_check::check_layout(&draw, &drawn, |_| true);
     // The light views' casting pass reads the draw group alone.
     layout_check::check_layout(
-        &[draw.as_str(), forest_baselines::shaders::GEOMETRY_CAST_WGSL].concat(),
+        &cast_source(),
         &layout_check::layout_bindings(0, &draw_entries()),
         |e| e.ends_with("_cast") || e == "vs_billboard",
     );
@@ -133,11 +123,9 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
         1,
         &forest_render::fragments::layout_entries(),
     ));
-    layout_check::check_layout(
-        &forest_render::passes::counting_source(&GEOMETRY_DRAW_WGSL),
-        &counted,
-        |e| e == "fs_geo" || e == "fs_billboard" || e.starts_with("vs_"),
-    );
+    layout_check::check_layout(&counting_draw_source(), &counted, |e| {
+        e == "fs_geo" || e == "fs_billboard" || e.starts_with("vs_")
+    });
     assert_eq!(
         layout_check::wgsl_const(&cull, "BANDS"),
         f64::from(forest_format::model::BANDS)

@@ -1,5 +1,7 @@
 // Bindings of the compute passes (cull, scan, refine, stats): one layout for all of them, see
-// crates/forest-render/src/passes/mod.rs. Appended after common.wgsl.
+// crates/forest-render/src/bindings.rs.
+
+#import common
 
 struct SceneConsts {
     instances: u32,     // N

@@ -1,4 +1,4 @@
-// The light views' casting pass (appended to the draw module): a light-view stream's quads as
+// The light views' casting pass (it imports the draw module): a light-view stream's quads as
 // depth only into one cascade's layer of the shadow map: far trees' composited quads
 // (vs_cast_composite, fs_cast_composite), then the plain ones (vs_cast, fs_cast). Each quad lies on
 // its plane, as in the draw. A fragment is kept where the slab image's coverage exceeds an
@@ -7,6 +7,8 @@
 // aspects combine as the draw combines them: split by its dither, or "over" each other (see
 // fs_cast). A fixed threshold of ½ was measured to drop a sparse crown's top: the test pine's
 // shadow fell 1.1 m short of its silhouette's. No opacity march: nothing is shaded.
+
+#import draw
 
 struct CastOut {
     @builtin(position) clip: vec4<f32>,

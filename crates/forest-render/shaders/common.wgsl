@@ -1,4 +1,4 @@
-// Types and helpers shared by every pass. Each pass's WGSL is appended to this file.
+// Types and helpers shared by every pass. Every pass's module imports it.
 // Host mirrors: crates/forest-render/src/gpu_types.rs (layouts checked by a naga test).
 
 struct Camera {

@@ -13,6 +13,10 @@
 // refinement never visits them (refine.wgsl), so the final stream keeps them at its front
 // and the draw pass draws each list alone.
 
+#import common
+#import bindings
+#import scan
+
 // Blend of the species' directions for an object-space view vector (unnormalised), exactly as
 // forest_format::directions::blend. Returns indices in .idx and weights in .w.
 struct Blend {

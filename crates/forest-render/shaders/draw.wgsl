@@ -31,6 +31,12 @@
 // covered by it, and what lies nearer (the tree's other aspects, which blend over it, and the
 // fragment itself, drawn again) is drawn as without the pass.
 
+#import common
+#import ground
+#import environment
+#import shadow
+#import count
+
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
 @group(0) @binding(2) var<storage, read> species: array<Species>;

@@ -1,9 +1,12 @@
 // The environment: an endless ground plane at y = 0 and the sky behind it, drawn first as one
 // full-screen triangle; the terrain's height field, drawn as a triangle mesh over the plane; and
-// the distance haze every method's fragments go through (`hazed`). Appended to draw.wgsl and
-// geometry_draw.wgsl, which declare `camera` at binding 0, after ground.wgsl. Mirrors
+// the distance haze every method's fragments go through (`hazed`). Imported by draw.wgsl and
+// geometry_draw.wgsl, which declare `camera` at binding 0. Mirrors
 // options::Atmosphere,
 // gpu_types::GpuEnvironment and forest_format::terrain::Terrain.
+
+#import common
+#import ground
 
 struct Environment {
     // xyz: the ground's second albedo, moss (linear); w unused.

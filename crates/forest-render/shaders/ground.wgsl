@@ -1,6 +1,6 @@
 // The ground's pattern: soil with patches of moss, two octaves of hashed value noise (23 m and
 // 6.1 m) through a smooth step. Pure functions of world (x, z), with no bindings, so that a host
-// drawing its own ground can include them (passes::GROUND_WGSL) and match the library's. Mirrors
+// drawing its own ground can import them (`#import ground`) and match the library's. Mirrors
 // options::ground_moss.
 
 // One of 2^24 values in [0, 1) per lattice point: a 32-bit integer hash (after Chris Wellons'

@@ -1,6 +1,9 @@
 // Where a quad lies on screen, for the refine pass. Mirrored by clip_at, edge_long and
 // error_long in crates/forest-render/src/reference.rs, operation for operation.
 
+#import common
+#import bindings
+
 // Clip-space position of image point (u, v) at slab-relative depth t of a quad's layer.
 fn quad_clip_at(q: Quad, u: f32, v: f32, t: f32) -> vec4<f32> {
     let inst = instances[q.instance];

@@ -21,6 +21,11 @@
 // after them alone. Indices into data, data_next and the block sums count from the first
 // plain quad; the stream buffers are indexed from the front (quads_in[front + i]).
 
+#import common
+#import bindings
+#import quad_geometry
+#import scan
+
 // Clip-space position of corner c (0 TL, 1 TR, 2 BL, 3 BR) of a quad.
 fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
     let size = 1.0 / f32(1u << quad_level(q));

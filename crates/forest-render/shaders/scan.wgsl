@@ -11,6 +11,8 @@
 // CPU reference (reference.rs) computes the same. Between scans every block sum is zero
 // (frame_setup clears them all; each block clears its own after reading it).
 
+#import bindings
+
 var<workgroup> wg_sum: array<u32, 256>;
 var<workgroup> wg_uniform: u32;
 

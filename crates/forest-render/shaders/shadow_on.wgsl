@@ -1,6 +1,8 @@
 // The sun's shadow lookup (group 2): the cascades' maps, one layer each, written by the light
 // views' casting pass (cast.wgsl) and described by the camera uniform (forest_render::shadow).
 
+#import common
+
 @group(2) @binding(0) var shadow_map: texture_depth_2d_array;
 // Compares with less-equal and filters bilinearly: each tap is a 2×2 PCF.
 @group(2) @binding(1) var shadow_sampler: sampler_comparison;

@@ -47,7 +47,7 @@ fn draw_structs_match_the_host() {
 #[test]
 fn counting_params_match_the_host() {
     use forest_render::fragments::CountParams;
-    let counted = forest_render::passes::counting_source(&forest_render::passes::DRAW_WGSL);
+    let counted = forest_render::passes::counting_draw_source();
     check(
         &counted,
         &[(
@@ -69,7 +69,8 @@ fn counting_params_match_the_host() {
 
 #[test]
 fn the_overdraw_view_matches_the_host() {
-    use forest_render::passes::overdraw::{OVERDRAW_COLOURS, OVERDRAW_WGSL, OverdrawParams};
+    use forest_render::passes::OVERDRAW_WGSL;
+    use forest_render::passes::overdraw::{OVERDRAW_COLOURS, OverdrawParams};
     check(
         OVERDRAW_WGSL,
         &[(
@@ -117,8 +118,8 @@ fn the_overdraw_view_matches_the_host() {
 
 #[test]
 fn shaders_validate() {
-    layout_check::validated(forest_render::passes::overdraw::OVERDRAW_WGSL);
-    let counted = forest_render::passes::counting_source(&forest_render::passes::DRAW_WGSL);
+    layout_check::validated(forest_render::passes::OVERDRAW_WGSL);
+    let counted = forest_render::passes::counting_draw_source();
     for src in [compute_source(), draw_source(), counted] {
         layout_check::validated(&src);
     }
@@ -147,7 +148,7 @@ fn bind_group_layouts_match_the_wgsl() {
     layout_check::check_layout(&draw_source(), &draw, |_| true);
     // The light views' casting pass reads group 0 alone.
     layout_check::check_layout(
-        &[draw_source().as_str(), forest_render::passes::CAST_WGSL].concat(),
+        &forest_render::passes::cast_source(),
         &layout_check::layout_bindings(0, &bind_entries()),
         |e| ["vs_cast", "fs_cast"].contains(&e),
     );
@@ -158,7 +159,7 @@ fn bind_group_layouts_match_the_wgsl() {
         &forest_render::fragments::layout_entries(),
     ));
     layout_check::check_layout(
-        &forest_render::passes::counting_source(&forest_render::passes::DRAW_WGSL),
+        &forest_render::passes::counting_draw_source(),
         &counted,
         |e| ["vs_quad", "fs_quad", "vs_composite", "fs_composite"].contains(&e),
     );

@@ -28,8 +28,10 @@ use wgpu::util::DeviceExt;
 pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// The host's ground: a square around the eye, soil and moss in the library's pattern
-/// (`ground_moss` from [`forest_render::passes::GROUND_WGSL`], prepended).
+/// (`ground_moss`, imported from the runtime's `ground` module by the composer).
 const HOST_GROUND_WGSL: &str = r#"
+#import ground
+
 struct Host {
     view_proj: mat4x4<f32>, colour: vec4<f32>, moss: vec4<f32>, eye: vec4<f32>,
     // The sun's shadow map (reverse-Z): its matrix, the shadowed soil and moss, and in
@@ -421,8 +423,9 @@ fn ground_pipeline(device: &wgpu::Device, format: wgpu::TextureFormat) -> wgpu::
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("host ground"),
         source: wgpu::ShaderSource::Wgsl(
-            [forest_render::passes::GROUND_WGSL, HOST_GROUND_WGSL]
-                .concat()
+            forest_render::shaders::Composer::runtime()
+                .with_module("host_ground", HOST_GROUND_WGSL)
+                .composed(&["host_ground"])
                 .into(),
         ),
     });

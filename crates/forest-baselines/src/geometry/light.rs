@@ -30,11 +30,7 @@ impl LightViews {
             bind_group_layouts: &[Some(&shared.draw_layout)],
             immediate_size: 0,
         });
-        let source = [
-            crate::shaders::GEOMETRY_DRAW_WGSL.concat().as_str(),
-            crate::shaders::GEOMETRY_CAST_WGSL,
-        ]
-        .concat();
+        let source = crate::shaders::cast_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry cast"),
             source: wgpu::ShaderSource::Wgsl(source.into()),

@@ -134,7 +134,7 @@ impl GeometryRenderer {
 
         let draw_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("geometry draw"),
-            source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_DRAW_WGSL.concat().into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shaders::draw_source().into()),
         });
         let (compute_layout, [reset, classify, args_pipeline, scatter]) = compute_pipelines(device);
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -555,7 +555,7 @@ impl forest_render::shadow_maps::Caster for GeometryRenderer {
 fn compute_pipelines(device: &wgpu::Device) -> (wgpu::BindGroupLayout, [wgpu::ComputePipeline; 4]) {
     let compute = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("geometry cull"),
-        source: wgpu::ShaderSource::Wgsl(crate::shaders::GEOMETRY_CULL_WGSL.concat().into()),
+        source: wgpu::ShaderSource::Wgsl(crate::shaders::cull_source().into()),
     });
     // One explicit layout shared by the four compute entry points (one bind group).
     let entries = compute_entries();
@@ -631,8 +631,7 @@ impl Form for GeometryRenderer {
                 ],
                 immediate_size: 0,
             });
-            let source =
-                forest_render::passes::counting_source(&crate::shaders::GEOMETRY_DRAW_WGSL);
+            let source = crate::shaders::counting_draw_source();
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("counted geometry draw"),
                 source: wgpu::ShaderSource::Wgsl(source.into()),

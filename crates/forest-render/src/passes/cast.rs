@@ -81,7 +81,7 @@ impl CastPass {
             bind_group_layouts: &[Some(&bind_layout)],
             immediate_size: 0,
         });
-        let source = [super::DRAW_WGSL.concat().as_str(), super::CAST_WGSL].concat();
+        let source = super::cast_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cast"),
             source: wgpu::ShaderSource::Wgsl(source.into()),

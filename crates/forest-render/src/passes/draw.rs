@@ -214,7 +214,7 @@ impl DrawPass {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("counted draw"),
-            source: wgpu::ShaderSource::Wgsl(super::counting_source(&super::DRAW_WGSL).into()),
+            source: wgpu::ShaderSource::Wgsl(super::counting_draw_source().into()),
         });
         let blend = Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
         let strip = wgpu::PrimitiveTopology::TriangleStrip;

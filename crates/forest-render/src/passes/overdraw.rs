@@ -4,9 +4,6 @@
 
 use crate::fragments::FragmentCounter;
 
-/// WGSL of the overdraw view.
-pub const OVERDRAW_WGSL: &str = include_str!("../../shaders/overdraw.wgsl");
-
 /// Linear RGB of the bands: 0 (no fragment), 1 (one), 2 (2–3), 3 (4–7) … 8 (128 or more).
 /// Mirrors `OVERDRAW_COLOURS` in the WGSL.
 pub const OVERDRAW_COLOURS: [[f32; 3]; 9] = [
@@ -85,7 +82,7 @@ impl OverdrawPass {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("overdraw"),
-            source: wgpu::ShaderSource::Wgsl(OVERDRAW_WGSL.into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shaders::OVERDRAW_WGSL.into()),
         });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("overdraw"),
