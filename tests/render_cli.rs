@@ -209,7 +209,7 @@ fn bake_scene_render_end_to_end() {
         assert!(v["work"]["draws"].as_u64().unwrap() > 0, "{v}");
         // The legend's band-0 swatch is black, its band-8 swatch white.
         let img = image::open(&out).unwrap().to_rgba8();
-        let side = forest_render::passes::overdraw::legend_side(64);
+        let side = forest_render::fragments::legend_side(64);
         assert_eq!(img.get_pixel(side / 2, 48 - 2 * side).0, [0, 0, 0, 255]);
         assert_eq!(
             img.get_pixel(8 * side + side / 2, 48 - 2 * side).0,

@@ -237,8 +237,8 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     let shot2 = image::open(shots.join("screenshot-002.png"))
         .unwrap()
         .to_rgba8();
-    let side = forest_render::passes::overdraw::legend_side(320);
-    for (b, c) in forest_render::passes::overdraw::OVERDRAW_COLOURS
+    let side = forest_render::fragments::legend_side(320);
+    for (b, c) in forest_render::fragments::OVERDRAW_COLOURS
         .iter()
         .enumerate()
     {

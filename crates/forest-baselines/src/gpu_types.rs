@@ -24,7 +24,7 @@ pub struct GpuGeoSpecies {
     pub r: f32,
     /// Mean shaded leaf colour (linear RGB) for contrast preservation.
     pub mean_leaf: [f32; 3],
-    /// The hybrid's switch unit ([`forest_render::forms::switch_unit`]).
+    /// The hybrid's switch unit ([`forest_render::extend::switch_unit`]).
     pub switch_unit: f32,
     /// Optical depth per voxel length of the species' opacity-volume code 255 (0: no
     /// self-shadowing; see [`forest_format::opacity`]).

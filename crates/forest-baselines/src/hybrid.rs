@@ -3,7 +3,7 @@
 //! quads are magnified past ε, and the triangle methods lose far away and in frame time.
 //!
 //! Each tree's form is decided on the GPU every frame, in both cull passes, from the camera's
-//! `forms` vector ([`forest_render::forms`]: the share, the band, the screen-door masks).
+//! `forms` vector ([`forest_render::extend`]: the share, the band, the screen-door masks).
 //! [`Hybrid::forms`] turns the parameters into that vector for a camera.
 //!
 //! Composition (see `methods::ForestRenderer`): both forms' compute passes, then one render
@@ -12,7 +12,7 @@
 //! while it is drawn as geometry alone.
 
 use forest_render::camera::Camera;
-use forest_render::forms::{FORMS_GEOMETRY, GEOMETRY_ALWAYS};
+use forest_render::extend::{FORMS_GEOMETRY, GEOMETRY_ALWAYS};
 use forest_render::options::StreamOptions;
 
 use crate::geometry::MeshMethod;
@@ -25,8 +25,8 @@ pub enum Near {
     /// the tolerance the bake measured it at, [`forest_format::atlas::HybridSwitch::tolerance`]):
     /// the distance at which the species' finest quads project to the size its atlas records
     /// ([`forest_format::atlas::HybridSwitch`], measured by `forest bake` against a 4×4
-    /// supersampled reference), else to [`forest_render::forms::DEFAULT_SWITCH_PIXELS`]. It follows
-    /// the tree's size, the viewport and the field of view ([`forest_render::forms::switch_unit`]);
+    /// supersampled reference), else to [`forest_render::DEFAULT_SWITCH_PIXELS`]. It follows
+    /// the tree's size, the viewport and the field of view ([`forest_render::extend::switch_unit`]);
     /// ε does not move it: a coarser ε makes the near trees' quads coarser still, not better (an
     /// ε-scaled switch left the hybrid at ε 8–32 less accurate than the discrete LODs at the
     /// same time). Measured on the five bundled species (400×300, 60°, ε 2) the crossover lies
@@ -131,7 +131,7 @@ pub fn auto_radii(camera: &Camera, levels: u32, pixels: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use forest_render::forms::DEFAULT_SWITCH_PIXELS;
+    use forest_render::DEFAULT_SWITCH_PIXELS;
     use forest_render::options::SHARPEN_MAX;
     use glam::Vec3;
 
@@ -188,7 +188,7 @@ mod tests {
         for (recorded, pixels) in [(None, DEFAULT_SWITCH_PIXELS), (Some(2.25), 2.25)] {
             let m = manifest(5.0, recorded);
             assert_eq!(m.levels, 8);
-            let unit = forest_render::forms::switch_unit(&m);
+            let unit = forest_render::extend::switch_unit(&m);
             // A tree of scale 2: crown radius 10 m, finest quads 20/128 m wide.
             let forms = Hybrid::default().forms(&c);
             let s = forms[0] + forms[1] * unit * 2.0;

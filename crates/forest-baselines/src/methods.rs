@@ -6,7 +6,7 @@
 
 use forest_render::camera::{Camera, CameraError};
 use forest_render::context::{GpuContext, RenderError};
-use forest_render::forms::{FORMS_GEOMETRY, FORMS_QUADS};
+use forest_render::extend::{FORMS_GEOMETRY, FORMS_QUADS};
 use forest_render::options::Background;
 use forest_render::stats::PassTimes;
 use forest_render::stream::QuadStream;
@@ -249,7 +249,7 @@ impl ForestRenderer {
     }
 
     /// Which trees each form draws from the next frame on: `quads` for the stream, `geometry`
-    /// for the geometry renderer ([`forest_render::forms`]).
+    /// for the geometry renderer ([`forest_render::extend::switch_unit`]).
     fn set_forms(&mut self, quads: [f32; 4], geometry: [f32; 4]) {
         self.stream.inputs_mut().set_forms(quads);
         if let Some(g) = &mut self.geometry {

@@ -108,7 +108,7 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
     let mut drawn = layout_check::layout_bindings(0, &draw_entries());
     drawn.extend(layout_check::layout_bindings(
         2,
-        &forest_render::shadow_maps::receiver_entries(),
+        &forest_render::extend::receiver_entries(),
     ));
     layout_check::check_layout(&draw, &drawn, |_| true);
     // The light views' casting pass reads the draw group alone.
@@ -143,7 +143,7 @@ fn bind_group_layouts_and_constants_match_the_wgsl() {
         let want = match entry.as_str() {
             "geo_reset" => RESET_WG,
             "geo_args" => 1,
-            _ => forest_render::capacity::WG,
+            _ => forest_render::extend::WG,
         };
         assert_eq!(size, want, "{entry}");
     }

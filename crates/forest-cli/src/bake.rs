@@ -372,7 +372,7 @@ fn measure_switch(
                 switch_note = Some(format!(
                     "no GPU adapter ({e}): the hybrid switch was not measured, the hybrid \
                      switches where the finest quads project to {} px",
-                    forest_render::forms::DEFAULT_SWITCH_PIXELS
+                    forest_render::DEFAULT_SWITCH_PIXELS
                 ));
             }
         }

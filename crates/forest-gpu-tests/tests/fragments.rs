@@ -68,7 +68,7 @@ fn counted_rectangles(
         "const ALPHA_1: f32 = {alpha_1:?};\nconst DEPTH_1: f32 = {:?};\nconst WRITES_DEPTH: bool = {};\n{}{RECTS_WGSL}",
         depth_1.unwrap_or(0.25),
         depth_1.is_some(),
-        forest_render::passes::COUNT_ON_WGSL
+        forest_render::shaders::COUNT_ON_WGSL
     );
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("counted rectangles"),
@@ -218,7 +218,7 @@ fn srgb(c: [f32; 3]) -> [u8; 3] {
 
 #[test]
 fn the_overdraw_view_shows_each_pixels_band() {
-    use forest_render::passes::overdraw::{OVERDRAW_COLOURS, OverdrawPass, band, legend_side};
+    use forest_render::fragments::{OVERDRAW_COLOURS, OverdrawPass, band, legend_side};
     let ctx = common::ctx();
     let (counter, counts) = counted_rectangles(&ctx, 2, 0.5, None);
     let view = OverdrawPass::new(&ctx.device, TARGET_FORMAT);

@@ -12,7 +12,7 @@ use forest_baselines::methods::{ForestRenderer, Method};
 use forest_format::atlas::HybridSwitch;
 use forest_format::forest::Forest;
 use forest_render::ForestView;
-use forest_render::forms as hybrid;
+use forest_render::extend as hybrid;
 use forest_render::options::{Atmosphere, Background, StreamOptions};
 use forest_render::target::Target;
 use forest_render::{Camera, GpuContext, SpeciesData, reference};

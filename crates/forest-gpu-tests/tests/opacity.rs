@@ -92,7 +92,7 @@ fn the_gpu_march_matches_the_cpu_mirror() {
             volumes[k].max_depth,
         ]);
     }
-    let (texture, _) = forest_render::opacity::opacity_texture(
+    let (texture, _) = forest_render::extend::opacity_texture(
         &ctx.device,
         &ctx.queue,
         &[&volumes[0], &volumes[1]],
@@ -110,7 +110,7 @@ fn the_gpu_march_matches_the_cpu_mirror() {
         .collect();
     let src = format!(
         "{}\n{}",
-        forest_render::passes::COMMON_WGSL,
+        forest_render::shaders::COMMON_WGSL,
         r#"
 // Declared for common.wgsl's shading, unused here (so not in the derived layout).
 @group(0) @binding(0) var<uniform> camera: Camera;

@@ -495,7 +495,7 @@ fn a_hosts_reverse_z_shadow_map_gives_the_forests_own_shadows() {
             array_layer_count: Some(1),
             ..Default::default()
         });
-        let mut pass = forest_render::shadow_maps::depth_pass(&mut encoder, &layer, 0.0, None);
+        let mut pass = forest_render::extend::depth_pass(&mut encoder, &layer, 0.0, None);
         caster.render_depth(&mut pass);
     }
     ctx.queue.submit([encoder.finish()]);

@@ -224,7 +224,7 @@ pub fn describe(m: &forest_format::AtlasManifest) -> String {
         Some(h) => describe_switch(h),
         None => format!(
             "finest quads {} px (not measured: the default)",
-            forest_render::forms::DEFAULT_SWITCH_PIXELS
+            forest_render::DEFAULT_SWITCH_PIXELS
         ),
     }
 }

@@ -129,7 +129,7 @@ pub fn upload(
 }
 
 /// [`upload`] of several cameras in one write, one after another from offset 0 (a view's
-/// camera and its light views', see [`crate::shadow_maps`]).
+/// camera and its light views', see `shadow_maps.rs`).
 pub fn upload_all(
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,

@@ -47,7 +47,7 @@ pub struct Capacity {
 
 impl Capacity {
     /// `Q = min(N · quads_per_tree, W · H / 4) + overdraw · W · H / (ε_min / 2)²`, at most
-    /// and at least `grown`, at most [`MAX_QUADS`], unless given.
+    /// and at least `grown`, at most [`crate::MAX_QUADS`], unless given.
     ///
     /// The second term holds the quads refinement adds: each refined quad is at least `ε/2`
     /// pixels on a side, so a screen covered `overdraw` times holds at most that many. The

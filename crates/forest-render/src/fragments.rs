@@ -8,6 +8,11 @@
 //! [`Phase::Hidden`] counts the shown fragments behind that front. The ground and sky are not
 //! counted.
 
+/// The overdraw view: the counts as a heat map with a legend (`passes/overdraw.rs`).
+pub use crate::passes::overdraw::{
+    LABELLED_SIDE, OVERDRAW_COLOURS, OverdrawBinding, OverdrawParams, OverdrawPass, band,
+    band_floor, legend_side,
+};
 use crate::{GpuContext, RenderError};
 
 /// Counters per pixel (see `shaders/count_on.wgsl`).

@@ -283,7 +283,7 @@ pub struct SceneConsts {
 
 /// The environment (160 bytes), written once: what `shaders/environment.wgsl` draws behind the
 /// trees (sky, ground, terrain) and the haze every method applies (see
-/// [`crate::options::Atmosphere`] and [`crate::terrain`]).
+/// [`crate::options::Atmosphere`] and the terrain, `terrain.rs`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuEnvironment {

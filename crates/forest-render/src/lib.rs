@@ -45,35 +45,46 @@
 
 #![deny(missing_docs)]
 
-pub mod bindings;
+// The public modules are what a host uses; `extend` is what a crate adding a drawing form
+// builds on. The rest (GPU resources, passes, receivers) is private.
+mod bindings;
 pub mod camera;
-pub mod capacity;
+mod capacity;
 pub mod context;
 pub mod error;
-pub mod forms;
+pub mod extend;
+mod forms;
 pub mod fragments;
 pub mod frame;
 pub mod gpu_types;
 pub mod load;
-pub mod opacity;
+mod opacity;
 pub mod options;
-pub mod passes;
-pub mod receivers;
+mod passes;
+mod receivers;
 pub mod reference;
 pub mod scene;
 pub mod shaders;
 pub mod shadow;
-pub mod shadow_maps;
+mod shadow_maps;
 pub mod stats;
 pub mod stream;
 mod stream_buffers;
 pub mod target;
-pub mod terrain;
+mod terrain;
 pub mod view;
 pub mod work;
 
+// The crate's own tests name it as its users do.
+#[cfg(test)]
+extern crate self as forest_render;
+#[cfg(test)]
+mod layout_tests;
+
 pub use camera::Camera;
+pub use capacity::{Capacity, CapacityInput, MAX_QUADS};
 pub use context::{ColourFormat, GpuContext, RenderError};
+pub use forms::DEFAULT_SWITCH_PIXELS;
 pub use frame::{FrameParams, Targets};
 pub use load::{load_scene, named_view, start_view};
 pub use options::{Background, DebugView, RendererOptions, StreamOptions};

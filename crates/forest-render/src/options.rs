@@ -2,6 +2,9 @@
 //! run-time choices (background, debug views, aspect blending) that travel in the camera
 //! uniform.
 
+/// The draw's thresholds: the coverage from which a quad fragment writes depth, and the
+/// opaque share from which a node's quad is drawn in the opaque pass.
+pub use crate::passes::draw::{DEPTH_WRITE_ALPHA, OPAQUE_SHARE_MIN};
 use forest_format::shading::Lighting;
 
 use crate::gpu_types::WEIGHT_ONE;
@@ -103,7 +106,7 @@ pub enum DebugView {
     /// The textured quads with their outlines drawn over them.
     Wireframe,
     /// A heat map of the tree fragments shaded per pixel, for every method: the host counts
-    /// the frame ([`crate::fragments`]) and draws [`crate::passes::overdraw`] over it; the
+    /// the frame ([`crate::fragments`]) and draws [`crate::fragments::OverdrawPass`] over it; the
     /// stream itself draws as [`DebugView::Off`].
     Overdraw,
 }

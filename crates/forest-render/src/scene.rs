@@ -277,7 +277,7 @@ pub struct GpuScene {
     /// Surface layers of all species, the same layout as `colour` (premultiplied octahedral
     /// normal, sky visibility, translucency; linear).
     pub surface: wgpu::Texture,
-    /// Opacity volumes of all species, stacked ([`crate::opacity`]).
+    /// Opacity volumes of all species, stacked ([`crate::extend::opacity_texture`]).
     pub opacity: wgpu::Texture,
     /// Node texture (`Rgba32Uint`, [`NODE_TEXTURE_WIDTH`] wide): the node's two words, its
     /// covered box and its opaque share ([`forest_format::trim::node_trims`]).

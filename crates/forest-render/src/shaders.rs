@@ -34,7 +34,7 @@ pub const REFINE_WGSL: &str = include_str!("../shaders/refine.wgsl");
 /// Pass 3, draw (the environment, then the stream's quads).
 pub const DRAW_WGSL: &str = include_str!("../shaders/draw.wgsl");
 /// The sun's shadow lookups against the cascades' maps, bound as group 2 (see
-/// [`crate::shadow_maps`]): `sun_shadow(world, normal)` and `tree_shadow(point, sphere)`.
+/// [`crate::shadow`]): `sun_shadow(world, normal)` and `tree_shadow(point, sphere)`.
 pub const SHADOW_ON_WGSL: &str = include_str!("../shaders/shadow_on.wgsl");
 /// The same lookups for a module drawn without shadow maps: every point lit.
 pub const SHADOW_OFF_WGSL: &str = include_str!("../shaders/shadow_off.wgsl");

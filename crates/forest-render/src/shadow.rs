@@ -9,7 +9,7 @@
 //! camera therefore moves every cascade by whole texels and never rescales it: the shadows do not
 //! swim.
 //!
-//! No wgpu here: [`crate::shadow_maps`] owns the maps and their passes.
+//! No wgpu here: `shadow_maps.rs` owns the maps and their passes.
 
 use glam::{Mat4, Vec3, Vec4};
 

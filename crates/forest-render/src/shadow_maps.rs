@@ -13,9 +13,6 @@ use crate::context::RenderError;
 use crate::gpu_types::GpuCamera;
 use crate::options::RendererOptions;
 use crate::passes::cast::CastPass;
-pub use crate::receivers::{
-    HostShadows, no_shadows, receiver_entries, receiver_layout, receivers_of,
-};
 use crate::receivers::{depth_array, receiver_group};
 use crate::shadow::ShadowOptions;
 use crate::stats::FrameStats;
@@ -47,7 +44,7 @@ pub struct ShadowTargets {
 
 impl ShadowTargets {
     /// The maps of `opts` (checked, and against the device, before anything is allocated),
-    /// read through `layout` (the receivers' layout, [`receiver_layout`]), for receivers in
+    /// read through `layout` (the receivers' layout, [`crate::receivers::receiver_layout`]), for receivers in
     /// `band` (every renderer casting into the maps fits its cascades to it).
     pub fn new(
         device: &wgpu::Device,

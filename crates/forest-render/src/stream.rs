@@ -331,7 +331,7 @@ impl QuadStream {
     /// Grow the stream after a frame that overflowed it (`stats`: that frame's counters), so
     /// that later frames of such views fit: to the frame's estimated need plus an eighth
     /// (its quads, the level-0 quads dropped, three per quad left unrefined), and at least
-    /// 1.5× the capacity, within [`crate::capacity::MAX_QUADS`] and the device's limits.
+    /// 1.5× the capacity, within [`crate::MAX_QUADS`] and the device's limits.
     /// Nothing happens when the frame fit or the options fix the capacity
     /// ([`RendererOptions::max_quads`]). Returns whether the buffers were rebuilt; the
     /// overflowed frame itself is not redrawn. The stream never shrinks.
@@ -657,7 +657,7 @@ impl crate::view::Form for QuadStream {
     }
 
     /// The compute passes of a frame: the sun's shadow maps when shadows are on (each
-    /// cascade's cull, refine and casting pass, [`crate::shadow_maps::ShadowMaps::encode`]),
+    /// cascade's cull, refine and casting pass, `ShadowMaps::encode`),
     /// then the view's cull and refine.
     fn encode_compute(&self, encoder: &mut wgpu::CommandEncoder) {
         self.encode_shadows(encoder, true, None);

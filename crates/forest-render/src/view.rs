@@ -46,7 +46,7 @@ pub struct FrameInputs {
 
 impl FrameInputs {
     /// The inputs of a form whose camera uniform is `camera`, drawing the trees `forms` selects
-    /// ([`crate::forms`]) with the light, background and depth convention of `opts`; its draw
+    /// ([`crate::extend::quad_share`]) with the light, background and depth convention of `opts`; its draw
     /// reads shadow receivers through `shadow_layout` ([`crate::receivers::receiver_layout`]).
     pub fn new(
         device: &wgpu::Device,
@@ -81,7 +81,7 @@ impl FrameInputs {
         self.light
     }
 
-    /// Which trees the form draws ([`crate::forms`]).
+    /// Which trees the form draws ([`crate::extend::quad_share`]).
     pub fn forms(&self) -> [f32; 4] {
         self.forms
     }
@@ -174,7 +174,7 @@ impl FrameInputs {
         self.prepared = true;
     }
 
-    /// Draw the trees `forms` selects from the next frame on ([`crate::forms`]; a hybrid
+    /// Draw the trees `forms` selects from the next frame on ([`crate::extend::quad_share`]; a hybrid
     /// method sets each form's share).
     pub fn set_forms(&mut self, forms: [f32; 4]) {
         self.forms = forms;

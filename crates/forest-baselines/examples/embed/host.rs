@@ -362,8 +362,7 @@ impl Host {
             };
             sun.caster.prepare_light(device, queue, &light)?;
             sun.caster.encode_compute(&mut encoder);
-            let mut pass =
-                forest_render::shadow_maps::depth_pass(&mut encoder, &sun.layer, 0.0, None);
+            let mut pass = forest_render::extend::depth_pass(&mut encoder, &sun.layer, 0.0, None);
             // The host's own casters would draw here too.
             sun.caster.render_depth(&mut pass);
             drop(pass);

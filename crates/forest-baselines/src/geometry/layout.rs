@@ -1,7 +1,7 @@
 //! The geometry renderer's bind-group layouts, as data (a test checks them against naga's
 //! reflection of `shaders/geometry*.wgsl`).
 
-use forest_render::passes::Slot;
+use forest_render::extend::Slot;
 
 /// The compute group shared by the four cull entry points (`shaders/geometry.wgsl`).
 pub const COMPUTE_SLOTS: [Slot; 11] = [
@@ -20,7 +20,7 @@ pub const COMPUTE_SLOTS: [Slot; 11] = [
 
 /// Layout entries of the compute group.
 pub fn compute_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    forest_render::passes::layout_entries(&COMPUTE_SLOTS, wgpu::ShaderStages::COMPUTE)
+    forest_render::extend::layout_entries(&COMPUTE_SLOTS, wgpu::ShaderStages::COMPUTE)
 }
 
 /// Layout entries of the draw group (bindings as in `shaders/geometry_draw.wgsl`).
@@ -70,9 +70,9 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         buffer(10, S::VERTEX_FRAGMENT, uniform),
         buffer(11, S::VERTEX, read),
         texture(12),
-        forest_render::terrain::heights_entry(),
+        forest_render::extend::heights_entry(),
         // The species' opacity volumes and their clamping sampler.
-        forest_render::opacity::opacity_entry(14),
+        forest_render::extend::opacity_entry(14),
         wgpu::BindGroupLayoutEntry {
             binding: 15,
             visibility: S::VERTEX_FRAGMENT,

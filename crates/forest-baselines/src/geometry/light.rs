@@ -6,8 +6,8 @@
 
 use std::sync::Arc;
 
-use forest_render::passes::cast::cast_pipeline;
-use forest_render::shadow_maps::ShadowTargets;
+use forest_render::extend::ShadowTargets;
+use forest_render::extend::cast_pipeline;
 
 use super::views::{Shared, View};
 

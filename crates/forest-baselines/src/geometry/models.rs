@@ -4,11 +4,11 @@
 
 use forest_format::forest::Forest;
 use forest_format::model::{BANDS, BILLBOARD_RESOLUTION};
-use forest_render::capacity::GeometryCapacity;
 use forest_render::context::{GpuContext, RenderError};
 use forest_render::error::{storage_limit, within_limit};
+use forest_render::extend::GeometryCapacity;
+use forest_render::extend::GpuTerrain;
 use forest_render::shadow::ReceiverBand;
-use forest_render::terrain::GpuTerrain;
 use wgpu::util::DeviceExt;
 
 use super::params::SpeciesFigures;
@@ -133,7 +133,7 @@ pub fn check_limits(
     for (what, needed, hint) in layers {
         within_limit(|| what.into(), needed as u64, limit, hint)?;
     }
-    forest_render::opacity::check_volumes(limits, prepared.opacity.len())
+    forest_render::extend::check_volumes(limits, prepared.opacity.len())
 }
 
 impl GpuModels {
@@ -238,7 +238,7 @@ impl GpuModels {
             billboard_surface,
             true,
         );
-        let (opacity_texture, opacity_bytes) = forest_render::opacity::opacity_texture(
+        let (opacity_texture, opacity_bytes) = forest_render::extend::opacity_texture(
             device,
             &ctx.queue,
             &opacity.iter().collect::<Vec<_>>(),

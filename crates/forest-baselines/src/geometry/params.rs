@@ -12,7 +12,7 @@ use crate::gpu_types::GpuMethod;
 pub struct GeometrySpecies {
     /// Its prepared model (the bake's, [`forest_format::model::PreparedModel`]).
     pub model: std::sync::Arc<PreparedModel>,
-    /// The hybrid's switch unit of its atlas ([`forest_render::forms::switch_unit`]), so that
+    /// The hybrid's switch unit of its atlas ([`forest_render::extend::switch_unit`]), so that
     /// both forms agree where each tree switches (any value when the hybrid is not used).
     pub switch_unit: f32,
     /// Where the hybrid draws its near trees in mesh LOD 1 and LOD 2 instead of the full
@@ -30,7 +30,7 @@ impl GeometrySpecies {
     ) -> Self {
         Self {
             model,
-            switch_unit: forest_render::forms::switch_unit(manifest),
+            switch_unit: forest_render::extend::switch_unit(manifest),
             lod_from: manifest
                 .hybrid_switch
                 .map_or([0.0; 2], |h| h.lod_from.map(|f| f.unwrap_or(0.0))),

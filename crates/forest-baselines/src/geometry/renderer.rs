@@ -5,11 +5,11 @@
 use forest_format::forest::Forest;
 use forest_format::model::BANDS;
 use forest_render::context::{GpuContext, RenderError};
+use forest_render::extend::draw_pipeline;
+use forest_render::extend::{Caster, ShadowTargets};
 use forest_render::gpu_types::GpuCamera;
 use forest_render::options::RendererOptions;
 use forest_render::options::{Atmosphere, Background};
-use forest_render::passes::draw::draw_pipeline;
-use forest_render::shadow_maps::{Caster, ShadowTargets};
 use forest_render::stats::PassTimes;
 use forest_render::work::{self, FrameWork, StatisticsQueries};
 use forest_render::{Form, FrameInputs};
@@ -141,7 +141,7 @@ impl GeometryRenderer {
             label: Some("geometry draw"),
             entries: &draw_entries(),
         });
-        let shadow_layout = forest_render::shadow_maps::receiver_layout(device);
+        let shadow_layout = forest_render::extend::receiver_layout(device);
         let draw_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("geometry draw"),
             bind_group_layouts: &[Some(&draw_layout), None, Some(&shadow_layout)],
@@ -172,7 +172,7 @@ impl GeometryRenderer {
             render_pipeline("vs_terrain", "fs_terrain", T::TriangleList, &draw_pl);
         let environment_buf = init(
             "geometry environment",
-            bytemuck::bytes_of(&forest_render::terrain::environment_uniform(
+            bytemuck::bytes_of(&forest_render::extend::environment_uniform(
                 &opts.atmosphere,
                 &models.terrain.grid,
             )),
@@ -212,7 +212,7 @@ impl GeometryRenderer {
             device,
             view.camera,
             shadow_layout.clone(),
-            forest_render::forms::FORMS_GEOMETRY,
+            forest_render::extend::FORMS_GEOMETRY,
             opts,
         );
         Ok(Self {
@@ -314,7 +314,7 @@ impl GeometryRenderer {
 
     /// Cast into and read `targets`, maps another renderer made (the quad stream's, so that
     /// the hybrid's two forms share them), or stop (`None`). Only the quad stream's passes
-    /// then draw into them: see [`forest_render::shadow_maps::Caster`].
+    /// then draw into them: see [`forest_render::extend::Caster`].
     pub fn share_shadows(
         &mut self,
         device: &wgpu::Device,
@@ -397,7 +397,7 @@ impl GeometryRenderer {
             self.shared
                 .models
                 .instance_count
-                .div_ceil(forest_render::capacity::WG)
+                .div_ceil(forest_render::extend::WG)
                 .max(1),
             1,
             1,
@@ -409,7 +409,7 @@ impl GeometryRenderer {
             self.shared
                 .models
                 .instance_count
-                .div_ceil(forest_render::capacity::WG)
+                .div_ceil(forest_render::extend::WG)
                 .max(1),
             1,
             1,
@@ -520,7 +520,7 @@ impl GeometryRenderer {
     }
 }
 
-impl forest_render::shadow_maps::Caster for GeometryRenderer {
+impl forest_render::extend::Caster for GeometryRenderer {
     /// Copy cascade `k`'s light camera into its light view and classify its trees.
     fn encode_light(&self, encoder: &mut wgpu::CommandEncoder, k: usize) {
         let Some(lv) = &self.shadows else { return };

@@ -69,7 +69,7 @@ impl Shared {
         let compute_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(label),
             layout: &self.compute_layout,
-            entries: &forest_render::passes::numbered(vec![
+            entries: &forest_render::extend::numbered(vec![
                 camera.as_entire_binding(),
                 m.instances.as_entire_binding(),
                 m.species.as_entire_binding(),
@@ -101,7 +101,7 @@ impl Shared {
             (11, m.leaf_centre.as_entire_binding()),
             (12, wgpu::BindingResource::TextureView(&m.billboard_view)),
             (
-                forest_render::terrain::HEIGHTS_BINDING,
+                forest_render::extend::HEIGHTS_BINDING,
                 m.terrain.heights.as_entire_binding(),
             ),
             (14, wgpu::BindingResource::TextureView(&m.opacity_view)),

@@ -243,16 +243,15 @@ fn resolution_rows(
         let (s, t) = b.measure(&mut r, Method::Quads, cam, target, b.frames)?;
         most = most.max(s.primitives);
         let m = forest_metrics::compare(reference, &target.read(&b.ctx))?;
-        let suggested =
-            forest_render::capacity::Capacity::new(&forest_render::capacity::CapacityInput {
-                instances: forest.instances.len() as u32,
-                quads_per_tree: 6,
-                viewport,
-                min_epsilon: epsilon,
-                overdraw: 16.0,
-                max_quads: Some((most as f64 * 1.25).ceil() as u32),
-                grown: 0,
-            });
+        let suggested = forest_render::Capacity::new(&forest_render::CapacityInput {
+            instances: forest.instances.len() as u32,
+            quads_per_tree: 6,
+            viewport,
+            min_epsilon: epsilon,
+            overdraw: 16.0,
+            max_quads: Some((most as f64 * 1.25).ceil() as u32),
+            grown: 0,
+        });
         let levels = species[0].atlas.manifest.nodes_per_level.len();
         println!(
             "budget: {res} px, {levels} levels, {below} directions below: {disk} B disk, \

@@ -31,7 +31,7 @@ use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
 use forest_format::camera_path::CameraPath;
 use forest_render::context::GpuContext;
 use forest_render::options::DebugView;
-use forest_render::passes::draw::DEPTH_FORMAT;
+use forest_render::target::DEPTH_FORMAT;
 use forest_render::{Camera, QuadStream};
 use glam::Vec3;
 use winit::application::ApplicationHandler;
@@ -86,8 +86,8 @@ struct Gfx {
 /// What the overdraw view draws with.
 struct Overdraw {
     counter: forest_render::fragments::FragmentCounter,
-    pass: forest_render::passes::overdraw::OverdrawPass,
-    binding: forest_render::passes::overdraw::OverdrawBinding,
+    pass: forest_render::fragments::OverdrawPass,
+    binding: forest_render::fragments::OverdrawBinding,
 }
 
 /// What a viewer starts with.
@@ -496,8 +496,7 @@ fn overdraw(g: &mut Gfx) -> Result<()> {
             g.config.height,
             g.renderer.stream.options_built().reverse_z,
         )?;
-        let pass =
-            forest_render::passes::overdraw::OverdrawPass::new(&g.ctx.device, g.config.format);
+        let pass = forest_render::fragments::OverdrawPass::new(&g.ctx.device, g.config.format);
         let binding = pass.bind(&g.ctx.device, &counter, true);
         g.renderer
             .set_fragment_counter(&g.ctx.device, Some(&counter));

@@ -6,7 +6,7 @@ use super::draw::bind_entries;
 pub use crate::receivers::SHADOW_FORMAT;
 
 /// A casting pipeline: `entries` (vertex, fragment) of `module` drawing depth only into a
-/// shadow map ([`SHADOW_FORMAT`], nearest wins), no face culling. The quad stream's and the
+/// shadow map ([`crate::extend::SHADOW_FORMAT`], nearest wins), no face culling. The quad stream's and the
 /// geometry renderer's casting pipelines are all built here.
 pub fn cast_pipeline(
     device: &wgpu::Device,

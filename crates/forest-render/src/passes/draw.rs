@@ -2,7 +2,6 @@
 //! an indirect, instanced triangle strip per quad, blended back to front.
 
 pub use crate::bindings::vertex_storage_entry;
-pub use crate::target::DEPTH_FORMAT;
 
 use super::{args, draw_source};
 

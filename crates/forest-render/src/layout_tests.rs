@@ -5,6 +5,7 @@ use std::mem::{offset_of, size_of};
 use forest_render::gpu_types::*;
 use forest_render::passes::{compute_source, draw_source};
 
+#[path = "../tests/layout_check/mod.rs"]
 mod layout_check;
 use layout_check::{check, shared, state_members};
 
@@ -143,7 +144,7 @@ fn bind_group_layouts_match_the_wgsl() {
     let mut draw = layout_check::layout_bindings(0, &bind_entries());
     draw.extend(layout_check::layout_bindings(
         2,
-        &forest_render::shadow_maps::receiver_entries(),
+        &forest_render::extend::receiver_entries(),
     ));
     layout_check::check_layout(&draw_source(), &draw, |_| true);
     // The light views' casting pass reads group 0 alone.
@@ -208,12 +209,12 @@ fn constants_shared_with_the_wgsl_agree() {
     }
     assert_eq!(
         layout_check::wgsl_const(&d, "DEPTH_WRITE_ALPHA"),
-        f64::from(forest_render::passes::draw::DEPTH_WRITE_ALPHA),
+        f64::from(forest_render::options::DEPTH_WRITE_ALPHA),
         "DEPTH_WRITE_ALPHA"
     );
     assert_eq!(
         layout_check::wgsl_const(&d, "OPAQUE_SHARE_MIN"),
-        f64::from(forest_render::passes::draw::OPAQUE_SHARE_MIN),
+        f64::from(forest_render::options::OPAQUE_SHARE_MIN),
         "OPAQUE_SHARE_MIN"
     );
     for (name, view) in [
