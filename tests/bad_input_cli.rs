@@ -314,6 +314,20 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
             &[&format!("'{span}'"), "--far-span", "1..=64"],
         );
     }
+    // Every numeric option takes a leading minus, so that its own parser names the value
+    // and the option (not "unexpected argument").
+    for (option, value) in [
+        ("--far-span", "-1"),
+        ("--sharpen-reach", "-2"),
+        ("--sharpen", "-0.1"),
+        ("--shadow-resolution", "-1"),
+        ("--shadow-cascades", "-1"),
+    ] {
+        let mut a = render("1,2,3");
+        a.extend(["--shadows", "on", option, value].map(String::from));
+        let e = refused(&strs(&a), d, &[&format!("'{value}'"), option]);
+        assert!(!e.contains("unexpected argument"), "{e}");
+    }
     // Shadow options out of range.
     for (option, value, cause) in [
         (
@@ -325,9 +339,11 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
         ("--shadow-distance", "-5", "shadow distance -5"),
         ("--shadow-epsilon", "0", "shadow epsilon 0"),
     ] {
-        let mut a = render("1,2,3");
-        a.extend(["--shadows", "on", option, value].map(String::from));
-        refused(&strs(&a), d, &[cause]);
+        for shadows in ["on", "off"] {
+            let mut a = render("1,2,3");
+            a.extend(["--shadows", shadows, option, value].map(String::from));
+            refused(&strs(&a), d, &[cause]);
+        }
     }
     // Options whose values may start with a hyphen reach their own check.
     let f = &forest_file;
@@ -354,4 +370,50 @@ fn cameras_and_numbers_are_named_for_what_is_wrong() {
             &[cause],
         );
     }
+}
+
+/// The bench refuses results that would land inside its inputs, and a frame count of 0,
+/// before any work.
+#[test]
+fn bench_results_stay_out_of_their_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    bush_forest(d, false);
+    let atlas = d.join("bush.atlas").display().to_string();
+    let inside = d.join("bush.atlas").join("results").display().to_string();
+    refused(
+        &["bench", "storage", "--species", &atlas, "--out", &inside],
+        d,
+        &["--out results folder", "bush.atlas"],
+    );
+    refused(
+        &["bench", "table1", "--species", &atlas, "--frames", "0"],
+        d,
+        &["--frames 0"],
+    );
+}
+
+/// Fragment counters too large for the device are refused before any frame is drawn.
+#[test]
+fn counters_too_large_are_refused_before_drawing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (_, forest_file) = bush_forest(d, false);
+    let png = d.join("x.png").display().to_string();
+    refused(
+        &[
+            "render",
+            &forest_file,
+            "-o",
+            &png,
+            "--view",
+            "birds-eye",
+            "--size",
+            "8192x8192",
+            "--debug-view",
+            "overdraw",
+        ],
+        d,
+        &["fragment counts of a 8192×8192 target", "smaller size"],
+    );
 }

@@ -3,18 +3,29 @@
 
 mod cli;
 
+use std::path::{Path, PathBuf};
+
 use cli::{bake_small, forest, model};
 
 #[test]
 fn quick_benchmarks_write_every_table_chart_and_the_report() {
     let dir = tempfile::tempdir().unwrap();
+    let results = run_quick_benchmarks(dir.path());
+    every_table_has_its_columns(&results);
+    every_method_is_in_the_tables(&results);
+    the_work_columns_count_alike(&results);
+    the_walkthroughs_charts_and_report(&results);
+}
+
+/// `forest bench all --quick` on two species baked small into `d`; its results folder.
+fn run_quick_benchmarks(d: &Path) -> PathBuf {
     let mut atlases = Vec::new();
     for s in ["bush", "pine"] {
-        let atlas = dir.path().join(format!("{s}.atlas"));
+        let atlas = d.join(format!("{s}.atlas"));
         bake_small(s, &atlas, 32, 5);
         atlases.push(atlas.display().to_string());
     }
-    let results = dir.path().join("results");
+    let results = d.join("results");
     let out = forest(&[
         "bench",
         "all",
@@ -31,14 +42,22 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let header = |f: &str| {
-        std::fs::read_to_string(results.join(f))
-            .unwrap_or_else(|e| panic!("{f}: {e}"))
-            .lines()
-            .next()
-            .unwrap()
-            .to_string()
-    };
+    results
+}
+
+/// A table's header line.
+fn header(results: &Path, f: &str) -> String {
+    std::fs::read_to_string(results.join(f))
+        .unwrap_or_else(|e| panic!("{f}: {e}"))
+        .lines()
+        .next()
+        .unwrap()
+        .to_string()
+}
+
+/// Every table's stable columns, the walk at real tree sizes and the fidelity variants.
+fn every_table_has_its_columns(results: &Path) {
+    let header = |f: &str| header(results, f);
     assert!(
         header("table1.csv")
             .starts_with("trees,view,visible_trees,quads,cull_ms,refine_ms,draw_ms,total_ms")
@@ -84,7 +103,10 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
         assert!(results.join(format!("{c}.png")).is_file(), "{c}.png");
         assert!(results.join(format!("{c}.svg")).is_file(), "{c}.svg");
     }
-    // Every method appears in the accuracy and stability tables.
+}
+
+/// Every method appears in the accuracy and stability tables.
+fn every_method_is_in_the_tables(results: &Path) {
     let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
     let stability = std::fs::read_to_string(results.join("stability.csv")).unwrap();
     for m in [
@@ -104,9 +126,11 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
             "{m}"
         );
     }
-    // The work columns, appended to Table 1, the path and the accuracy tables, with counts
-    // wherever the adapter has pipeline statistics, and the exact fragment counts of every
-    // row; the work-against-accuracy charts.
+}
+
+/// The work columns, appended to Table 1, the path and the accuracy tables, with counts
+/// wherever the adapter has pipeline statistics, and the exact fragment counts of every row.
+fn the_work_columns_count_alike(results: &Path) {
     let work = "dispatches,draws,vertex_invocations,primitives_rasterised,fragment_invocations,\
                 compute_invocations,gpu_mb,covered_pixels,fragments_per_covered_pixel,work_source,\
                 exact_fragments_per_covered_pixel,exact_median,exact_p95,\
@@ -160,6 +184,12 @@ fn quick_benchmarks_write_every_table_chart_and_the_report() {
             })
             .collect();
     assert_eq!(sources.len(), 1, "{sources:?}");
+}
+
+/// The work-against-accuracy charts, the walkthroughs, the budget, and the report's charts;
+/// no scratch bake is left behind.
+fn the_walkthroughs_charts_and_report(results: &Path) {
+    let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
     assert!(results.join("accuracy_work_walkthrough.png").is_file());
     // The walkthrough of random eye-height cameras, and the hybrid's switch choices.
     assert!(accuracy.lines().any(|l| l.contains(",walkthrough,")));

@@ -8,6 +8,18 @@ use cli::{bake_small, forest, model, ok, one_line_error as err};
 fn bake_scene_render_end_to_end() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
+    bake_scene_and_render_named_views(d);
+    a_json_forest_renders(d);
+    the_hybrid_draws_stored_and_obj_models_alike(d);
+    no_method_draws_the_hybrid(d);
+    an_atlas_without_its_model(d);
+    fragment_counts_and_the_overdraw_view(d);
+    view_plays_a_path_back(d);
+    bad_inputs_are_refused(d);
+}
+
+/// Bake two species, make a forest of them, and render two named views of it.
+fn bake_scene_and_render_named_views(d: &std::path::Path) {
     let p = |n: &str| d.join(n).display().to_string();
     for s in ["bush", "aspen"] {
         bake_small(s, &d.join(format!("{s}.atlas")), 64, 5);
@@ -51,7 +63,12 @@ fn bake_scene_render_end_to_end() {
         let img = image::open(d.join(format!("shot-{name}.png"))).unwrap();
         assert_eq!((img.width(), img.height()), (96, 72));
     }
-    // A JSON forest written by `forest scene` renders the same way.
+}
+
+/// A JSON forest written by `forest scene` renders the same way.
+fn a_json_forest_renders(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
+    let species = format!("{},{}", p("bush.atlas"), p("aspen.atlas"));
     ok(&forest(&[
         "scene",
         "--model-sizes",
@@ -75,8 +92,12 @@ fn bake_scene_render_end_to_end() {
         "64x48",
     ]));
     assert!(d.join("small.png").is_file());
-    // The hybrid: near trees as geometry (a fixed switch distance), the rest as quads; drawn
-    // from the models the bake stored in the atlases, and from the OBJ files, alike.
+}
+
+/// The hybrid: near trees as geometry (a fixed switch distance), the rest as quads; drawn
+/// from the models the bake stored in the atlases, and from the OBJ files, alike.
+fn the_hybrid_draws_stored_and_obj_models_alike(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
     let hybrid = |out: &str, models: &[&str]| {
         let mut a = vec![
             "render",
@@ -112,7 +133,11 @@ fn bake_scene_render_end_to_end() {
     let stored = image::open(d.join("hybrid.png")).unwrap().to_rgba8();
     let from_obj = image::open(d.join("hybrid-obj.png")).unwrap().to_rgba8();
     assert_eq!(stored, from_obj, "the stored models are the OBJs prepared");
-    // Without --method: the hybrid at its defaults, the same image as asked for by name.
+}
+
+/// Without --method: the hybrid at its defaults, the same image as asked for by name.
+fn no_method_draws_the_hybrid(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
     let small = p("small.json");
     let view = |out: &str, method: &[&str]| {
         let mut a = vec![
@@ -132,7 +157,10 @@ fn bake_scene_render_end_to_end() {
     ok(&view(&p("quads.png"), &["--method", "quads"]));
     let quads = image::open(d.join("quads.png")).unwrap().to_rgba8();
     assert_ne!(default, quads, "the near trees are drawn as their models");
-    // Without model.bin (an atlas baked with --no-model), the message says what to do.
+}
+
+/// Without model.bin (an atlas baked with --no-model), the message says what to do.
+fn an_atlas_without_its_model(d: &std::path::Path) {
     let bare = d.join("bare");
     std::fs::create_dir_all(bare.join("bush.atlas")).unwrap();
     for e in std::fs::read_dir(d.join("bush.atlas")).unwrap() {
@@ -176,7 +204,11 @@ fn bake_scene_render_end_to_end() {
     let v: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
     assert!(v["quads"].as_u64().unwrap() > 0, "{v}");
     assert!(bare.join("x.png").is_file());
-    // Exact fragment counts and the overdraw view, for a quad method and a geometry one.
+}
+
+/// Exact fragment counts and the overdraw view, for a quad method and a geometry one.
+fn fragment_counts_and_the_overdraw_view(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
     for method in ["quads", "lods"] {
         let out = p(&format!("overdraw-{method}.png"));
         let text = ok(&forest(&[
@@ -241,8 +273,11 @@ fn bake_scene_render_end_to_end() {
         "--near=-3",
     ]));
     assert!(e.contains("auto or a distance"), "{e}");
+}
 
-    // `forest view` plays a camera path back headless, one PNG per key, with any method.
+/// `forest view` plays a camera path back headless, one PNG per key, with any method.
+fn view_plays_a_path_back(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
     let walk = d.join("walk.json");
     let mut path = forest_format::camera_path::CameraPath::new(60.0);
     for i in 0..3 {
@@ -252,20 +287,24 @@ fn bake_scene_render_end_to_end() {
     path.save(&walk).unwrap();
     let frames = d.join("frames");
     std::fs::create_dir(&frames).unwrap();
-    for method in ["quads", "lods"] {
-        let text = ok(&forest(&[
+    // `forest view` of the forest along the walk into the frames folder, with `extra`.
+    let forest_file = p("f.forest");
+    let view_frames = |extra: &[&str]| {
+        let mut a = vec![
             "view",
-            &p("f.forest"),
+            &forest_file,
             "--path",
             walk.to_str().unwrap(),
             "--frames",
             frames.to_str().unwrap(),
-            "--size",
-            "64x48",
-            "--method",
-            method,
-            "--models",
-            &format!("{},{}", model("bush"), model("aspen")),
+        ];
+        a.extend(extra);
+        forest(&a)
+    };
+    let models = format!("{},{}", model("bush"), model("aspen"));
+    for method in ["quads", "lods"] {
+        let text = ok(&view_frames(&[
+            "--size", "64x48", "--method", method, "--models", &models,
         ]));
         assert!(text.contains(&format!("3 frames of {method}")), "{text}");
         for i in 0..3 {
@@ -273,18 +312,17 @@ fn bake_scene_render_end_to_end() {
             assert_eq!((img.width(), img.height()), (64, 48));
         }
     }
+    // The overdraw heat map is not drawn into headless frames: refused, not plain frames.
+    let e = err(&view_frames(&["--debug-view", "overdraw"]));
+    assert!(e.contains("not into --frames"), "{e}");
     std::fs::write(&walk, "{\"version\":1,\"fov_deg\":60,\"keys\":[]}").unwrap();
-    let e = err(&forest(&[
-        "view",
-        &p("f.forest"),
-        "--path",
-        walk.to_str().unwrap(),
-        "--frames",
-        frames.to_str().unwrap(),
-    ]));
+    let e = err(&view_frames(&[]));
     assert!(e.contains("no keys"), "{e}");
+}
 
-    // Bad inputs: one line, non-zero exit, nothing written.
+/// Bad inputs: one line, non-zero exit, nothing written.
+fn bad_inputs_are_refused(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
     let e = err(&forest(&[
         "render",
         &p("none.forest"),

@@ -505,3 +505,21 @@ fn the_private_runtime_folder_is_removed_at_exit() {
         assert!(left.is_empty(), "{args:?} left {left:?}");
     }
 }
+
+/// `forest view` without a forest, run outside the repository, names the cause and writes
+/// nothing: not into the working folder, and not into the source tree it was built from.
+#[test]
+fn the_demo_is_made_only_in_the_repositorys_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_forest"))
+        .arg("view")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let e = cli::one_line_error(&out);
+    assert!(
+        e.contains("assets/trees") && e.contains("working folder"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

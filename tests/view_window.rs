@@ -80,6 +80,22 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     need("xdotool");
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
+    let last = scene_and_start_path(d);
+    let shots = d.join("shots");
+    std::fs::create_dir(&shots).unwrap();
+    let x = Xvfb::start();
+    let mut v = start_viewer(&x, d, &shots);
+    let win = walk_look_and_switch(&x, &mut v);
+    record_grow_and_close(&x, &mut v, d, &win);
+    the_overdraw_legend_is_drawn(&shots);
+    let (eye0, dir0) = the_start_is_the_paths_end(&shots, last);
+    the_input_moved_the_walker(&shots, eye0, dir0);
+    the_window_draws_what_the_headless_renderer_draws(d, &shots);
+}
+
+/// Two species baked, a forest of them, and a short path the window plays first (control
+/// returns at its last key, returned).
+fn scene_and_start_path(d: &Path) -> forest_format::camera_path::CameraKey {
     let p = |n: &str| d.join(n).display().to_string();
     for s in ["bush", "pine"] {
         bake_small(s, &d.join(format!("{s}.atlas")), 64, 5);
@@ -105,11 +121,13 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         path.push(Vec3::new(0.0, 8.0, z), Vec3::new(-3.0, 0.0, z - 30.0));
     }
     path.save(&d.join("start.json")).unwrap();
-    let last = path.keys[2];
-    let shots = d.join("shots");
-    std::fs::create_dir(&shots).unwrap();
+    path.keys[2]
+}
 
-    let x = Xvfb::start();
+/// The viewer started in `x`'s display on the forest, playing the start path, saving
+/// screenshots into `shots` and recording into walk.json; once its first frame is on screen.
+fn start_viewer(x: &Xvfb, d: &Path, shots: &Path) -> Viewer {
+    let p = |n: &str| d.join(n).display().to_string();
     let mut child = Command::new(env!("CARGO_BIN_EXE_forest"))
         .args([
             "view",
@@ -151,6 +169,11 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     let first = v.wait_for("first frame on screen", 240);
     assert!(first.contains("320x240"), "{first}");
 
+    v
+}
+
+/// Walk, look and switch the method and debug views, with screenshots; the window's id.
+fn walk_look_and_switch(x: &Xvfb, v: &mut Viewer) -> String {
     let win = x.xdotool(&["search", "--sync", "--name", "^forest view$"]);
     let win = win.lines().next().unwrap().to_string();
     // No window manager: give the window the keyboard focus by hand, as a WM would on click.
@@ -186,6 +209,11 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     x.xdotool(&["key", "F12"]);
     let saved = v.wait_for("screenshot-002.png", 60);
     assert!(saved.contains("(impostor, debug view overdraw)"), "{saved}");
+    win
+}
+
+/// Record a path, grow the window past the stream's size, and close the viewer with Esc.
+fn record_grow_and_close(x: &Xvfb, v: &mut Viewer, d: &Path, win: &str) {
     // R records a path while walking sideways; R again saves it.
     x.xdotool(&["key", "r"]);
     x.xdotool(&["keydown", "d"]);
@@ -205,7 +233,7 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     );
     // A larger window and a smaller ε than the stream was sized for: it overflows, and the
     // viewer builds a larger stream.
-    x.xdotool(&["windowsize", &win, "640", "480"]);
+    x.xdotool(&["windowsize", win, "640", "480"]);
     // (It grows at whichever ε first overflows, 16 to 2 depending on the frames drawn in
     // between; ε 2 at 640x480 fits lavapipe's 128 MiB storage-buffer limit, ε 1 would not.)
     x.xdotool(&["key", "1"]);
@@ -231,7 +259,11 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         std::thread::sleep(Duration::from_millis(100));
     };
     assert!(status.success(), "the viewer exited with {status}");
+}
 
+/// The overdraw screenshot shows the legend's swatches along the bottom edge, in the bands'
+/// colours.
+fn the_overdraw_legend_is_drawn(shots: &Path) {
     // The overdraw screenshot: the legend's swatches along the bottom edge, in the bands'
     // colours.
     let shot2 = image::open(shots.join("screenshot-002.png"))
@@ -249,7 +281,14 @@ fn walk_look_switch_and_screenshot_in_a_window() {
             "legend swatch {b}: {p:?}, want {want:?}"
         );
     }
+}
 
+/// The first screenshot is the path's last key, drawn as the stored reference shows it; its
+/// eye and view direction.
+fn the_start_is_the_paths_end(
+    shots: &Path,
+    last: forest_format::camera_path::CameraKey,
+) -> (Vec3, Vec3) {
     // The first screenshot is the path's last key drawn by the default method (the hybrid: the
     // models are given), and looks like the stored reference.
     let (eye0, target0) = key_of(&shots.join("screenshot-000.json"));
@@ -280,6 +319,11 @@ fn walk_look_switch_and_screenshot_in_a_window() {
         "screenshot vs stored reference: mean FLIP {mean:.4} > 0.05 (see target/test-output/)"
     );
 
+    (eye0, dir0)
+}
+
+/// The input moved the walker: forward along the view, turned right by the drag.
+fn the_input_moved_the_walker(shots: &Path, eye0: Vec3, dir0: Vec3) {
     // The input moved the walker: forward along the view, turned right by the drag.
     let (eye1, target1) = key_of(&shots.join("screenshot-001.json"));
     let flat = Vec3::new(dir0.x, 0.0, dir0.z).normalize();
@@ -289,7 +333,11 @@ fn walk_look_switch_and_screenshot_in_a_window() {
     let dir1 = (target1 - eye1).normalize();
     let turned = flat.cross(Vec3::new(dir1.x, 0.0, dir1.z).normalize()).y;
     assert!(turned < -0.02, "did not turn right: {dir0} -> {dir1}");
+}
 
+/// The window draws what the headless renderer draws for that camera, method and view.
+fn the_window_draws_what_the_headless_renderer_draws(d: &Path, shots: &Path) {
+    let p = |n: &str| d.join(n).display().to_string();
     // The window draws what the headless renderer draws for that camera, method and view.
     let frames = d.join("frames");
     std::fs::create_dir(&frames).unwrap();

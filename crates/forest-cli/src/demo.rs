@@ -37,20 +37,28 @@ fn parse_args<A: clap::Args + clap::FromArgMatches>(
     Ok(A::from_arg_matches(&m)?)
 }
 
-/// The folder holding `assets/trees/`: the working folder, else the source tree this binary
-/// was built from.
+/// The folder holding `assets/trees/`: the working folder only. (The source tree this binary
+/// was built from is not used: the demo's cache would then be written into it, unasked, from
+/// wherever the command ran.)
 fn root() -> Result<PathBuf> {
-    let candidates = [
-        PathBuf::from("."),
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."),
-    ];
-    candidates
-        .into_iter()
-        .find(|r| r.join("assets/trees/oak/oak.obj").is_file())
-        .context(
-            "no forest given and the bundled tree models (assets/trees/) are not here: run \
-             from the repository's folder, or give a forest file (forest view FOREST)",
+    let here = PathBuf::from(".");
+    if here.join("assets/trees/oak/oak.obj").is_file() {
+        return Ok(here);
+    }
+    let built_from = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let hint = if built_from.join("assets/trees/oak/oak.obj").is_file() {
+        format!(
+            " (the repository this binary was built from is {})",
+            built_from.display()
         )
+    } else {
+        String::new()
+    };
+    anyhow::bail!(
+        "no forest given and the bundled tree models (assets/trees/) are not in the working \
+         folder: run from the repository's folder{hint}, or give a forest file (forest view \
+         FOREST)"
+    )
 }
 
 fn modified(p: &Path) -> Option<SystemTime> {
@@ -143,6 +151,11 @@ fn prepare_in(root: &Path, bake_args: &[&str]) -> Result<Demo> {
 mod tests {
     use super::*;
 
+    /// The repository's folder (the tests run in the crate's).
+    fn repository() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    }
+
     #[test]
     fn sub_command_defaults_come_from_their_own_definitions() {
         let b: crate::bake::BakeArgs = parse_args("bake", &["m.obj", "-o", "m.atlas"]).unwrap();
@@ -156,7 +169,7 @@ mod tests {
     #[test]
     fn the_demo_bakes_once_and_again_only_what_changed() {
         let tmp = tempfile::tempdir().unwrap();
-        let src = root().unwrap().join("assets/trees");
+        let src = repository().join("assets/trees");
         for s in SPECIES {
             let d = tmp.path().join("assets/trees").join(s);
             std::fs::create_dir_all(&d).unwrap();
@@ -225,7 +238,7 @@ mod tests {
 
     #[test]
     fn the_bundled_models_are_found() {
-        let r = root().unwrap();
+        let r = repository();
         for s in SPECIES {
             assert!(r.join(format!("assets/trees/{s}/{s}.obj")).is_file(), "{s}");
         }

@@ -112,6 +112,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.shadow.options(false)?;
     let method = args.m.chosen(mesh_method)?;
     let ctx = crate::gpu_context()?;
+    if args.counts_fragments() {
+        // Refused before the frames are drawn, not after.
+        FragmentCounter::check_size(&ctx.device, args.size.0, args.size.1)?;
+    }
     let geometry = if method.needs_models() {
         let prepared = args_models(args, &forest, &species)?;
         let opts = target_options(args);

@@ -130,12 +130,9 @@ pub struct ShadowArgs {
 }
 
 impl ShadowArgs {
-    /// The shadow options asked for (None: off; `on` when not given), checked: the error
-    /// names the bad value.
+    /// The shadow options asked for (None: off; `on` when not given), checked whether the
+    /// shadows are on or off (a bad value is never silently ignored): the error names it.
     pub fn options(&self, on: bool) -> Result<Option<ShadowOptions>> {
-        if self.shadows.as_deref().map_or(!on, |s| s == "off") {
-            return Ok(None);
-        }
         let o = ShadowOptions {
             cascades: self.shadow_cascades,
             resolution: self.shadow_resolution,
@@ -144,7 +141,8 @@ impl ShadowArgs {
             ..Default::default()
         };
         o.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
-        Ok(Some(o))
+        let off = self.shadows.as_deref().map_or(!on, |s| s == "off");
+        Ok((!off).then_some(o))
     }
 }
 
@@ -341,7 +339,7 @@ impl MethodArgs {
         let missing = forest
             .species
             .iter()
-            .find(|s| !dir.join(s).join(forest_format::model::MODEL_FILE).is_file());
+            .find(|s| !dir.join(s).join(forest_format::model::MODEL_FILE).exists());
         self.method = Some(match missing {
             Some(s) if self.models.is_empty() => {
                 eprintln!(

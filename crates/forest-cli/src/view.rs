@@ -167,6 +167,14 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         .path
         .as_ref()
         .expect("clap requires --path with --frames");
+    if args.debug_view == forest_render::DebugView::Overdraw {
+        // The heat map needs each frame counted and drawn again; the window and `render`
+        // do that, the headless frames do not (they would be plain frames, silently).
+        bail!(
+            "--debug-view overdraw is drawn by the window and by `forest render --debug-view \
+             overdraw`, not into --frames: choose another debug view for the frames"
+        );
+    }
     let path = CameraPath::load(path_file)?;
     if !frames.is_dir() {
         bail!("frames folder {} does not exist", frames.display());

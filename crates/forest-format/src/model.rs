@@ -343,6 +343,29 @@ impl Header {
             + 2 * u64::from(self.billboards) * image(self.billboard_side)
             + u64::from(self.opacity_resolution).pow(3))
     }
+
+    /// The figures within the ranges an atlas's manifest allows, checked when a file is read
+    /// (a bake writes only models whose coordinates its loaders checked).
+    fn check_ranges(&self) -> Result<(), String> {
+        let radius = self.sphere[3];
+        let reach = self.sphere[..3].iter().fold(0f32, |m, v| m.max(v.abs())) + radius;
+        if reach > crate::species::MAX_MODEL_COORDINATE {
+            return Err(format!(
+                "bounding sphere {:?} reaches {reach:e} model units from the origin, beyond the \
+                 ±{:e} a model may have",
+                self.sphere,
+                crate::species::MAX_MODEL_COORDINATE
+            ));
+        }
+        if self.opacity_depth > crate::opacity::MAX_VOXEL_DEPTH {
+            return Err(format!(
+                "opacity depth {} per voxel, beyond the {} an atlas may record",
+                self.opacity_depth,
+                crate::opacity::MAX_VOXEL_DEPTH
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Share of a model's height, above its lowest point, that counts as its foot
@@ -438,11 +461,20 @@ impl PreparedModel {
     }
 
     /// Read and check the prepared model of atlas folder `atlas`: `Ok(None)` when it has none
-    /// (an atlas baked without one, or by an older bake).
+    /// (an atlas baked without one, or by an older bake). A `model.bin` that is there but not
+    /// a regular file (a folder, a device behind a link) is an error, not a missing model.
     pub fn load(atlas: &Path) -> Result<Option<Self>, FormatError> {
         let path = atlas.join(MODEL_FILE);
-        if !path.is_file() {
-            return Ok(None);
+        match std::fs::metadata(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Ok(m) if !m.is_file() => {
+                return Err(FormatError::invalid(
+                    &path,
+                    "not a regular file (a folder, or a link to a device): bake the atlas \
+                     again, or remove it to draw without the model",
+                ));
+            }
+            _ => {}
         }
         let bytes = crate::bounded::read(&path, crate::bounded::limit::DATA)?;
         Self::decode(&bytes, &path).map(Some)
@@ -478,6 +510,7 @@ impl PreparedModel {
             std::array::from_fn(|i| f32::from_bits(word(12 + 4 * (HEADER_U32S + i))));
         let header = Header::from_words(u, f);
         let size = header.check().map_err(bad)?;
+        header.check_ranges().map_err(bad)?;
         let stream = &bytes[HEADER_BYTES..];
         if size > crate::bounded::limit::DATA || size > stream.len() as u64 * MAX_RATIO + 1024 {
             return Err(bad(format!(

@@ -61,6 +61,11 @@ pub const fn quad_march(quad_level: u32) -> (u32, u32) {
     }
 }
 
+/// The largest optical depth per voxel length an atlas may record for code 255: a voxel that
+/// dense passes e^−100 of the light, so anything denser draws the same. The bundled trees' are
+/// 1.8 to 7.
+pub const MAX_VOXEL_DEPTH: f32 = 100.0;
+
 /// Projection factor of leaf area onto a ray for randomly (spherically) oriented leaves.
 pub const LEAF_PROJECTION: f32 = 1.0;
 
@@ -77,14 +82,17 @@ pub struct OpacityVolume {
 }
 
 impl OpacityVolume {
-    /// Code a grid of optical depths per voxel length (`resolution³` values, ≥ 0).
+    /// Code a grid of optical depths per voxel length (`resolution³` values, ≥ 0; those
+    /// beyond [`MAX_VOXEL_DEPTH`] code as it).
     pub fn from_depths(resolution: u32, depths: &[f32]) -> Self {
         assert_eq!(depths.len(), (resolution as usize).pow(3));
         let max_depth = depths
             .iter()
             .copied()
             .filter(|d| d.is_finite())
-            .fold(0.0f32, f32::max);
+            .fold(0.0f32, f32::max)
+            // Denser voxels draw the same: they code as 255, the densest an atlas records.
+            .min(MAX_VOXEL_DEPTH);
         let codes = depths
             .iter()
             .map(|&d| {

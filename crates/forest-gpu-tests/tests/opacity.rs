@@ -43,7 +43,6 @@ fn volume(k: f32) -> OpacityVolume {
 fn the_gpu_march_matches_the_cpu_mirror() {
     let ctx = common::ctx();
     let volumes = [volume(1.0), volume(2.5)];
-    let mips = [volumes[0].mips(COARSE_LEVEL), volumes[1].mips(COARSE_LEVEL)];
     let spheres = [
         Sphere {
             center: Vec3::new(0.0, 3.0, 0.0),
@@ -54,6 +53,16 @@ fn the_gpu_march_matches_the_cpu_mirror() {
             radius: 8.0,
         },
     ];
+    let (input, expected) = cpu_marches(&volumes, &spheres);
+    let got = gpu_marches(&ctx, &volumes, &spheres, &input);
+    compare_marches(&got, &expected, &input, &spheres);
+}
+
+/// Per point: its shader input (point, species, direction towards the sun, the volume's
+/// largest depth) and the CPU mirror's six answers (the full, coarse and quad level's
+/// marches, and a billboard's median depth point).
+fn cpu_marches(volumes: &[OpacityVolume; 2], spheres: &[Sphere; 2]) -> (Vec<[f32; 8]>, Vec<f32>) {
+    let mips = [volumes[0].mips(COARSE_LEVEL), volumes[1].mips(COARSE_LEVEL)];
     // Per point: species, point in its sphere's cube, direction with y > 0.05.
     let mut input: Vec<[f32; 8]> = Vec::new();
     let mut expected = Vec::new();
@@ -92,6 +101,16 @@ fn the_gpu_march_matches_the_cpu_mirror() {
             volumes[k].max_depth,
         ]);
     }
+    (input, expected)
+}
+
+/// The same six answers per point, marched by the runtime's WGSL.
+fn gpu_marches(
+    ctx: &forest_render::GpuContext,
+    volumes: &[OpacityVolume; 2],
+    spheres: &[Sphere; 2],
+    input: &[[f32; 8]],
+) -> Vec<f32> {
     let (texture, _) = forest_render::extend::opacity_texture(
         &ctx.device,
         &ctx.queue,
@@ -108,10 +127,12 @@ fn the_gpu_march_matches_the_cpu_mirror() {
         .iter()
         .map(|s| s.center.extend(s.radius).to_array())
         .collect();
-    let src = format!(
-        "{}\n{}",
-        forest_render::shaders::COMMON_WGSL,
-        r#"
+    let src = forest_render::shaders::Composer::runtime()
+        .with_module(
+            "march",
+            r#"
+#import common
+
 // Declared for common.wgsl's shading, unused here (so not in the derived layout).
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var vol: texture_3d<f32>;
@@ -136,8 +157,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     out[o + 4u] = v.y;
     out[o + 5u] = v.z;
 }
-"#
-    );
+"#,
+        )
+        .compose(&["march"])
+        .unwrap();
     let module = ctx
         .device
         .create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -162,7 +185,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 usage,
             })
     };
-    let points = buffer(bytemuck::cast_slice(&input), wgpu::BufferUsages::STORAGE);
+    let points = buffer(bytemuck::cast_slice(input), wgpu::BufferUsages::STORAGE);
     let spheres_buf = buffer(
         bytemuck::cast_slice(&sphere_data),
         wgpu::BufferUsages::STORAGE,
@@ -207,9 +230,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     ctx.queue.submit([enc.finish()]);
     let got: Vec<f32> = bytemuck::cast_slice(&ctx.read_buffer(&out, (POINTS * 24) as u64)).to_vec();
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    got
+}
+
+/// The GPU's answers are the CPU's, and the case is not trivial: the volumes shadow and the
+/// rays meet the crowns.
+fn compare_marches(got: &[f32], expected: &[f32], input: &[[f32; 8]], spheres: &[Sphere; 2]) {
     let mut worst = 0f32;
     let mut worst_point = 0f32;
-    for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+    for (i, (g, e)) in got.iter().zip(expected).enumerate() {
         let (point, j) = (i / 6, i % 6);
         if j < 3 {
             // The rasteriser filters with 8-bit weights: a small tolerance.

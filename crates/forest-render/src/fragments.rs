@@ -92,15 +92,10 @@ pub struct FragmentCounter {
 }
 
 impl FragmentCounter {
-    /// Counters for a `width` × `height` target (the fragment positions of the draws counted;
-    /// positions outside it are clamped onto its edge). Checks the size against the device's
-    /// storage-buffer limit before allocating.
-    pub fn new(
-        device: &wgpu::Device,
-        width: u32,
-        height: u32,
-        reverse_z: bool,
-    ) -> Result<Self, RenderError> {
+    /// The counters' size in bytes for a `width` × `height` target, checked against the
+    /// device's storage-buffer limit: a front end calls it before drawing anything, so that a
+    /// size too large is refused before the work, not after.
+    pub fn check_size(device: &wgpu::Device, width: u32, height: u32) -> Result<u64, RenderError> {
         if width == 0 || height == 0 {
             return Err(RenderError::Parameter(format!(
                 "fragment counts need a target of at least 1×1 pixels, not {width}×{height}"
@@ -113,6 +108,19 @@ impl FragmentCounter {
             crate::error::storage_limit(&device.limits()),
             ": count at a smaller size",
         )?;
+        Ok(bytes)
+    }
+
+    /// Counters for a `width` × `height` target (the fragment positions of the draws counted;
+    /// positions outside it are clamped onto its edge). Checks the size against the device's
+    /// storage-buffer limit before allocating.
+    pub fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        reverse_z: bool,
+    ) -> Result<Self, RenderError> {
+        let bytes = Self::check_size(device, width, height)?;
         use wgpu::BufferUsages as U;
         let counts = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fragment counts"),

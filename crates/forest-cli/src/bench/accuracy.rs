@@ -636,12 +636,102 @@ pub fn redraw(b: &Bench) -> Result<Section> {
     } else if header != table.header {
         anyhow::bail!("{}: unexpected columns {header:?}", path.display());
     }
-    for l in lines.filter(|l| !l.is_empty()) {
+    for (i, l) in lines.enumerate().filter(|(_, l)| !l.is_empty()) {
         let row: Vec<String> = l.split(',').map(str::to_string).collect();
         if row.len() != table.header.len() {
             anyhow::bail!("{}: a row with {} cells: {l}", path.display(), row.len());
         }
+        check_row(&table.header, &row)
+            .with_context(|| format!("{}, line {}", path.display(), i + 2))?;
         table.push(row);
     }
     report(b, table)
+}
+
+/// A row of `accuracy.csv` as `--redraw` takes it: its names usable in file names (views and
+/// methods name the charts), every figure empty (not measured) or a finite number in its
+/// range: shares and FLIP in 0 to 1, SSIM in −1 to 1, the rest 0 or more.
+fn check_row(header: &[&str], row: &[String]) -> Result<()> {
+    for (name, cell) in header.iter().zip(row) {
+        match *name {
+            "method" | "param" | "view" => check_name(name, cell)?,
+            "work_source" => {}
+            _ if cell.is_empty() => {}
+            _ => {
+                let v: f64 = cell
+                    .trim()
+                    .parse()
+                    .map_err(|_| anyhow::anyhow!("{name} is {cell:?}, not a number"))?;
+                let (lo, hi) = match *name {
+                    "flip_mean" | "transparent_share" | "hidden_share" => (0.0, 1.0),
+                    "ssim" => (-1.0, 1.0),
+                    _ => (0.0, f64::INFINITY),
+                };
+                if !v.is_finite() || v < lo || v > hi {
+                    let range = if hi.is_finite() {
+                        format!("{lo} to {hi}")
+                    } else {
+                        format!("a finite {lo} or more")
+                    };
+                    anyhow::bail!("{name} is {cell}: expected {range}");
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A name from a results file that becomes part of a chart's file name: not empty (but a
+/// method's parameter may be), no path separator, control character or leading dot.
+fn check_name(what: &str, name: &str) -> Result<()> {
+    let bad = name.starts_with('.')
+        || name
+            .chars()
+            .any(|c| c == '/' || c == '\\' || c.is_control())
+        || (name.is_empty() && what != "param");
+    if bad {
+        anyhow::bail!(
+            "{what} {name:?} cannot name a chart file: no '/', '\\', control characters or \
+             leading '.'"
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(view: &str, frame_ms: &str, flip: &str) -> Vec<String> {
+        let mut r: Vec<String> = columns().iter().map(|_| String::new()).collect();
+        r[0] = "quads".into();
+        r[2] = view.into();
+        r[3] = frame_ms.into();
+        r[4] = flip.into();
+        r
+    }
+
+    /// `--redraw` takes finite figures in their ranges and names the cell otherwise; names
+    /// that would leave the results folder as chart paths are refused.
+    #[test]
+    fn redrawn_rows_are_checked_cell_by_cell() {
+        let header = columns();
+        assert!(check_row(&header, &row("inside", "1.5", "0.2")).is_ok());
+        assert!(check_row(&header, &row("inside", "1e308", "0")).is_ok());
+        for (view, ms, flip, cause) in [
+            ("inside", "NaN", "0.2", "frame_ms is NaN"),
+            ("inside", "abc", "0.2", "not a number"),
+            ("inside", "-5", "0.2", "frame_ms is -5"),
+            ("inside", "inf", "0.2", "frame_ms is inf"),
+            ("inside", "1", "1.5", "flip_mean is 1.5: expected 0 to 1"),
+            ("x/y", "1", "0.2", "cannot name a chart file"),
+            ("../../escaped", "1", "0.2", "cannot name a chart file"),
+            ("", "1", "0.2", "cannot name a chart file"),
+        ] {
+            let e = check_row(&header, &row(view, ms, flip))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(cause), "{view} {ms} {flip}: {e}");
+        }
+    }
 }

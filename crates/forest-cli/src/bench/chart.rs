@@ -132,6 +132,9 @@ fn label(v: f64, log: bool) -> String {
     }
 }
 
+/// The largest magnitude an axis reaches; data beyond it is drawn at the edge.
+const AXIS_LIMIT: f64 = 1e300;
+
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, c: &Chart) -> Result<()>
 where
     DB::ErrorType: 'static,
@@ -145,24 +148,38 @@ where
             s.points
                 .iter()
                 .filter_map(|&(x, y)| Some((axis(x, c.log_x)?, axis(y, c.log_y)?)))
+                // Non-finite points are left out, the rest kept within the axes' reach (a
+                // point beyond an axis overflows the plotting's pixel arithmetic).
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|(x, y)| {
+                    let clamp = |v: f64| v.clamp(-AXIS_LIMIT, AXIS_LIMIT);
+                    (clamp(x), clamp(y))
+                })
                 .collect()
         })
         .collect();
     let all: Vec<&(f64, f64)> = pts.iter().flatten().collect();
+    // Axes hold any finite data: the extremes are clamped to ±AXIS_LIMIT, and spans are
+    // taken as differences of scaled ends, so no step overflows.
     let range = |f: fn(&(f64, f64)) -> f64| {
-        let lo = all.iter().map(|p| f(p)).fold(f64::INFINITY, f64::min);
-        let hi = all.iter().map(|p| f(p)).fold(f64::NEG_INFINITY, f64::max);
-        if !lo.is_finite() {
+        let finite = all.iter().map(|p| f(p)).filter(|v| v.is_finite());
+        let lo = finite
+            .clone()
+            .fold(f64::INFINITY, f64::min)
+            .max(-AXIS_LIMIT);
+        let hi = finite.fold(f64::NEG_INFINITY, f64::max).min(AXIS_LIMIT);
+        if lo > hi {
             return 0.0..1.0;
         }
-        let pad = ((hi - lo) * 0.08).max(if lo.abs() > 0.0 { lo.abs() * 0.05 } else { 0.5 });
+        let pad = (hi * 0.08 - lo * 0.08).max(if lo.abs() > 0.0 { lo.abs() * 0.05 } else { 0.5 });
         (lo - pad)..(hi + pad)
     };
     // Room above the data for the legend.
     let y_range = {
         let r = range(|p| p.1);
-        let legend = (r.end - r.start) * (0.05 * c.series.len() as f64 + 0.03);
-        r.start..r.end + legend
+        let share = 0.05 * c.series.len() as f64 + 0.03;
+        let legend = r.end * share - r.start * share;
+        r.start..(r.end + legend).min(f64::MAX)
     };
     let mut chart = ChartBuilder::on(&root)
         .caption(&c.title, ("sans-serif", 22))
@@ -277,5 +294,33 @@ mod tests {
             svg.contains("<svg") && svg.contains("Caption of the test"),
             "caption in the SVG"
         );
+    }
+
+    /// Any finite data is drawn, extremes included (an axis padded by its span once
+    /// overflowed to infinity and never finished); non-finite points are left out.
+    #[test]
+    fn extreme_finite_values_are_charted() {
+        let dir = tempfile::tempdir().unwrap();
+        for points in [
+            vec![(0.0, 1e308), (1.0, -1e308), (2.0, f64::NAN)],
+            vec![(f64::MAX, f64::MAX), (-f64::MAX, 0.0)],
+            vec![(1.0, 5.0), (1.0, 5.0)],
+            vec![(f64::INFINITY, 1.0)],
+        ] {
+            let c = Chart {
+                title: "extremes".into(),
+                series: (0..10)
+                    .map(|k| Series {
+                        name: format!("s{k}"),
+                        points: points.clone(),
+                        line: true,
+                        front: true,
+                    })
+                    .collect(),
+                ..Default::default()
+            };
+            save(&c, &dir.path().join("x")).unwrap();
+            assert!(dir.path().join("x.png").is_file());
+        }
     }
 }

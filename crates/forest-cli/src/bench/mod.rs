@@ -164,6 +164,13 @@ fn default_model(atlas_path: &Path, data: &SpeciesData) -> Option<PathBuf> {
 
 impl Bench {
     fn new(args: &BenchArgs) -> Result<Self> {
+        if args.frames == 0 {
+            bail!("--frames 0: measure at least 1 frame per setting");
+        }
+        // The results never land inside an input: an atlas, a model, or a folder holding one.
+        let inputs: Vec<PathBuf> = args.species.iter().chain(&args.models).cloned().collect();
+        crate::guard::not_an_input(&args.out, "--out results folder", &inputs)?;
+        crate::guard::not_in_atlas(&args.out, "--out results folder")?;
         let species = args
             .species
             .iter()
@@ -211,7 +218,7 @@ impl Bench {
             prepared: OnceCell::new(),
             out: args.out.clone(),
             quick: args.quick,
-            frames: if args.quick { 1 } else { args.frames.max(1) },
+            frames: if args.quick { 1 } else { args.frames },
             views: args.views.clone(),
             methods: args.methods.clone(),
             shadows: args.shadow.options(false)?,

@@ -295,9 +295,10 @@ impl AtlasManifest {
                 crate::opacity::VOLUME_RESOLUTION
             ));
         }
-        if !(self.opacity.max_depth.is_finite() && self.opacity.max_depth >= 0.0) {
+        let max = crate::opacity::MAX_VOXEL_DEPTH;
+        if !(self.opacity.max_depth.is_finite() && (0.0..=max).contains(&self.opacity.max_depth)) {
             return bad(format!(
-                "opacity.max_depth = {}, expected a finite number ≥ 0",
+                "opacity.max_depth = {}, expected an optical depth per voxel of 0 to {max}",
                 self.opacity.max_depth
             ));
         }
@@ -373,6 +374,16 @@ impl AtlasManifest {
         }
         if let Some(h) = &self.hybrid_switch {
             h.check().or_else(|e| bad(format!("hybrid_switch.{e}")))?;
+        }
+        if let Some(t) = self.source.top {
+            // The highest vertex of a tree standing on y = 0, within a model's coordinates.
+            let max = crate::species::MAX_MODEL_COORDINATE;
+            if !(t.is_finite() && t > 0.0 && t <= max) {
+                return bad(format!(
+                    "source.top = {t}, expected a height above 0 (the tree's foot) of at most \
+                     {max:e}"
+                ));
+            }
         }
         if let Some(f) = self.source.foot
             && !(f.is_finite() && f >= 0.0)

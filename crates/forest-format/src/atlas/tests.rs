@@ -123,14 +123,20 @@ fn save_then_load_round_trips_and_replaces_atomically() {
     assert_eq!(names, vec![std::ffi::OsString::from("s.atlas")]);
 }
 
-#[test]
-fn the_loader_names_what_is_wrong() {
+/// The synthetic atlas saved as `x.atlas` in a temporary folder (kept while the guard lives).
+fn saved_synthetic() -> (Atlas, tempfile::TempDir, std::path::PathBuf) {
     let (atlas, _) = synthetic(ColourEncoding::Png);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("x.atlas");
+    atlas.save(&path).unwrap();
+    (atlas, dir, path)
+}
+
+#[test]
+fn the_loader_names_what_is_wrong() {
+    let (atlas, _dir, path) = saved_synthetic();
     let reset = || atlas.save(&path).unwrap();
     let err = |p: &Path| Atlas::load(p).unwrap_err().to_string();
-    reset();
     let manifest = path.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&manifest).unwrap();
     std::fs::write(&manifest, text.replace("\"version\": 4", "\"version\": 7")).unwrap();
@@ -191,6 +197,15 @@ fn the_loader_names_what_is_wrong() {
     reset();
     std::fs::remove_file(path.join(ALPHA_FILE)).unwrap();
     assert!(err(&path).contains(ALPHA_FILE), "{}", err(&path));
+}
+
+/// The manifest's measured figures (the hybrid's switch, its tolerance, mesh-LOD bands, the
+/// foot) round-trip, and out of their ranges are named.
+#[test]
+fn the_loader_names_bad_measured_figures() {
+    let (atlas, dir, path) = saved_synthetic();
+    let err = |p: &Path| Atlas::load(p).unwrap_err().to_string();
+    let manifest = path.join(MANIFEST_FILE);
     // A measured hybrid switch round-trips; one outside its range is named.
     let mut measured = atlas.clone();
     measured.manifest.hybrid_switch = Some(HybridSwitch {
@@ -253,6 +268,21 @@ fn the_loader_names_what_is_wrong() {
     v["source"].as_object_mut().unwrap().remove("foot");
     std::fs::write(&manifest, v.to_string()).unwrap();
     assert_eq!(Atlas::load(&path).unwrap().manifest.source.foot, None);
+    // A top at or below the foot, and an opacity volume denser than any crown, are named
+    // (they once fell back to the sphere's top, and drew every crown black).
+    for (field, value, cause) in [
+        ("top", -2.0, "source.top = -2"),
+        ("top", 0.0, "source.top = 0"),
+        ("max_depth", 1e30, "optical depth per voxel of 0 to 100"),
+        ("max_depth", -1.0, "opacity.max_depth = -1"),
+    ] {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let section = if field == "top" { "source" } else { "opacity" };
+        v[section][field] = serde_json::json!(value);
+        std::fs::write(&manifest, v.to_string()).unwrap();
+        assert!(err(&path).contains(cause), "{}", err(&path));
+    }
+    std::fs::write(&manifest, &text).unwrap();
     let lods = |path: &std::path::Path| {
         Atlas::load(path)
             .unwrap()

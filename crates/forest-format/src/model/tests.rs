@@ -192,6 +192,26 @@ fn a_model_survives_encoding() {
     assert!(e.contains("another model") && e.contains(MODEL_FILE), "{e}");
 }
 
+/// A model.bin that is a folder, or a link to a device, is named as not a file: never
+/// taken for an atlas baked without its model.
+#[test]
+fn a_model_that_is_not_a_file_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join(MODEL_FILE)).unwrap();
+    let e = PreparedModel::load(dir.path()).unwrap_err().to_string();
+    assert!(
+        e.contains(MODEL_FILE) && e.contains("not a regular file"),
+        "{e}"
+    );
+    #[cfg(unix)]
+    {
+        let linked = tempfile::tempdir().unwrap();
+        std::os::unix::fs::symlink("/dev/zero", linked.path().join(MODEL_FILE)).unwrap();
+        let e = PreparedModel::load(linked.path()).unwrap_err().to_string();
+        assert!(e.contains("not a regular file"), "{e}");
+    }
+}
+
 fn refused(bytes: &[u8]) -> String {
     PreparedModel::decode(bytes, Path::new("m.bin"))
         .unwrap_err()
@@ -224,6 +244,16 @@ fn bad_files_are_refused_with_their_cause() {
     let mut more = good.clone();
     more[16..20].copy_from_slice(&6u32.to_le_bytes());
     assert!(refused(&more).contains("inflate to"), "{}", refused(&more));
+    // A bounding sphere beyond a model's coordinates, or a volume denser than an atlas may
+    // record, is named (a radius of 1e30 once drew every crown nearly black).
+    let mut far = tiny();
+    far.sphere[3] = 1e30;
+    let e = refused(&far.encode());
+    assert!(e.contains("reaches"), "{e}");
+    let mut dense = tiny();
+    dense.opacity.max_depth = 1e30;
+    let e = refused(&dense.encode());
+    assert!(e.contains("opacity depth"), "{e}");
 }
 
 #[test]
