@@ -37,10 +37,16 @@ pub fn models_for(
     allow_other: bool,
 ) -> Result<PreparedGeometry> {
     let sourced = geometry::models_for(models, forest_file, forest, species, allow_other)?;
+    Ok(noted(sourced))
+}
+
+/// The models prepared, their notes (a model drawn though its bytes differ from the baked
+/// one's) said on stderr.
+pub fn noted(sourced: geometry::SourcedModels) -> PreparedGeometry {
     for note in &sourced.notes {
         eprintln!("forest: note: {note}");
     }
-    Ok(sourced.geometry)
+    sourced.geometry
 }
 
 /// Run `forest render`.

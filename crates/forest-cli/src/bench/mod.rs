@@ -264,15 +264,11 @@ impl Bench {
                  pass --models (none found under assets/trees/)"
             );
         }
-        let sourced = forest_baselines::geometry::prepare_models(
+        let p = crate::render::noted(forest_baselines::geometry::prepare_models(
             &self.models,
             &self.species,
             self.allow_other_models,
-        )?;
-        for note in &sourced.notes {
-            eprintln!("forest: note: {note}");
-        }
-        let p = sourced.geometry;
+        )?);
         Ok(self.prepared.get_or_init(|| p))
     }
 
