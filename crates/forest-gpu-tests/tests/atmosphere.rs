@@ -226,6 +226,54 @@ fn sky_ground_and_sun_have_their_analytic_colours() {
 }
 
 #[test]
+fn exposure_scales_the_sky_the_ground_the_haze_and_the_trees_alike() {
+    let ctx = common::ctx();
+    let forest = common::one_tree(1, 0.4);
+    let centre = common::atlases()[1].manifest.bounding_sphere.center;
+    // A far tree in thick haze, the ground below it and the sky with the sun's glow above.
+    let atmosphere = Atmosphere {
+        haze_height: 3.0,
+        ..Atmosphere::hazy(60.0)
+    };
+    let cam = camera(centre + Vec3::new(2.0, 1.0, -12.0), centre);
+    let bright = options(Background::Sky, atmosphere);
+    let exposure = 0.25;
+    let mut dim = bright.clone();
+    dim.lighting.exposure = exposure;
+    for (name, draw) in [
+        ("quads", quads as fn(&_, &_, &_, &_) -> Image),
+        ("geometry", geometry),
+    ] {
+        let (full, scaled) = (
+            draw(&ctx, &forest, &bright, &cam),
+            draw(&ctx, &forest, &dim, &cam),
+        );
+        let mut checked = 0;
+        for y in (0..SIZE.1).step_by(3) {
+            for x in (0..SIZE.0).step_by(3) {
+                let (a, b) = (full.linear(x, y), scaled.linear(x, y));
+                // Saturated pixels say nothing of the scale.
+                if a.truncate().max_element() >= 0.99 {
+                    continue;
+                }
+                let want = a.truncate() * exposure;
+                if (b.truncate() - want).abs().max_element() > 0.01 + 0.02 * want.max_element() {
+                    full.save(&format!("exposure_{name}_1"));
+                    scaled.save(&format!("exposure_{name}_{exposure}"));
+                }
+                close(
+                    b,
+                    want,
+                    &format!("{name}: pixel ({x}, {y}) at exposure {exposure}"),
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 1000, "{name}: only {checked} pixels checked");
+    }
+}
+
+#[test]
 fn haze_mixes_every_methods_tree_towards_the_horizon_by_its_distance() {
     let ctx = common::ctx();
     let forest = common::one_tree(1, 0.4);

@@ -52,13 +52,14 @@ fn sky_tint() -> vec3<f32> {
     return camera.sky_light.rgb / REFERENCE_SKY;
 }
 
-// Premultiplied colour `c` of a surface at `world` seen through the haze: it keeps
-// T = exp(−τ) and takes (1 − T) of the horizon colour (tinted by the light), in proportion
-// to its coverage.
+// Premultiplied colour `c` (exposure applied) of a surface at `world` seen through the haze:
+// it keeps T = exp(−τ) and takes (1 − T) of the horizon colour (tinted by the light, scaled by
+// the exposure as every radiance is), in proportion to its coverage.
 fn hazed(c: vec4<f32>, world: vec3<f32>) -> vec4<f32> {
     if (env.horizon.w <= 0.0) { return c; }
     let t = exp(-optical_depth(world));
-    return vec4<f32>(c.rgb * t + env.horizon.rgb * sky_tint() * (c.a * (1.0 - t)), c.a);
+    let haze = env.horizon.rgb * sky_tint() * camera.exposure;
+    return vec4<f32>(c.rgb * t + haze * (c.a * (1.0 - t)), c.a);
 }
 
 // The world direction (not normalised, in front of the eye) through pixel `pixel`: the 3×3 of
@@ -77,7 +78,7 @@ fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
 }
 
 // The sky seen along unit direction `d`: the horizon colour rising to the zenith's (tinted by
-// the light), the sun's disc with a faint glow around it.
+// the light), the sun's disc with a faint glow around it; scaled by the exposure.
 fn sky(d: vec3<f32>) -> vec3<f32> {
     let up = clamp(d.y, 0.0, 1.0);
     var c = mix(env.horizon.rgb, env.zenith.rgb, sqrt(up)) * sky_tint();
@@ -86,7 +87,7 @@ fn sky(d: vec3<f32>) -> vec3<f32> {
         c = c + camera.sun_colour.rgb * (0.25 * pow(max(s, 0.0), 256.0));
         if (s >= env.sun.x) { c = camera.sun_colour.rgb * 1.5; }
     }
-    return c;
+    return c * camera.exposure;
 }
 
 struct EnvironmentOut {
