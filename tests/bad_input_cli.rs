@@ -417,3 +417,41 @@ fn counters_too_large_are_refused_before_drawing() {
         &["fragment counts of a 8192×8192 target", "smaller size"],
     );
 }
+
+/// A model whose only texture is transparent at every texel bakes nothing: the bake says so,
+/// names the material, and writes no atlas. With one solid material beside it, it bakes.
+#[test]
+fn a_model_that_draws_nothing_is_refused_before_baking() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([60, 140, 40, 0]))
+        .save(d.join("clear.png"))
+        .unwrap();
+    std::fs::write(
+        d.join("m.mtl"),
+        "newmtl leaf\nmap_Kd clear.png\nnewmtl bark\nKd 0.3 0.2 0.1\n",
+    )
+    .unwrap();
+    let quad = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    std::fs::write(d.join("clear.obj"), quad).unwrap();
+    let small = ["--resolution", "32", "--directions", "4", "--spp", "1"];
+    let bake = |obj: &str, atlas: &Path| {
+        let mut args = vec!["bake".to_string(), d.join(obj).display().to_string()];
+        args.extend(["-o".into(), atlas.display().to_string()]);
+        args.extend(small.map(String::from));
+        args.push("--no-hybrid-switch".into());
+        args
+    };
+    let atlas = d.join("clear.atlas");
+    refused(
+        &strs(&bake("clear.obj", &atlas)),
+        d,
+        &["clear.obj", "\"leaf\"", "transparent", "draws nothing"],
+    );
+    assert!(!atlas.exists(), "a refused bake left {}", atlas.display());
+    // A solid triangle beside the clear quad: the model draws something, and bakes.
+    let mixed = format!("{quad}v 0 0 1\nusemtl bark\nf 1 2 5\n");
+    std::fs::write(d.join("mixed.obj"), mixed).unwrap();
+    ok(&forest(&strs(&bake("mixed.obj", &d.join("mixed.atlas")))));
+}

@@ -150,6 +150,7 @@ pub fn bake_mesh(
 ) -> Result<BakeOutput, BakeError> {
     params.validate()?;
     check_memory(params)?;
+    mesh.check_drawable(Path::new(file))?;
     let start = Instant::now();
     let sphere = bounding_sphere(mesh);
     let scene = trace::Scene::new(mesh);
@@ -202,6 +203,18 @@ pub fn bake_mesh(
         .iter()
         .map(|t| t.levels.iter().map(|l| l.len() as u64).sum::<u64>())
         .sum();
+    if total == 0 {
+        return Err(BakeError::Model {
+            path: file.into(),
+            what: format!(
+                "no texel of any of the {} layers is covered: the model draws nothing at \
+                 --resolution {} (its surfaces are thinner than a texel, or their textures \
+                 transparent where the rays hit them)",
+                params.layers(),
+                params.resolution
+            ),
+        });
+    }
     if total > MAX_NODES {
         return Err(FormatError::Param(format!(
             "the bake produced {total} nodes, more than the format's {MAX_NODES}: lower \

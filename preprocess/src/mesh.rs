@@ -120,6 +120,51 @@ pub(crate) fn no_triangles(path: &Path, degenerate: u64) -> BakeError {
 pub use forest_format::species::MAX_MODEL_COORDINATE;
 
 impl Mesh {
+    /// Names of the materials whose alpha texture is transparent at every texel (alpha below
+    /// [`ALPHA_CUTOFF`]), in material order: their triangles draw nothing.
+    pub fn transparent_materials(&self) -> Vec<&str> {
+        self.materials
+            .iter()
+            .filter(|m| {
+                m.alpha.is_some_and(|(t, channel)| {
+                    let cut = (ALPHA_CUTOFF * 255.0).ceil() as u8;
+                    self.textures[t]
+                        .rgba
+                        .chunks_exact(4)
+                        .all(|p| texel_alpha([p[0], p[1], p[2], p[3]], channel) < cut)
+                })
+            })
+            .map(|m| m.name.as_str())
+            .collect()
+    }
+
+    /// Refuses a mesh whose every triangle uses a material transparent at every texel: its
+    /// bake would draw nothing. The error names those materials.
+    pub fn check_drawable(&self, path: &Path) -> Result<(), BakeError> {
+        let clear = self.transparent_materials();
+        let names: Vec<&str> = self.materials.iter().map(|m| m.name.as_str()).collect();
+        let all_clear = self
+            .tris
+            .iter()
+            .all(|t| clear.contains(&names[t.material as usize]));
+        if self.tris.is_empty() || !all_clear {
+            return Ok(());
+        }
+        Err(BakeError::Model {
+            path: path.into(),
+            what: format!(
+                "every texel of the alpha texture of material{} {} is transparent (alpha below                  {ALPHA_CUTOFF}), and every triangle uses {}: the model draws nothing",
+                if clear.len() == 1 { "" } else { "s" },
+                clear
+                    .iter()
+                    .map(|n| format!("{n:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                if clear.len() == 1 { "it" } else { "them" },
+            ),
+        })
+    }
+
     /// Whether barycentric point `b` of triangle `t` is solid: not a hole of an alpha-tested
     /// material (alpha below [`ALPHA_CUTOFF`]).
     pub fn solid_at(&self, t: &Tri, b: [f32; 3]) -> bool {
