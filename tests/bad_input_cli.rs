@@ -455,3 +455,22 @@ fn a_model_that_draws_nothing_is_refused_before_baking() {
     std::fs::write(d.join("mixed.obj"), mixed).unwrap();
     ok(&forest(&strs(&bake("mixed.obj", &d.join("mixed.atlas")))));
 }
+
+/// An option that needs another names the one missing, on the same line as clap's message.
+#[test]
+fn a_missing_companion_option_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let png = d.join("x.png").display().to_string();
+    let frames = d.display().to_string();
+    for (args, missing) in [
+        (
+            vec!["render", "f.json", "-o", &png, "--eye", "1,2,3"],
+            "--target",
+        ),
+        (vec!["view", "f.json", "--frames", &frames], "--path"),
+        (vec!["render", "f.json"], "--output"),
+    ] {
+        refused(&args, d, &["required arguments were not provided", missing]);
+    }
+}

@@ -206,6 +206,25 @@ fn an_atlas_without_its_model(d: &std::path::Path) {
     assert!(bare.join("x.png").is_file());
 }
 
+/// The overdraw view's legend is along the bottom of the image at `path`: its band-0 swatch
+/// black, its band-8 swatch white.
+fn assert_overdraw_legend(path: &dyn AsRef<std::path::Path>) {
+    let img = image::open(path).unwrap().to_rgba8();
+    let (w, h) = img.dimensions();
+    let side = forest_render::fragments::legend_side(w);
+    let p = path.as_ref().display();
+    assert_eq!(
+        img.get_pixel(side / 2, h - 2 * side).0,
+        [0, 0, 0, 255],
+        "{p}"
+    );
+    assert_eq!(
+        img.get_pixel(8 * side + side / 2, h - 2 * side).0,
+        [255; 4],
+        "{p}"
+    );
+}
+
 /// Exact fragment counts and the overdraw view, for a quad method and a geometry one.
 fn fragment_counts_and_the_overdraw_view(d: &std::path::Path) {
     let p = |n: &str| d.join(n).display().to_string();
@@ -239,14 +258,7 @@ fn fragment_counts_and_the_overdraw_view(d: &std::path::Path) {
             "{v}"
         );
         assert!(v["work"]["draws"].as_u64().unwrap() > 0, "{v}");
-        // The legend's band-0 swatch is black, its band-8 swatch white.
-        let img = image::open(&out).unwrap().to_rgba8();
-        let side = forest_render::fragments::legend_side(64);
-        assert_eq!(img.get_pixel(side / 2, 48 - 2 * side).0, [0, 0, 0, 255]);
-        assert_eq!(
-            img.get_pixel(8 * side + side / 2, 48 - 2 * side).0,
-            [255; 4]
-        );
+        assert_overdraw_legend(&out);
     }
     let e = err(&forest(&[
         "render",
@@ -312,9 +324,35 @@ fn view_plays_a_path_back(d: &std::path::Path) {
             assert_eq!((img.width(), img.height()), (64, 48));
         }
     }
-    // The overdraw heat map is not drawn into headless frames: refused, not plain frames.
-    let e = err(&view_frames(&["--debug-view", "overdraw"]));
-    assert!(e.contains("not into --frames"), "{e}");
+    // The overdraw heat map is drawn into headless frames, legend and all.
+    let text = ok(&view_frames(&[
+        "--size",
+        "64x48",
+        "--debug-view",
+        "overdraw",
+    ]));
+    assert!(text.contains("3 frames of"), "{text}");
+    for i in 0..3 {
+        assert_overdraw_legend(&frames.join(format!("frame-{i:05}.png")));
+    }
+    // A frames folder that is a file, or that is missing, is named as such.
+    let file = d.join("frames.txt");
+    std::fs::write(&file, "mine").unwrap();
+    let into = |f: &std::path::Path| {
+        err(&forest(&[
+            "view",
+            &forest_file,
+            "--path",
+            walk.to_str().unwrap(),
+            "--frames",
+            f.to_str().unwrap(),
+        ]))
+    };
+    let e = into(&file);
+    assert!(e.contains("frames.txt is a file, not a folder"), "{e}");
+    assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+    let e = into(&d.join("no-such-folder"));
+    assert!(e.contains("does not exist: create it first"), "{e}");
     std::fs::write(&walk, "{\"version\":1,\"fov_deg\":60,\"keys\":[]}").unwrap();
     let e = err(&view_frames(&[]));
     assert!(e.contains("no keys"), "{e}");

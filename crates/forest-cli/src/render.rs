@@ -330,7 +330,7 @@ fn render_views(
 }
 
 /// Draw the overdraw view of `counter`'s counts over `target`, with its legend.
-fn overdraw_view(ctx: &GpuContext, target: &Target, counter: &FragmentCounter) {
+pub(crate) fn overdraw_view(ctx: &GpuContext, target: &Target, counter: &FragmentCounter) {
     let view = OverdrawPass::new(&ctx.device, target.format);
     let binding = view.bind(&ctx.device, counter, true);
     let mut enc = ctx.device.create_command_encoder(&Default::default());

@@ -12,13 +12,14 @@ use forest_baselines::geometry::{GeometryRenderer, PreparedGeometry};
 use forest_baselines::methods::ForestRenderer;
 use forest_format::camera_path::CameraPath;
 use forest_format::forest::Forest;
+use forest_render::fragments::FragmentCounter;
 use forest_render::options::{Atmosphere, Background, DebugView, RendererOptions};
 use forest_render::scene::SpeciesData;
 use forest_render::target::{TARGET_FORMAT, Target};
-use forest_render::{Camera, GpuContext, QuadStream};
+use forest_render::{Camera, ForestView, GpuContext, QuadStream};
 use glam::Vec3;
 
-use crate::render::{MethodArgs, load_scene, models_for, write_png};
+use crate::render::{MethodArgs, load_scene, models_for, overdraw_view, write_png};
 use crate::render_args::parse_size;
 
 /// Arguments of `forest view`.
@@ -167,17 +168,18 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         .path
         .as_ref()
         .expect("clap requires --path with --frames");
-    if args.debug_view == forest_render::DebugView::Overdraw {
-        // The heat map needs each frame counted and drawn again; the window and `render`
-        // do that, the headless frames do not (they would be plain frames, silently).
+    let path = CameraPath::load(path_file)?;
+    if frames.exists() && !frames.is_dir() {
         bail!(
-            "--debug-view overdraw is drawn by the window and by `forest render --debug-view \
-             overdraw`, not into --frames: choose another debug view for the frames"
+            "frames folder {} is a file, not a folder: name a folder for the frames",
+            frames.display()
         );
     }
-    let path = CameraPath::load(path_file)?;
     if !frames.is_dir() {
-        bail!("frames folder {} does not exist", frames.display());
+        bail!(
+            "frames folder {} does not exist: create it first",
+            frames.display()
+        );
     }
     crate::guard::not_in_atlas(frames, "frames folder")?;
     let (forest, species) = load_scene(&forest_file)?;
@@ -224,6 +226,16 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     r.set_method(&ctx, method)?;
     r.set_shadows(&ctx.device, args.shadow.options(true)?)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
+    // The overdraw view: each frame counted (drawn twice more) and its heat map drawn over it.
+    let counter = match args.debug_view {
+        DebugView::Overdraw => Some(FragmentCounter::new(
+            &ctx.device,
+            args.size.0,
+            args.size.1,
+            r.stream.options_built().reverse_z,
+        )?),
+        _ => None,
+    };
     let mut total_ms = 0.0;
     for (i, key) in path.keys.iter().enumerate() {
         let cam = Camera {
@@ -238,6 +250,16 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         let stats = r
             .render_fitted(&ctx, &cam, &target)
             .with_context(|| format!("{}: key {i}", path_file.display()))?;
+        if let Some(counter) = &counter {
+            forest_render::fragments::count_fragments(
+                &ctx,
+                counter,
+                &mut r,
+                |r, device, counter| r.set_fragment_counter(device, counter),
+                |r| r.render_frame(&ctx, &cam, &target),
+            )?;
+            overdraw_view(&ctx, &target, counter);
+        }
         ctx.check_errors()?;
         let t = stats.times.unwrap_or_default();
         total_ms += t.total_ms();
