@@ -176,6 +176,34 @@ fn species_are_checked_alike_by_scene_info_and_render() {
         d,
         &["broken.atlas"],
     );
+    // A colour mosaic cut to a quarter of its bytes (the JPEG decoder fills the rest with
+    // grey and says nothing) is refused by info and render alike.
+    let cut = d.join("cut.atlas");
+    edited_atlas(&good, &cut, |_| {});
+    let colour = cut.join(colour.file_name().unwrap());
+    let bytes = std::fs::read(&colour).unwrap();
+    std::fs::write(&colour, &bytes[..bytes.len() / 4]).unwrap();
+    let name = colour.file_name().unwrap().to_string_lossy().into_owned();
+    let c = cut.display().to_string();
+    // Small bakes store their colour as JPEG by default.
+    assert_eq!(name, "colour.jpg");
+    refused(&["info", &c], d, &[&name, "JPEG cut short"]);
+    let mut cut_forest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&forest_file).unwrap()).unwrap();
+    cut_forest["species"] = serde_json::json!(["cut.atlas"]);
+    std::fs::write(d.join("cut.json"), serde_json::to_vec(&cut_forest).unwrap()).unwrap();
+    refused(
+        &[
+            "render",
+            &p("cut.json"),
+            "-o",
+            &p("x.png"),
+            "--size",
+            "32x24",
+        ],
+        d,
+        &["cut.atlas", &name],
+    );
     // Instances scaled past the physical range, in a forest written by hand.
     let mut f: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&forest_file).unwrap()).unwrap();

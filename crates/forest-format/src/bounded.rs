@@ -58,6 +58,27 @@ pub fn image_dimensions(
         })
 }
 
+/// Refuse a JPEG cut short: the decoder fills what is missing with grey and says nothing.
+/// The main image's entropy-coded data follows its last start-of-scan marker (FF DA) and
+/// must be closed by an end-of-image marker (FF D9); neither pair can occur inside
+/// entropy-coded data (0xFF is stuffed there), and bytes after the marker are allowed.
+fn check_jpeg_end(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        return Ok(());
+    }
+    let marker = |m: u8| move |w: &[u8]| w == [0xFF, m];
+    let Some(scan) = bytes.windows(2).rposition(marker(0xDA)) else {
+        return Err("JPEG without image data (no start-of-scan marker)".into());
+    };
+    if !bytes[scan..].windows(2).any(marker(0xD9)) {
+        return Err(format!(
+            "JPEG cut short: no end-of-image marker after its image data ({} bytes read)",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
 /// Refuse a PNG whose palette chunk (PLTE) is not a whole number of RGB entries, as the PNG
 /// specification requires: png 0.18.1 panics on one (image-rs/image-png#694). Other chunks
 /// are the decoder's to check.
@@ -97,6 +118,7 @@ pub fn decode_image(
         what,
     };
     check_png_chunks(bytes).map_err(err)?;
+    check_jpeg_end(bytes).map_err(err)?;
     let mut reader = image_reader(bytes, format, path)?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(limit::IMAGE_SIDE);
@@ -166,6 +188,27 @@ mod tests {
         png.extend_from_slice(b"PLTE\x01\x02\x03\x04\0\0\0\0");
         let e = decode_image(&png, None, Path::new("p.png")).unwrap_err();
         assert!(e.to_string().contains("not a multiple of 3"), "{e}");
+        // A JPEG cut short anywhere after its header is refused; whole, or with bytes after
+        // its end, it decodes.
+        let img =
+            image::RgbImage::from_fn(64, 48, |x, y| image::Rgb([x as u8 * 3, y as u8 * 5, 90]));
+        let mut jpeg = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut jpeg, image::ImageFormat::Jpeg).unwrap();
+        let jpeg = jpeg.into_inner();
+        let p = Path::new("c.jpg");
+        assert!(decode_image(&jpeg, Some(image::ImageFormat::Jpeg), p).is_ok());
+        let mut trailed = jpeg.clone();
+        trailed.extend_from_slice(b"trailing bytes");
+        assert!(decode_image(&trailed, None, p).is_ok());
+        for keep in [jpeg.len() / 4, jpeg.len() / 2, jpeg.len() - 1] {
+            let e = decode_image(&jpeg[..keep], None, p)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("c.jpg") && e.contains("JPEG"),
+                "{keep} bytes: {e}"
+            );
+        }
         // Sizes come from the header alone.
         let img = image::RgbImage::new(40, 3);
         let mut bytes = std::io::Cursor::new(Vec::new());
