@@ -502,3 +502,100 @@ fn a_missing_companion_option_is_named() {
         refused(&args, d, &["required arguments were not provided", missing]);
     }
 }
+
+/// No command writes into an atlas, its inputs or not: an atlas holds what the bake wrote.
+#[test]
+fn no_output_lands_inside_an_atlas() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |n: &str| d.join(n).display().to_string();
+    let (good, forest_file) = bush_forest(d, false);
+    // An atlas that none of the commands reads.
+    let other = d.join("other.atlas");
+    edited_atlas(&good, &other, |_| {});
+    let inside = |n: &str| other.join(n).display().to_string();
+    for n in ["a.png", "b.png"] {
+        image::RgbaImage::from_pixel(8, 8, image::Rgba([9, 9, 9, 255]))
+            .save(d.join(n))
+            .unwrap();
+    }
+    let walk = d.join("walk.json");
+    let mut path = forest_format::camera_path::CameraPath::new(60.0);
+    path.push(
+        glam::Vec3::new(0.0, 1.7, 20.0),
+        glam::Vec3::new(0.0, 2.0, 0.0),
+    );
+    path.save(&walk).unwrap();
+    let bush = model("bush");
+    let atlas = good.display().to_string();
+    let cases: [(Vec<String>, &str); 6] = [
+        (
+            vec![
+                "render".into(),
+                forest_file.clone(),
+                "-o".into(),
+                inside("x.png"),
+                "--view".into(),
+                "hill".into(),
+            ],
+            "output",
+        ),
+        (
+            vec![
+                "scene".into(),
+                "--trees".into(),
+                "2".into(),
+                "--species".into(),
+                atlas.clone(),
+                "-o".into(),
+                inside("f.json"),
+            ],
+            "output",
+        ),
+        (
+            vec![
+                "compare".into(),
+                p("a.png"),
+                p("b.png"),
+                "--flip-map".into(),
+                inside("m.png"),
+            ],
+            "FLIP map",
+        ),
+        (
+            vec!["bake".into(), bush, "-o".into(), inside("inner.atlas")],
+            "output atlas's folder",
+        ),
+        (
+            vec![
+                "bench".into(),
+                "storage".into(),
+                "--species".into(),
+                atlas,
+                "--out".into(),
+                inside("results"),
+            ],
+            "--out results folder",
+        ),
+        (
+            vec![
+                "view".into(),
+                forest_file,
+                "--path".into(),
+                walk.display().to_string(),
+                "--frames".into(),
+                p(""),
+                "--record".into(),
+                inside("r.json"),
+            ],
+            "--record",
+        ),
+    ];
+    for (args, what) in cases {
+        refused(
+            &strs(&args),
+            d,
+            &[what, "lies inside the atlas", "other.atlas"],
+        );
+    }
+}

@@ -315,14 +315,18 @@ fn check(args: &BakeArgs, params: &forest_format::BakeParams) -> Result<u64> {
     // the outputs never overwrite each other.
     let inputs = forest_bake::source_files(&args.model)?;
     crate::guard::not_an_input(&args.output, "output atlas", &inputs)?;
+    // An atlas is rebaked in place, but never inside another atlas.
+    if let Some(parent) = args.output.parent().filter(|p| !p.as_os_str().is_empty()) {
+        crate::guard::not_in_atlas(parent, "output atlas's folder")?;
+    }
     if let Some(p) = &args.contact_sheet {
-        crate::guard::not_an_input(p, "contact sheet", &inputs)?;
+        crate::guard::output(p, "contact sheet", &inputs)?;
         crate::guard::apart_from(p, "contact sheet", &args.output, "output atlas")?;
         crate::guard::extension(p, "contact sheet", "PNG", &["png"])?;
         check_output_file(p, "contact sheet")?;
     }
     if let Some(p) = &args.depth_exr {
-        crate::guard::not_an_input(p, "depth EXR", &inputs)?;
+        crate::guard::output(p, "depth EXR", &inputs)?;
         crate::guard::apart_from(p, "depth EXR", &args.output, "output atlas")?;
         if let Some(c) = &args.contact_sheet {
             crate::guard::apart_from(p, "depth EXR", c, "contact sheet")?;

@@ -24,7 +24,7 @@ pub struct CompareArgs {
 pub fn run(args: &CompareArgs) -> Result<()> {
     if let Some(p) = &args.flip_map {
         let inputs = [args.reference.clone(), args.test.clone()];
-        crate::guard::not_an_input(p, "FLIP map", &inputs)?;
+        crate::guard::output(p, "FLIP map", &inputs)?;
         crate::guard::extension(p, "FLIP map", "PNG", &["png"])?;
     }
     let open = |p: &PathBuf| -> Result<image::RgbaImage> {

@@ -23,6 +23,13 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
+/// Refuse `output` (described as `what`) when it is, holds or lies inside one of `inputs`,
+/// or lies inside any atlas ([`not_in_atlas`]): the check every command's outputs pass.
+pub fn output(output: &Path, what: &str, inputs: &[PathBuf]) -> Result<()> {
+    not_an_input(output, what, inputs)?;
+    not_in_atlas(output, what)
+}
+
 /// Refuse `output` (described as `what`) when it is, holds or lies inside one of `inputs`.
 pub fn not_an_input(output: &Path, what: &str, inputs: &[PathBuf]) -> Result<()> {
     apart(output, what, inputs, "input")

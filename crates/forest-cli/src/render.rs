@@ -92,7 +92,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     for (name, _) in &cameras {
         let out = output_for(&args.output, name, cameras.len());
-        crate::guard::not_an_input(&out, "output", &inputs)?;
+        crate::guard::output(&out, "output", &inputs)?;
         crate::guard::extension(&out, "output", "PNG", &["png"])?;
         let parent = out.parent().filter(|p| !p.as_os_str().is_empty());
         if let Some(p) = parent

@@ -224,7 +224,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     if !matches!(args.terrain.as_str(), "flat" | "hills") {
         inputs.push(PathBuf::from(&args.terrain));
     }
-    crate::guard::not_an_input(&args.output, "output", &inputs)?;
+    crate::guard::output(&args.output, "output", &inputs)?;
     let mut species = Vec::new();
     // Every atlas loaded whole, as render loads it: a forest is not written over atlases
     // that render would refuse.

@@ -157,8 +157,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     for m in &args_models.models {
         inputs.extend(forest_bake::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
     }
-    crate::guard::not_an_input(&args.record, "--record", &inputs)?;
-    crate::guard::not_in_atlas(&args.record, "--record")?;
+    crate::guard::output(&args.record, "--record", &inputs)?;
     crate::guard::extension(&args.record, "--record", "a camera path (JSON)", &["json"])?;
     crate::guard::not_in_atlas(&args.screenshots, "screenshot folder")?;
     let Some(frames) = &args.frames else {
@@ -188,7 +187,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     inputs.extend(forest.species.iter().map(|s| dir.join(s)));
     let frame_file = |i: usize| frames.join(format!("frame-{i:05}.png"));
     for i in 0..path.keys.len() {
-        crate::guard::not_an_input(&frame_file(i), "frame", &inputs)?;
+        crate::guard::output(&frame_file(i), "frame", &inputs)?;
     }
     let mesh_method = args_models.checked_method(forest.species.len())?;
     let ctx = crate::gpu_context()?;

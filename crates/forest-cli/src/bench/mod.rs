@@ -167,10 +167,10 @@ impl Bench {
         if args.frames == 0 {
             bail!("--frames 0: measure at least 1 frame per setting");
         }
-        // The results never land inside an input: an atlas, a model, or a folder holding one.
+        // The results never land inside an input: an atlas, a model (given, or found beside
+        // the assets), a model's material library or texture, or a folder holding one.
         let inputs: Vec<PathBuf> = args.species.iter().chain(&args.models).cloned().collect();
-        crate::guard::not_an_input(&args.out, "--out results folder", &inputs)?;
-        crate::guard::not_in_atlas(&args.out, "--out results folder")?;
+        crate::guard::output(&args.out, "--out results folder", &inputs)?;
         let species = args
             .species
             .iter()
@@ -192,6 +192,11 @@ impl Bench {
         } else {
             args.models.clone()
         };
+        let mut inputs = inputs;
+        for m in &models {
+            inputs.extend(forest_bake::source_files(m).unwrap_or_else(|_| vec![m.clone()]));
+        }
+        crate::guard::output(&args.out, "--out results folder", &inputs)?;
         std::fs::create_dir_all(&args.out)
             .with_context(|| format!("creating {}", args.out.display()))?;
         let ctx = crate::gpu_context()?;
