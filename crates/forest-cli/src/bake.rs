@@ -481,7 +481,7 @@ pub fn info(args: &InfoArgs) -> Result<()> {
     // The prepared model, checked as a renderer checks it.
     let model = forest_format::model::PreparedModel::load(&args.atlas)?;
     if let Some(model) = &model {
-        model.check_source(&args.atlas, &m.source.hash)?;
+        model.check_atlas(&args.atlas, m)?;
     }
     let mut files = atlas.file_bytes();
     let model_path = args.atlas.join(forest_format::model::MODEL_FILE);

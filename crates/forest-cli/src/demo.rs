@@ -100,7 +100,15 @@ fn prepare_in(root: &Path, bake_args: &[&str]) -> Result<Demo> {
         let atlas = atlases.join(format!("{s}.atlas"));
         let manifest = atlas.join(forest_format::atlas::MANIFEST_FILE);
         let fresh = match modified(&manifest) {
-            Some(t) => t >= newest_in(&dir)? && forest_format::Atlas::load(&atlas).is_ok(),
+            // Loadable by this version, its prepared model included.
+            Some(t) => {
+                t >= newest_in(&dir)?
+                    && forest_format::Atlas::load(&atlas).is_ok_and(|a| {
+                        forest_format::model::PreparedModel::load(&atlas).is_ok_and(|m| {
+                            m.is_some_and(|m| m.check_atlas(&atlas, &a.manifest).is_ok())
+                        })
+                    })
+            }
             None => false,
         };
         if !fresh {

@@ -194,6 +194,80 @@ pub fn triangulate_sphere(dirs: &[Vec3]) -> (Vec<[u32; 3]>, Vec<[u32; 3]>) {
     (upper, lower)
 }
 
+/// Check that `tris` triangulate one half of `dirs` as [`triangulate_sphere`] makes them: the
+/// directions with `y ≥ 0` in [`disk_point`] (`lower` false) or those with `y ≤ 0` in
+/// [`disk_point_lower`]. Every triangle names three distinct directions of that half and
+/// all turn the same way (or have no area: nearly collinear directions); each directed edge is used once, an inner edge by two triangles
+/// in opposite senses; the edges used once bound the half's convex hull; and every direction
+/// of the half is a corner. Any Delaunay tie the bake broke either way passes; a changed
+/// index does not. The error names the first triangle or direction at fault.
+pub fn check_triangulation(dirs: &[Vec3], tris: &[[u32; 3]], lower: bool) -> Result<(), String> {
+    let n = dirs.len() as u32;
+    let half = |i: u32| {
+        i < n && {
+            let d = dirs[i as usize];
+            if lower { d.y <= 0.0 } else { d.y >= 0.0 }
+        }
+    };
+    let at = |i: u32| {
+        let d = dirs[i as usize];
+        let p = if lower {
+            disk_point_lower(d)
+        } else {
+            disk_point(d)
+        };
+        (f64::from(p.x), f64::from(p.y))
+    };
+    let cross = |a: u32, b: u32, c: u32| {
+        let (pa, pb, pc) = (at(a), at(b), at(c));
+        (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0)
+    };
+    let members: Vec<u32> = (0..n).filter(|&i| half(i)).collect();
+    // Rounding leaves some triangles of (nearly) collinear directions with no area; the
+    // others all turn the first one's way (delaunator's is clockwise here).
+    const FLAT: f64 = 1e-9;
+    let sense = tris
+        .iter()
+        .filter(|t| t.iter().all(|&i| half(i)))
+        .map(|&[a, b, c]| cross(a, b, c))
+        .find(|x| x.abs() > FLAT)
+        .map_or(1.0, f64::signum);
+    let mut edges = std::collections::HashSet::new();
+    for t in tris {
+        let [a, b, c] = *t;
+        if !(half(a) && half(b) && half(c)) || a == b || b == c || a == c {
+            return Err(format!(
+                "triangle {t:?} does not name three directions of its half"
+            ));
+        }
+        if sense * cross(a, b, c) < -FLAT {
+            return Err(format!("triangle {t:?} turns against the others"));
+        }
+        for e in [(a, b), (b, c), (c, a)] {
+            if !edges.insert(e) {
+                return Err(format!("triangle {t:?} overlaps another along {e:?}"));
+            }
+        }
+    }
+    for &(a, b) in &edges {
+        if !edges.contains(&(b, a))
+            && let Some(&p) = members.iter().find(|&&p| sense * cross(a, b, p) < -1e-6)
+        {
+            return Err(format!(
+                "edge ({a}, {b}) bounds the triangles, but direction {p} lies beyond it"
+            ));
+        }
+    }
+    if !tris.is_empty()
+        && let Some(p) = members
+            .iter()
+            .find(|&&p| !edges.iter().any(|&(a, _)| a == p))
+    {
+        return Err(format!("direction {p} is no triangle's corner"));
+    }
+    Ok(())
+}
+
 /// The 1–3 directions blended for a view, with weights summing to 1 (unused slots weigh 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Blend {
@@ -273,6 +347,39 @@ pub fn blend(dirs: &[Vec3], upper: &[[u32; 3]], lower: &[[u32; 3]], view: Vec3) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_bakes_triangulations_pass_their_check_and_a_changed_index_does_not() {
+        let mut changed = 0;
+        for upper in 1..=40 {
+            for below in [0, 1, 2, 5, 12] {
+                let dirs = sampling_directions(upper, below);
+                let (up, lo) = triangulate_sphere(&dirs);
+                for (tris, lower) in [(&up, false), (&lo, true)] {
+                    check_triangulation(&dirs, tris, lower)
+                        .unwrap_or_else(|e| panic!("{upper} + {below}: {e}"));
+                    // Every corner of every triangle moved to every other direction.
+                    for t in 0..tris.len() {
+                        for corner in 0..3 {
+                            for to in 0..dirs.len() as u32 {
+                                let mut bad = tris.clone();
+                                if bad[t][corner] == to {
+                                    continue;
+                                }
+                                bad[t][corner] = to;
+                                assert!(
+                                    check_triangulation(&dirs, &bad, lower).is_err(),
+                                    "{upper} + {below}: {bad:?} passed"
+                                );
+                                changed += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(changed > 10_000, "{changed}");
+    }
 
     #[test]
     fn default_set_has_15_unit_upper_directions() {

@@ -6,8 +6,10 @@
 //! `forest bake` writes it into the atlas folder as [`MODEL_FILE`]; it records the hash of the
 //! model it was prepared from, which must equal the atlas manifest's `source.hash`.
 //!
-//! The file: an uncompressed header (magic, version, counts, the few scalars), then one zlib
-//! stream holding the arrays in a fixed order. Every count is checked, and the inflated size
+//! The file: an uncompressed header (magic, version, counts, the few scalars, and an FNV-1a
+//! 64 checksum of the header's bytes before it), then one zlib stream holding the arrays in a
+//! fixed order (zlib's Adler-32 covers them). A header changed by a byte is refused, whatever
+//! the value it was changed to. Every count is checked, and the inflated size
 //! computed from them bounded, before anything is allocated; every index is checked against
 //! what it indexes, so a renderer can upload the arrays as they are.
 
@@ -22,7 +24,7 @@ pub const MODEL_FILE: &str = "model.bin";
 /// The file's first eight bytes.
 pub const MODEL_MAGIC: [u8; 8] = *b"FORESTMD";
 /// The format version this crate reads and writes.
-pub const MODEL_VERSION: u32 = 1;
+pub const MODEL_VERSION: u32 = 2;
 /// Side (texels) of every material texture layer.
 pub const MATERIAL_TEXTURE_SIZE: u32 = 512;
 /// Billboard image side (texels).
@@ -211,8 +213,17 @@ struct Header {
 
 const HEADER_U32S: usize = 12;
 const HEADER_F32S: usize = 9;
-/// Magic, version, then the header's words.
-const HEADER_BYTES: usize = 8 + 4 + 4 * (HEADER_U32S + HEADER_F32S);
+/// Magic, version, the header's words, then their checksum.
+const HEADER_BYTES: usize = SUMMED_BYTES + 8;
+/// The header's bytes its checksum covers: magic, version and words.
+const SUMMED_BYTES: usize = 8 + 4 + 4 * (HEADER_U32S + HEADER_F32S);
+
+/// FNV-1a 64 of `bytes`: the header's checksum.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
 const MATERIAL_BYTES: u64 = 24;
 
 impl Header {
@@ -449,6 +460,8 @@ impl PreparedModel {
             .for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
         f.iter()
             .for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+        let sum = fnv1a(&out);
+        out.extend_from_slice(&sum.to_le_bytes());
         let mut z = flate2::write::ZlibEncoder::new(out, flate2::Compression::fast());
         std::io::Write::write_all(&mut z, &payload).expect("writing to memory");
         z.finish().expect("writing to memory")
@@ -504,6 +517,14 @@ impl PreparedModel {
                 "{} bytes, shorter than its {HEADER_BYTES}-byte header",
                 bytes.len()
             )));
+        }
+        let sum = u64::from_le_bytes(bytes[SUMMED_BYTES..HEADER_BYTES].try_into().expect("8"));
+        if sum != fnv1a(&bytes[..SUMMED_BYTES]) {
+            return Err(bad(
+                "its header does not match its checksum (the file was changed or damaged): \
+                 bake the model again"
+                    .into(),
+            ));
         }
         let u: [u32; HEADER_U32S] = std::array::from_fn(|i| word(12 + 4 * i));
         let f: [f32; HEADER_F32S] =
@@ -606,6 +627,10 @@ impl PreparedModel {
             },
         };
         model.check_indices().map_err(bad)?;
+        model
+            .opacity
+            .check_scale()
+            .map_err(|e| bad(format!("opacity volume: {e}")))?;
         Ok(model)
     }
 
@@ -672,6 +697,39 @@ impl PreparedModel {
         }
         if !self.leaf_centre.iter().flatten().all(|v| v.is_finite()) {
             return Err("a leaf centre is not finite".into());
+        }
+        Ok(())
+    }
+
+    /// Refuse a model that is not its atlas's: prepared from another model file
+    /// ([`Self::check_source`]), or with another bounding sphere or opacity scale than the
+    /// manifest records (both come from the same bake; `atlas` names the folder).
+    pub fn check_atlas(
+        &self,
+        atlas: &Path,
+        manifest: &crate::atlas::AtlasManifest,
+    ) -> Result<(), FormatError> {
+        self.check_source(atlas, &manifest.source.hash)?;
+        let bad = |what: String| Err(FormatError::invalid(atlas.join(MODEL_FILE), what));
+        let s = manifest.bounding_sphere;
+        let [x, y, z, r] = self.sphere;
+        let off = (glam::Vec3::new(x, y, z) - s.center)
+            .abs()
+            .max_element()
+            .max((r - s.radius).abs());
+        // NaN fails too.
+        if off.is_nan() || off > 1e-5 * s.radius {
+            return bad(format!(
+                "its bounding sphere (centre [{x}, {y}, {z}], radius {r}) is not the atlas's \
+                 (centre {}, radius {}): bake the model again",
+                s.center, s.radius
+            ));
+        }
+        if self.opacity.max_depth != manifest.opacity.max_depth {
+            return bad(format!(
+                "its opacity volume's max_depth {} is not the atlas's {}: bake the model again",
+                self.opacity.max_depth, manifest.opacity.max_depth
+            ));
         }
         Ok(())
     }

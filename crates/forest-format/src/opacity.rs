@@ -282,11 +282,30 @@ impl OpacityVolume {
                 ),
             ));
         }
-        Ok(Self {
+        let v = Self {
             resolution,
             max_depth,
             codes: img.into_raw(),
-        })
+        };
+        v.check_scale().map_err(|e| FormatError::invalid(file, e))?;
+        Ok(v)
+    }
+
+    /// Check the codes against `max_depth` as [`Self::from_depths`] writes them: the densest
+    /// voxel codes as 255 when `max_depth` > 0, and every code is 0 when it is 0.
+    pub fn check_scale(&self) -> Result<(), String> {
+        let densest = self.codes.iter().copied().max().unwrap_or(0);
+        match (self.max_depth > 0.0, densest) {
+            (true, 255) | (false, 0) => Ok(()),
+            (true, c) => Err(format!(
+                "the densest voxel codes as {c}, but a volume of max_depth {} codes its \
+                 densest as 255",
+                self.max_depth
+            )),
+            (false, c) => Err(format!(
+                "max_depth is 0 (no self-shadowing), but a voxel codes as {c}"
+            )),
+        }
     }
 }
 

@@ -93,7 +93,7 @@ fn renderer_alone(
         reverse_z: true,
         viewport: (w, h),
         min_epsilon: args.settings.epsilon,
-        atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO),
+        atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO, 1.0),
         ..Default::default()
     };
     let scene = std::sync::Arc::new(GpuScene::new(ctx, species, forest)?);

@@ -122,7 +122,7 @@ impl AssetLoader for AtlasLoader {
         let model = match files.iter().find(|(n, _)| *n == MODEL_FILE) {
             Some((_, Ok(bytes))) => {
                 let model = PreparedModel::decode(bytes, &shown.join(MODEL_FILE))?;
-                model.check_source(&shown, &atlas.manifest.source.hash)?;
+                model.check_atlas(&shown, &atlas.manifest)?;
                 Some(Arc::new(model))
             }
             _ => None,

@@ -99,9 +99,9 @@ pub enum Falloff {
 ///
 /// Bevy mixes its fog colour into the exposed colour as it is; the forest tints its horizon
 /// colour by the frame's sky irradiance over the default light's (so that a sinking sun dims
-/// the haze), so the horizon given here is the fog colour divided by that tint. No fog:
-/// clear air.
-pub fn atmosphere(fog: Option<(Vec3, Falloff)>, sky: Vec3) -> Atmosphere {
+/// the haze) and scales it by the `exposure` as every radiance, so the horizon given here
+/// is the fog colour divided by that tint and that exposure. No fog: clear air.
+pub fn atmosphere(fog: Option<(Vec3, Falloff)>, sky: Vec3, exposure: f32) -> Atmosphere {
     let Some((colour, falloff)) = fog else {
         return Atmosphere {
             sun_disc: false,
@@ -120,7 +120,12 @@ pub fn atmosphere(fog: Option<(Vec3, Falloff)>, sky: Vec3) -> Atmosphere {
     } else {
         reference
     };
-    let colour = (colour.max(Vec3::ZERO) * reference / tint).to_array();
+    let exposure = if exposure.is_finite() && exposure > 0.0 {
+        exposure
+    } else {
+        1.0
+    };
+    let colour = (colour.max(Vec3::ZERO) * reference / tint / exposure).to_array();
     Atmosphere {
         visibility: if visibility.is_finite() && visibility > 0.0 {
             visibility
@@ -182,12 +187,13 @@ mod tests {
 
     /// Each falloff leaves 2 % contrast at the visibility it is given, and the haze's colour,
     /// once the forest tints it by the sky (`sky_tint` in environment.wgsl), is Bevy's fog
-    /// colour whatever Bevy's light units.
+    /// colour whatever Bevy's light units and exposure.
     #[test]
     fn fog_visibility_leaves_two_percent() {
         let colour = Vec3::new(0.5, 0.6, 0.7);
         let sky = Vec3::new(800.0, 1000.0, 1500.0);
-        let fog = |falloff| atmosphere(Some((colour, falloff)), sky);
+        let exposure = 0.25;
+        let fog = |falloff| atmosphere(Some((colour, falloff)), sky, exposure);
         let exp = fog(Falloff::Exponential { density: 0.01 });
         assert!(((-0.01 * exp.visibility).exp() - 0.02).abs() < 1e-4);
         let sq = fog(Falloff::ExponentialSquared { density: 0.01 });
@@ -199,10 +205,10 @@ mod tests {
         assert!((1.0 - (lin.visibility - 10.0) / 100.0 - 0.02).abs() < 1e-4);
         assert_eq!(exp.haze_height, f32::INFINITY);
         let reference = Vec3::from_array(Lighting::default().sky.to_array());
-        let seen = Vec3::from_array(exp.horizon) * sky / reference;
+        let seen = Vec3::from_array(exp.horizon) * sky / reference * exposure;
         assert!((seen - colour).abs().max_element() < 1e-4, "{seen}");
         // No fog: no haze.
-        assert_eq!(atmosphere(None, sky).visibility, f32::INFINITY);
+        assert_eq!(atmosphere(None, sky, 1.0).visibility, f32::INFINITY);
         // Degenerate fog or light: no NaN.
         assert_eq!(
             fog(Falloff::Exponential { density: 0.0 }).visibility,
@@ -211,6 +217,7 @@ mod tests {
         let dark = atmosphere(
             Some((colour, Falloff::Exponential { density: 0.01 })),
             Vec3::ZERO,
+            0.0,
         );
         assert!(dark.horizon.iter().all(|c| c.is_finite()));
     }

@@ -69,7 +69,7 @@ pub fn models_for(
             let atlas = dir.join(name);
             let model = PreparedModel::load(&atlas)?
                 .ok_or_else(|| ModelSourceError::NoModel(atlas.clone()))?;
-            model.check_source(&atlas, &s.atlas.manifest.source.hash)?;
+            model.check_atlas(&atlas, &s.atlas.manifest)?;
             Ok(GeometrySpecies::new(model.into(), &s.atlas.manifest))
         })
         .collect::<Result<Vec<_>, ModelSourceError>>()?;

@@ -319,23 +319,43 @@ impl AtlasManifest {
                 total
             ));
         }
-        for (i, f) in self.directions.iter().enumerate() {
-            let ok = [f.dir, f.right, f.up]
+        // The frames are the params' directions (within rounding of the platform's
+        // trigonometry), and the triangles triangulate them.
+        let want = directions::sampling_directions(self.params.directions, self.params.below);
+        for (i, (f, &d)) in self.directions.iter().zip(&want).enumerate() {
+            let w = DirectionFrame::new(d);
+            let close = [(f.dir, w.dir), (f.right, w.right), (f.up, w.up)]
                 .iter()
-                .all(|v| v.is_finite() && (v.length() - 1.0).abs() < 1e-3);
-            if !ok {
-                return bad(format!("direction {i} is not a unit frame"));
+                .all(|(a, b)| a.is_finite() && a.abs_diff_eq(*b, 1e-4));
+            if !close {
+                return bad(format!(
+                    "direction {i} is not the frame of the params' direction {i} (dir {}, right \
+                     {}, up {}; expected {}, {}, {})",
+                    f.dir, f.right, f.up, w.dir, w.right, w.up
+                ));
             }
         }
-        if let Some(t) = self
-            .direction_triangles
-            .iter()
-            .chain(&self.lower_triangles)
-            .find(|t| t.iter().any(|&i| i >= total))
-        {
-            return bad(format!(
-                "direction triangle {t:?} names a direction beyond {total}"
-            ));
+        let dirs = self.direction_vectors();
+        directions::check_triangulation(&dirs, &self.direction_triangles, false)
+            .or_else(|e| bad(format!("direction_triangles: {e}")))?;
+        if self.params.below == 0 && !self.lower_triangles.is_empty() {
+            return bad("lower_triangles given for an atlas without directions below".into());
+        }
+        directions::check_triangulation(&dirs, &self.lower_triangles, true)
+            .or_else(|e| bad(format!("lower_triangles: {e}")))?;
+        // Empty lists pass the check above; they are right only where there is nothing to
+        // triangulate (fewer than three directions in a half).
+        let (upper, lower) = directions::triangulate_sphere(&dirs);
+        for (name, stored, made) in [
+            ("direction_triangles", &self.direction_triangles, upper),
+            ("lower_triangles", &self.lower_triangles, lower),
+        ] {
+            if stored.is_empty() && !made.is_empty() {
+                return bad(format!(
+                    "{name} is empty, but its directions make {} triangles",
+                    made.len()
+                ));
+            }
         }
         let s = &self.bounding_sphere;
         if !(s.center.is_finite() && s.radius.is_finite() && s.radius > 0.0) {

@@ -637,7 +637,15 @@ fn parse_manifest(mpath: &Path, bytes: &[u8]) -> Result<AtlasManifest, FormatErr
             path: mpath.to_path_buf(),
             source,
         })?;
+    let mut manifest = manifest;
     manifest.check(mpath)?;
+    // The frames as this program computes them from the params, which the stored ones
+    // were checked to be within rounding of.
+    manifest.directions =
+        crate::directions::sampling_directions(manifest.params.directions, manifest.params.below)
+            .into_iter()
+            .map(crate::slab::DirectionFrame::new)
+            .collect();
     Ok(manifest)
 }
 

@@ -168,7 +168,7 @@ pub(crate) fn tiny() -> PreparedModel {
             resolution: VOLUME_RESOLUTION,
             max_depth: 1.5,
             codes: (0..VOLUME_RESOLUTION.pow(3))
-                .map(|i| (i % 251) as u8)
+                .map(|i| (i % 256) as u8)
                 .collect(),
         },
     }
@@ -212,6 +212,13 @@ fn a_model_that_is_not_a_file_is_named() {
     }
 }
 
+/// `bytes` with its header's checksum made right again after an edit of the header.
+fn resummed(mut bytes: Vec<u8>) -> Vec<u8> {
+    let sum = fnv1a(&bytes[..SUMMED_BYTES]);
+    bytes[SUMMED_BYTES..HEADER_BYTES].copy_from_slice(&sum.to_le_bytes());
+    bytes
+}
+
 fn refused(bytes: &[u8]) -> String {
     PreparedModel::decode(bytes, Path::new("m.bin"))
         .unwrap_err()
@@ -230,19 +237,29 @@ fn bad_files_are_refused_with_their_cause() {
     // Truncated arrays.
     let e = refused(&good[..good.len() - 10]);
     assert!(e.contains("inflate"), "{e}");
-    // A header claiming a huge count is refused before anything is allocated.
+    // A header changed anywhere but its checksum not: refused, whatever the change.
+    let mut changed = good.clone();
+    changed[20] ^= 1;
+    let e = refused(&changed);
+    assert!(e.contains("checksum"), "{e}");
+    // The header's counts are checked too (a file written with a wrong count, its checksum
+    // right). A header claiming a huge count is refused before anything is allocated.
     let mut huge = good.clone();
     huge[12..16].copy_from_slice(&(u32::MAX / 3 * 3).to_le_bytes());
+    let huge = resummed(huge);
     assert!(refused(&huge).contains("cannot hold"), "{}", refused(&huge));
     // Counts that do not make triangles, or disagree with the arrays.
     let mut odd = good.clone();
     odd[16..20].copy_from_slice(&4u32.to_le_bytes());
+    let odd = resummed(odd);
     assert!(refused(&odd).contains("whole triangles"));
     let mut branches = good.clone();
     branches[24..28].copy_from_slice(&12u32.to_le_bytes());
+    let branches = resummed(branches);
     assert!(refused(&branches).contains("12 branch vertices of LOD 0's 9"));
     let mut more = good.clone();
     more[16..20].copy_from_slice(&6u32.to_le_bytes());
+    let more = resummed(more);
     assert!(refused(&more).contains("inflate to"), "{}", refused(&more));
     // A bounding sphere beyond a model's coordinates, or a volume denser than an atlas may
     // record, is named (a radius of 1e30 once drew every crown nearly black).

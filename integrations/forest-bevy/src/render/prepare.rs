@@ -438,7 +438,7 @@ impl ForestRenderState {
             reverse_z: true,
             viewport: view.viewport,
             min_epsilon: cam.settings.epsilon,
-            atmosphere: light::atmosphere(cam.fog, cam.ambient),
+            atmosphere: light::atmosphere(cam.fog, cam.ambient, view.camera.exposure),
             write_depth: cam.settings.write_depth,
             ..Default::default()
         };

@@ -395,7 +395,7 @@ fn reference_over(
         sample_count: samples,
         viewport: SIZE,
         min_epsilon: epsilon,
-        atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO),
+        atmosphere: forest_bevy::light::atmosphere(None, Vec3::ZERO, 1.0),
         ..Default::default()
     };
     let stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
