@@ -4,6 +4,8 @@
 //! eye-height cameras inside the forest; then the same walkthrough through a forest at real
 //! tree sizes and the demo's density (`walkthrough-real`).
 
+use std::path::Path;
+
 use anyhow::{Context, Result};
 use forest_baselines::geometry::{Lods, MeshMethod, Stochastic, downsample};
 use forest_baselines::hybrid::{Hybrid, Near};
@@ -622,6 +624,13 @@ pub fn redraw(b: &Bench) -> Result<Section> {
     let path = b.out.join("accuracy.csv");
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("reading {} (run the accuracy suite first)", path.display()))?;
+    report(b, read_table(&text, &path)?)
+}
+
+/// The table of an `accuracy.csv` (`text`, read from `path`, which errors name), each row
+/// checked by [`check_row`]; files written before the work columns or the exact fragment
+/// counts were added are read as they are.
+fn read_table(text: &str, path: &Path) -> Result<Table> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
     // Files written before the work columns were added have the first columns only.
@@ -645,7 +654,7 @@ pub fn redraw(b: &Bench) -> Result<Section> {
             .with_context(|| format!("{}, line {}", path.display(), i + 2))?;
         table.push(row);
     }
-    report(b, table)
+    Ok(table)
 }
 
 /// A row of `accuracy.csv` as `--redraw` takes it: its names usable in file names (views and
@@ -732,6 +741,53 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(e.contains(cause), "{view} {ms} {flip}: {e}");
+        }
+    }
+
+    /// A cell as a hostile results file may hold it: any float as Rust prints it (NaN,
+    /// infinities, subnormals, ±1e308), its spellings, words, empty, separators.
+    fn cell() -> impl proptest::strategy::Strategy<Value = String> {
+        use proptest::prelude::*;
+        prop_oneof![
+            any::<f64>().prop_map(|v| v.to_string()),
+            any::<f64>().prop_map(|v| format!("{v:e}")),
+            (0.0f64..1.0).prop_map(|v| v.to_string()),
+            prop::sample::select(vec![
+                "", "NaN", "inf", "-inf", "abc", "1e999", "-0", " 1", "."
+            ])
+            .prop_map(String::from),
+            r"[a-z./\\\x00-\x1f]{0,6}",
+        ]
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config::with_cases(256))]
+
+        /// Any table of hostile cells is read or refused, never with a panic; what is read
+        /// holds finite figures in their ranges and names usable as file names.
+        #[test]
+        fn any_csv_is_read_checked_or_refused(
+            rows in proptest::collection::vec(proptest::collection::vec(cell(), columns().len()), 0..5),
+            short in proptest::bool::ANY,
+        ) {
+            let header = columns();
+            let mut text = header.join(",") + "\n";
+            for r in &rows {
+                let cells = if short { &r[..r.len() - 1] } else { &r[..] };
+                text += &(cells.join(",") + "\n");
+            }
+            if let Ok(table) = read_table(&text, Path::new("accuracy.csv")) {
+                for row in &table.rows {
+                    for (name, c) in header.iter().zip(row) {
+                        if matches!(*name, "method" | "param" | "view") {
+                            proptest::prop_assert!(!c.contains('/') && !c.starts_with('.'));
+                        } else if *name != "work_source" && !c.is_empty() {
+                            let v: f64 = c.trim().parse().unwrap();
+                            proptest::prop_assert!(v.is_finite(), "{name} = {c}");
+                        }
+                    }
+                }
+            }
         }
     }
 }

@@ -323,4 +323,50 @@ mod tests {
             assert!(dir.path().join("x.png").is_file());
         }
     }
+
+    /// A value as any results may hold it: any float (NaN, infinities, subnormals, the
+    /// largest), or an ordinary figure.
+    fn value() -> impl proptest::strategy::Strategy<Value = f64> {
+        use proptest::prelude::*;
+        prop_oneof![
+            any::<f64>(),
+            -1e6f64..1e6,
+            prop::sample::select(vec![0.0, f64::MAX, -f64::MAX, f64::MIN_POSITIVE, 1e-320]),
+        ]
+    }
+
+    proptest::proptest! {
+        // Each case draws a chart: the count of cases bounds the test, not a clock.
+        #![proptest_config(proptest::test_runner::Config::with_cases(48))]
+
+        /// Any values, on linear or log axes, are drawn without a panic and the drawing
+        /// returns (the padding that once overflowed made it loop for good).
+        #[test]
+        fn any_values_are_drawn(
+            series in proptest::collection::vec(
+                proptest::collection::vec((value(), value()), 0..6), 1..4),
+            log_x in proptest::bool::ANY,
+            log_y in proptest::bool::ANY,
+        ) {
+            let c = Chart {
+                title: "any".into(),
+                log_x,
+                log_y,
+                series: series
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, points)| Series {
+                        name: format!("s{k}"),
+                        points,
+                        line: k % 2 == 0,
+                        front: true,
+                    })
+                    .collect(),
+                ..Default::default()
+            };
+            let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+            register_font();
+            draw(BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area(), &c).unwrap();
+        }
+    }
 }
