@@ -49,6 +49,7 @@ pub mod slab;
 pub mod species;
 pub mod terrain;
 pub mod trim;
+pub mod wind;
 
 pub use atlas::{Atlas, AtlasManifest, BakeParams, ColourEncoding, PlaneFit};
 pub use error::FormatError;

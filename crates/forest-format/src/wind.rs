@@ -1,0 +1,350 @@
+//! Wind: one model of how trees move, evaluated alike by every method on the GPU
+//! (`wind.wgsl` in forest-render, operation for operation) and here on the CPU.
+//!
+//! The frame carries the wind ([`Wind`]: where it blows, its mean speed, its gustiness and the
+//! instant) in the camera uniform. Every method moves a tree's points by [`Wind::swayed`], a
+//! function of the point's world position, the tree's foot and height and its instance
+//! index, so that the same point of the same tree moves alike whichever form draws it: a
+//! model's vertex, a quad's corner, a billboard's corner. Each form samples the motion at its
+//! own vertices: per vertex near (geometry), per node further (a quad's corners), per tree
+//! far (a composited quad's or a billboard's corners). Nothing is baked: every atlas sways.
+//!
+//! The motion, after the main and detail bending of GPU Gems 3 ch. 16 (CryEngine):
+//!
+//! - **Gusts** travel downwind at the mean speed as waves over the canopy (two sines along the
+//!   wind, 37 m and 17 m long, their crests bent across it), so neighbouring trees lean in
+//!   turn, not in phase. The speed a tree feels is `u = speed · (1 + gustiness · n)`,
+//!   `n ∈ [−1, 1]` the waves at its foot.
+//! - **Bending** of the whole tree, its top moved by `height · (lean + sway)`: the lean grows
+//!   with the drag, `BEND · u²`, saturating at [`MAX_LEAN`]; the sway oscillates about it at
+//!   the tree's own frequency (`2.2 / √height` Hz, 0.15 to 2 Hz: tall trees sway slowly), with
+//!   a phase from a hash of the instance, along the wind and, less, across it. A point at
+//!   height `h` above the foot moves by the top's offset times `(h / height)²`, then back
+//!   onto its distance from the foot, so the trunk bends instead of stretching.
+//! - **Flutter** of branches and leaves: a few centimetres at 2 to 3 Hz, growing with the
+//!   distance from the trunk's axis and the height, mostly vertical, its phase varying
+//!   smoothly through the crown (a wave through space), so a branch moves as one.
+//!
+//! With no wind (speed 0) every point stays exactly where it is.
+
+use glam::{Vec2, Vec3};
+
+/// The highest mean wind speed taken (m/s): a violent storm on the Beaufort scale (11) is
+/// 28.5 to 32.6 m/s, a hurricane from 32.7; beyond 50 m/s the model means nothing.
+pub const MAX_SPEED: f32 = 50.0;
+/// The largest instant taken (seconds, either sign; about 28 hours): f32 phases stay within
+/// a sixtieth of a cycle up to it. Hosts running longer wrap their clock.
+pub const MAX_TIME: f32 = 1.0e5;
+/// The gustiness of [`Wind::new`]: gusts from half to one and a half times the mean speed.
+pub const DEFAULT_GUSTINESS: f32 = 0.5;
+/// The lean's growth with the squared speed (fraction of the height per (m/s)²).
+pub const BEND: f32 = 2.5e-4;
+/// The lean a tree approaches in the strongest wind (a fraction of its height).
+pub const MAX_LEAN: f32 = 0.2;
+/// Flutter amplitude per m/s of wind at the crown's rim and top (metres).
+pub const FLUTTER: f32 = 0.004;
+/// A point higher than this many times the tree's height bends as if at it (a bounding
+/// sphere's top lies above the model's).
+pub const MAX_RELATIVE_HEIGHT: f32 = 1.5;
+
+const TAU: f32 = std::f32::consts::TAU;
+
+/// The wind of a frame.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Wind {
+    /// The azimuth it blows towards, degrees from +Z towards +X (as the sun's azimuth).
+    pub towards_deg: f32,
+    /// Mean speed, m/s: 0 (calm) to [`MAX_SPEED`].
+    pub speed: f32,
+    /// How much gusts vary the speed: 0 (steady) to 1 (from calm to twice the mean).
+    pub gustiness: f32,
+    /// The instant, seconds: within ±[`MAX_TIME`].
+    pub time: f32,
+}
+
+impl Default for Wind {
+    /// Calm.
+    fn default() -> Self {
+        Self::CALM
+    }
+}
+
+/// Where and how tall a tree stands, for [`Wind::swayed`]: what every method knows of an
+/// instance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SwayedTree {
+    /// The tree's foot (world, metres): its instance's position.
+    pub foot: Vec3,
+    /// Its height above the foot (metres, > 0): the top of its bounding sphere, scaled.
+    pub height: f32,
+    /// Its crown's radius (metres, > 0): the bounding sphere's, scaled.
+    pub radius: f32,
+    /// Its instance index (the phase of its sway).
+    pub seed: u32,
+}
+
+impl Wind {
+    /// No wind: nothing moves.
+    pub const CALM: Self = Self {
+        towards_deg: 0.0,
+        speed: 0.0,
+        gustiness: DEFAULT_GUSTINESS,
+        time: 0.0,
+    };
+
+    /// A wind blowing towards `towards_deg` at `speed` m/s, [`DEFAULT_GUSTINESS`], at time 0.
+    pub fn new(towards_deg: f32, speed: f32) -> Self {
+        Self {
+            towards_deg,
+            speed,
+            ..Self::CALM
+        }
+    }
+
+    /// The same wind at instant `time` (seconds).
+    pub fn at(self, time: f32) -> Self {
+        Self { time, ..self }
+    }
+
+    /// Check every field against its bound; the error names the field and the bound.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.towards_deg.is_finite() {
+            return Err(format!(
+                "wind direction {} is not a number of degrees",
+                self.towards_deg
+            ));
+        }
+        if !(self.speed.is_finite() && (0.0..=MAX_SPEED).contains(&self.speed)) {
+            return Err(format!(
+                "wind speed {} m/s: expected 0 to {MAX_SPEED} m/s",
+                self.speed
+            ));
+        }
+        if !(self.gustiness.is_finite() && (0.0..=1.0).contains(&self.gustiness)) {
+            return Err(format!(
+                "wind gustiness {}: expected 0 (steady) to 1",
+                self.gustiness
+            ));
+        }
+        if !(self.time.is_finite() && self.time.abs() <= MAX_TIME) {
+            return Err(format!(
+                "wind time {} s: expected within ±{MAX_TIME:e} s (wrap a longer clock)",
+                self.time
+            ));
+        }
+        Ok(())
+    }
+
+    /// The unit direction it blows towards, (x, z) in the world.
+    pub fn direction(&self) -> Vec2 {
+        let a = self.towards_deg.to_radians();
+        Vec2::new(a.sin(), a.cos())
+    }
+
+    /// The camera uniform's two vectors: (direction x, direction z, speed, gustiness) and
+    /// (time, 0, 0, 0).
+    pub fn uniform(&self) -> [[f32; 4]; 2] {
+        let d = self.direction();
+        [
+            [d.x, d.y, self.speed, self.gustiness],
+            [self.time, 0.0, 0.0, 0.0],
+        ]
+    }
+
+    /// The farthest any point of a tree of `height` metres moves (metres): what its bounding
+    /// sphere grows by, so that no tree is culled while a part of it is on screen.
+    pub fn reach(&self, height: f32) -> f32 {
+        reach(&self.uniform(), height)
+    }
+
+    /// Where point `p` (world, metres) of `tree` is in this wind.
+    pub fn swayed(&self, p: Vec3, tree: &SwayedTree) -> Vec3 {
+        swayed(&self.uniform(), p, tree)
+    }
+}
+
+/// [`Wind::reach`] from the uniform's vectors (`wind.wgsl`'s `wind_reach`).
+pub fn reach(w: &[[f32; 4]; 2], height: f32) -> f32 {
+    let [_, _, speed, gust] = w[0];
+    if speed <= 0.0 {
+        return 0.0;
+    }
+    let u = speed * (1.0 + gust);
+    let lean = lean_of(u);
+    let top = height * (lean * (1.25 + 0.8 * gust)) * MAX_RELATIVE_HEIGHT * MAX_RELATIVE_HEIGHT;
+    2.0 * (top + FLUTTER * u * MAX_RELATIVE_HEIGHT)
+}
+
+/// The lean (top's offset over the height) at speed `u`: `BEND · u²`, saturating at
+/// [`MAX_LEAN`].
+fn lean_of(u: f32) -> f32 {
+    let b = BEND * u * u;
+    b / (1.0 + b / MAX_LEAN)
+}
+
+/// A 32-bit integer hash (PCG's output permutation), the same on the GPU.
+pub fn hash(x: u32) -> u32 {
+    let h = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let h = ((h >> ((h >> 28) + 4)) ^ h).wrapping_mul(277_803_737);
+    (h >> 22) ^ h
+}
+
+/// [`hash`] as a number in [0, 1).
+fn hash01(x: u32) -> f32 {
+    (hash(x) >> 8) as f32 / 16_777_216.0
+}
+
+/// The gust waves at a foot `at` (world x, z) at `time`: in [−1, 1], travelling downwind
+/// (`dir`) at `speed`.
+fn gusts(dir: Vec2, speed: f32, time: f32, at: Vec2) -> f32 {
+    let s = at.dot(dir) - speed * time;
+    let c = at.dot(Vec2::new(-dir.y, dir.x));
+    0.6 * (TAU * s / 37.0 + 0.9 * (TAU * c / 53.0).sin()).sin()
+        + 0.4 * (TAU * s / 17.0 + 2.1 + 0.7 * (TAU * c / 29.0).sin()).sin()
+}
+
+/// [`Wind::swayed`] from the uniform's vectors (`wind.wgsl`'s `swayed`).
+pub fn swayed(w: &[[f32; 4]; 2], p: Vec3, tree: &SwayedTree) -> Vec3 {
+    let [dx, dz, speed, gust] = w[0];
+    let time = w[1][0];
+    if speed <= 0.0 {
+        return p;
+    }
+    let dir = Vec2::new(dx, dz);
+    let foot = tree.foot;
+    let height = tree.height.max(1e-3);
+    let u = (speed * (1.0 + gust * gusts(dir, speed, time, Vec2::new(foot.x, foot.z)))).max(0.0);
+    let lean = lean_of(u);
+    // The sway about the lean, at the tree's own frequency and phase.
+    let freq = (2.2 / height.sqrt()).clamp(0.15, 2.0);
+    let phase = hash01(tree.seed);
+    let along = lean * (0.25 + 0.5 * gust) * (TAU * (freq * time + phase)).sin();
+    let across = lean * (0.1 + 0.3 * gust) * (TAU * (1.37 * freq * time + 2.0 * phase) + 1.0).sin();
+    let top = Vec3::new(dx, 0.0, dz) * (lean + along) + Vec3::new(-dz, 0.0, dx) * across;
+    let q = p - foot;
+    let rel = (q.y / height).clamp(0.0, MAX_RELATIVE_HEIGHT);
+    // Flutter: growing from the trunk's axis outwards and upwards, a wave through the crown.
+    let rim = (Vec2::new(q.x, q.z).length() / tree.radius.max(1e-3)).min(1.0);
+    let wave = q.dot(Vec3::new(1.9, 2.3, 1.7)) + TAU * phase;
+    let flutter_freq = 2.0 + phase;
+    let flutter = FLUTTER * u * rim * rel * (TAU * flutter_freq * time + wave).sin();
+    let offset = top * (height * rel * rel) + Vec3::new(0.4 * dx, 0.6, 0.4 * dz) * flutter;
+    // Back onto the point's distance from the foot: the trunk bends, it does not stretch.
+    let moved = q + offset;
+    let len = moved.length();
+    if len > 0.0 {
+        foot + moved * (q.length() / len)
+    } else {
+        p
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tree() -> SwayedTree {
+        SwayedTree {
+            foot: Vec3::new(3.0, 1.0, -2.0),
+            height: 12.0,
+            radius: 5.0,
+            seed: 7,
+        }
+    }
+
+    #[test]
+    fn calm_moves_nothing_and_the_foot_never_moves() {
+        let p = Vec3::new(4.0, 9.0, -1.0);
+        assert_eq!(Wind::CALM.swayed(p, &tree()), p);
+        assert_eq!(Wind::CALM.reach(12.0), 0.0);
+        let storm = Wind::new(70.0, 30.0).at(12.5);
+        assert_eq!(storm.swayed(tree().foot, &tree()), tree().foot);
+    }
+
+    #[test]
+    fn the_tree_leans_downwind_more_the_higher_and_stays_within_its_reach() {
+        let t = tree();
+        for towards in [0.0f32, 90.0, 215.0] {
+            let wind = Wind {
+                gustiness: 0.0,
+                ..Wind::new(towards, 12.0)
+            };
+            let dir = wind.direction();
+            let mut last = 0.0;
+            for h in [2.0f32, 5.0, 8.0, 12.0] {
+                // The trunk: the mean over a sway period leans downwind, more at height.
+                let p = t.foot + Vec3::Y * h;
+                let mean = (0..200)
+                    .map(|k| wind.at(k as f32 * 0.05).swayed(p, &t) - p)
+                    .fold(Vec3::ZERO, |a, b| a + b)
+                    / 200.0;
+                let downwind = mean.x * dir.x + mean.z * dir.y;
+                assert!(
+                    downwind > last,
+                    "{towards}: at {h} m {downwind} after {last}"
+                );
+                last = downwind;
+            }
+            // About BEND·u²·height at the top (within the sway's spread).
+            let want = lean_of(12.0) * 12.0;
+            assert!((last - want).abs() < 0.35 * want, "{last} vs {want}");
+        }
+        // No point of the tree moves farther than the reach, over a minute of gusts.
+        let wind = Wind::new(40.0, 25.0);
+        wind.validate().unwrap();
+        let reach = wind.reach(t.height);
+        for k in 0..600 {
+            let w = wind.at(k as f32 * 0.1);
+            for p in [
+                Vec3::new(0.0, 12.0, 0.0),
+                Vec3::new(5.0, 16.0, 0.0),
+                Vec3::new(-4.0, 7.0, 3.0),
+            ] {
+                let p = t.foot + p;
+                assert!((w.swayed(p, &t) - p).length() <= reach, "{k}");
+            }
+        }
+    }
+
+    #[test]
+    fn gusts_travel_downwind_and_neighbours_are_not_in_phase() {
+        let dir = Vec2::new(0.6, 0.8);
+        // A crest at a point reaches a point 10 m downwind 1 s later at 10 m/s.
+        let a = Vec2::new(3.0, 4.0);
+        let b = a + dir * 10.0;
+        for t in [0.0f32, 0.7, 3.1] {
+            let now = gusts(dir, 10.0, t, a);
+            let later = gusts(dir, 10.0, t + 1.0, b);
+            assert!((now - later).abs() < 1e-4, "{now} {later}");
+        }
+        // Two trees side by side sway with different phases.
+        let w = Wind::new(0.0, 8.0).at(3.0);
+        let (mut t1, mut t2) = (tree(), tree());
+        t1.seed = 1;
+        t2.seed = 2;
+        let p = tree().foot + Vec3::Y * 12.0;
+        assert!((w.swayed(p, &t1) - w.swayed(p, &t2)).length() > 1e-3);
+    }
+
+    #[test]
+    fn bad_winds_are_named_with_their_bound() {
+        for (w, cause) in [
+            (Wind::new(f32::NAN, 5.0), "direction"),
+            (Wind::new(0.0, -1.0), "0 to 50"),
+            (Wind::new(0.0, f32::NAN), "wind speed"),
+            (Wind::new(0.0, 1e9), "0 to 50"),
+            (
+                Wind {
+                    gustiness: 2.0,
+                    ..Wind::new(0.0, 5.0)
+                },
+                "gustiness",
+            ),
+            (Wind::new(0.0, 5.0).at(1e9), "wrap"),
+            (Wind::new(0.0, 5.0).at(f32::INFINITY), "wind time"),
+        ] {
+            let e = w.validate().unwrap_err();
+            assert!(e.contains(cause), "{w:?}: {e}");
+        }
+    }
+}
