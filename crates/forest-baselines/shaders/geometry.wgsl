@@ -7,6 +7,7 @@
 
 #import common
 #import geometry_types
+#import wind
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -32,7 +33,8 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
     let inst = instances[i];
     let sp = geo_species[inst.species];
     let c = to_world(inst, sp.sphere.xyz);
-    let r = sp.sphere.w * inst.scale;
+    // Grown by the farthest the wind moves any of its points.
+    let r = sp.sphere.w * inst.scale + wind_reach(wind_height(sp.sphere, inst.scale));
     for (var k = 0u; k < 6u; k++) {
         let pl = camera.planes[k];
         if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) {

@@ -18,6 +18,7 @@
 #import environment
 #import shadow
 #import count
+#import wind
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -128,7 +129,10 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
             if (method.contrast != 0u) { contrast = vec4<f32>(sp.mean_leaf, sqrt(lambda)); }
         }
     }
-    let w = to_world(inst, p);
+    let sp = geo_species[inst.species];
+    // The frame's wind moves the vertex with its tree, as every method moves that point.
+    let w = swayed(to_world(inst, p), inst.position, wind_height(sp.sphere, inst.scale),
+                   sp.sphere.w * inst.scale, id);
     var out: GeoOut;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);
     out.world = w;
@@ -139,7 +143,6 @@ fn geo_vertex(vi: u32, ii: u32, shaded: bool) -> GeoOut {
     out.material = v.material;
     out.contrast = contrast;
     out.form = geo_form(id, inst, lod);
-    let sp = geo_species[inst.species];
     out.tree = vec4<f32>(to_world(inst, sp.sphere.xyz), sp.sphere.w * inst.scale);
     out.sun_vis = 1.0;
     if (shaded) {
@@ -227,7 +230,9 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     let elevation = degrees(asin(clamp(-f.y, -1.0, 1.0)));
     let e = u32(clamp(round(elevation / 30.0), 0.0, 3.0));
     var out: BillboardOut;
-    out.world = c + (right * x + up * y) * r;
+    let rest = c + (right * x + up * y) * r;
+    // The card's corners move with the tree (it sways as a whole, bending with its height).
+    out.world = swayed(rest, inst.position, wind_height(sp.sphere, inst.scale), r, id);
     out.clip = camera.view_proj * vec4<f32>(out.world, 1.0);
     out.uv = vec2<f32>(0.5 + 0.5 * x, 0.5 - 0.5 * y);
     out.layer = sp.lod_first.w + e;
@@ -235,7 +240,7 @@ fn vs_billboard(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32
     out.right = right;
     out.up = up;
     out.back = -f;
-    out.obj = to_object_point(inst, out.world);
+    out.obj = to_object_point(inst, rest);
     out.sphere = sp.sphere;
     out.species = inst.species;
     out.sun_obj = vec4<f32>(to_object_dir(inst, camera.sun), sp.opacity_depth);

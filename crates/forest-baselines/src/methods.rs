@@ -445,6 +445,15 @@ impl ForestView for ForestRenderer {
         self.stream.light()
     }
 
+    /// Both forms' wind, so that the hybrid's two forms move alike.
+    fn set_wind(&mut self, wind: forest_format::wind::Wind) -> Result<(), RenderError> {
+        self.forms_mut().try_for_each(|f| f.set_wind(wind))
+    }
+
+    fn wind(&self) -> forest_format::wind::Wind {
+        self.stream.wind()
+    }
+
     fn set_pipeline_statistics(&mut self, on: bool) {
         self.forms_mut().for_each(|f| f.set_pipeline_statistics(on));
     }

@@ -19,8 +19,13 @@
 //!   with the drag, `BEND · u²`, saturating at [`MAX_LEAN`]; the sway oscillates about it at
 //!   the tree's own frequency (`2.2 / √height` Hz, 0.15 to 2 Hz: tall trees sway slowly), with
 //!   a phase from a hash of the instance, along the wind and, less, across it. A point at
-//!   height `h` above the foot moves by the top's offset times `(h / height)²`, then back
-//!   onto its distance from the foot, so the trunk bends instead of stretching.
+//!   height `h` above the foot moves by the top's offset times `h / height`, then back onto
+//!   its distance from the foot, so the tree turns about its foot instead of stretching. The
+//!   profile is linear in height so that a quad or a card, whose corners move and whose
+//!   inside follows them linearly, moves its inside as the model's own points move: a
+//!   quadratic bend drew coarse quads and billboards swaying up to twice as far as the
+//!   model under them (measured: a storm shifted a bush's crown 0.68 px as geometry, 1.08 px
+//!   as quads, 1.77 px as an impostor).
 //! - **Flutter** of branches and leaves: a few centimetres at 2 to 3 Hz, growing with the
 //!   distance from the trunk's axis and the height, mostly vertical, its phase varying
 //!   smoothly through the crown (a wave through space), so a branch moves as one.
@@ -43,8 +48,8 @@ pub const BEND: f32 = 2.5e-4;
 pub const MAX_LEAN: f32 = 0.2;
 /// Flutter amplitude per m/s of wind at the crown's rim and top (metres).
 pub const FLUTTER: f32 = 0.004;
-/// A point higher than this many times the tree's height bends as if at it (a bounding
-/// sphere's top lies above the model's).
+/// A point higher (or lower, below the foot) than this many times the tree's height bends as
+/// if at it (a bounding sphere's top lies above the model's).
 pub const MAX_RELATIVE_HEIGHT: f32 = 1.5;
 
 const TAU: f32 = std::f32::consts::TAU;
@@ -81,6 +86,21 @@ pub struct SwayedTree {
     pub radius: f32,
     /// Its instance index (the phase of its sway).
     pub seed: u32,
+}
+
+impl SwayedTree {
+    /// The tree of an instance at `foot` scaled by `scale`, whose species' bounding sphere
+    /// (object space, the foot at y = 0) has its centre at height `centre_y` and radius
+    /// `radius`; `seed` its instance index. The height is the sphere's top (`wind.wgsl`'s
+    /// `wind_height`).
+    pub fn from_sphere(foot: Vec3, scale: f32, centre_y: f32, radius: f32, seed: u32) -> Self {
+        Self {
+            foot,
+            height: ((centre_y + radius) * scale).max(1e-3),
+            radius: radius * scale,
+            seed,
+        }
+    }
 }
 
 impl Wind {
@@ -171,7 +191,7 @@ pub fn reach(w: &[[f32; 4]; 2], height: f32) -> f32 {
     }
     let u = speed * (1.0 + gust);
     let lean = lean_of(u);
-    let top = height * (lean * (1.25 + 0.8 * gust)) * MAX_RELATIVE_HEIGHT * MAX_RELATIVE_HEIGHT;
+    let top = height * (lean * (1.25 + 0.8 * gust)) * MAX_RELATIVE_HEIGHT;
     2.0 * (top + FLUTTER * u * MAX_RELATIVE_HEIGHT)
 }
 
@@ -222,13 +242,15 @@ pub fn swayed(w: &[[f32; 4]; 2], p: Vec3, tree: &SwayedTree) -> Vec3 {
     let across = lean * (0.1 + 0.3 * gust) * (TAU * (1.37 * freq * time + 2.0 * phase) + 1.0).sin();
     let top = Vec3::new(dx, 0.0, dz) * (lean + along) + Vec3::new(-dz, 0.0, dx) * across;
     let q = p - foot;
-    let rel = (q.y / height).clamp(0.0, MAX_RELATIVE_HEIGHT);
+    // Linear in height on both sides of the foot, so that a card reaching below it (a
+    // billboard over the bounding sphere) moves as the points it shows.
+    let rel = (q.y / height).clamp(-MAX_RELATIVE_HEIGHT, MAX_RELATIVE_HEIGHT);
     // Flutter: growing from the trunk's axis outwards and upwards, a wave through the crown.
     let rim = (Vec2::new(q.x, q.z).length() / tree.radius.max(1e-3)).min(1.0);
     let wave = q.dot(Vec3::new(1.9, 2.3, 1.7)) + TAU * phase;
     let flutter_freq = 2.0 + phase;
-    let flutter = FLUTTER * u * rim * rel * (TAU * flutter_freq * time + wave).sin();
-    let offset = top * (height * rel * rel) + Vec3::new(0.4 * dx, 0.6, 0.4 * dz) * flutter;
+    let flutter = FLUTTER * u * rim * rel.max(0.0) * (TAU * flutter_freq * time + wave).sin();
+    let offset = top * (height * rel) + Vec3::new(0.4 * dx, 0.6, 0.4 * dz) * flutter;
     // Back onto the point's distance from the foot: the trunk bends, it does not stretch.
     let moved = q + offset;
     let len = moved.length();

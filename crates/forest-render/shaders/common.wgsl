@@ -57,6 +57,11 @@ struct Camera {
     // (metres). All zero: every tree casts (casts_into, forest_render::shadow::caster_planes).
     casters: array<vec4<f32>, 6>,
     caster_floor: vec4<f32>,
+    // The frame's wind (forest_format::wind::Wind::uniform, mirrored by wind.wgsl): xy the unit
+    // direction it blows towards (world x, z), z its mean speed (m/s; 0: calm), w its
+    // gustiness; wind_time.x the instant (seconds).
+    wind: vec4<f32>,
+    wind_time: vec4<f32>,
 }
 
 // Whether a caster's bounding sphere (world centre `c`, radius `r`) can shadow the light

@@ -16,6 +16,7 @@
 #import common
 #import bindings
 #import scan
+#import wind
 
 // Blend of the species' directions for an object-space view vector (unnormalised), exactly as
 // forest_format::directions::blend. Returns indices in .idx and weights in .w.
@@ -97,7 +98,8 @@ fn instance_in_order(i: u32) -> u32 {
 // its shadow can reach the view's receivers).
 fn visible(inst: Instance, sp: Species) -> bool {
     let c = to_world(inst, sp.sphere.xyz);
-    let r = sp.sphere.w * inst.scale;
+    // Grown by the farthest the wind moves any of its points.
+    let r = sp.sphere.w * inst.scale + wind_reach(wind_height(sp.sphere, inst.scale));
     for (var k = 0u; k < 6u; k++) {
         let pl = camera.planes[k];
         if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) { return false; }

@@ -36,6 +36,7 @@
 #import environment
 #import shadow
 #import count
+#import wind
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -361,6 +362,10 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
         p = slab_point(sp, f, slab, u, v, t0);
         w = to_world(inst, p);
     }
+    // The frame's wind moves the corner with its tree, as every method moves that point (the
+    // node's quads move with their corners; a composited tree sways as a whole).
+    w = swayed(w, inst.position, wind_height(sp.sphere, inst.scale), sp.sphere.w * inst.scale,
+               q.instance);
     let flags = stream_flags(camera);
     var out: QuadVertex;
     out.clip = camera.view_proj * vec4<f32>(w, 1.0);

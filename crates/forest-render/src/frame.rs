@@ -25,11 +25,14 @@ pub struct FrameParams {
     /// The frame's light: sun (world direction, colour), sky, ground and exposure. It rides in
     /// the camera uniform, so the camera stays the frame's only upload.
     pub light: forest_format::shading::Lighting,
+    /// The frame's wind, which moves every tree ([`forest_format::wind`]); it rides in the
+    /// camera uniform too.
+    pub wind: forest_format::wind::Wind,
 }
 
 impl From<&Camera> for FrameParams {
     /// The camera's matrices with the default light ([`forest_format::shading::Lighting`]'s
-    /// `Default`).
+    /// `Default`), in calm air.
     fn from(c: &Camera) -> Self {
         Self {
             view: c.view(),
@@ -37,6 +40,7 @@ impl From<&Camera> for FrameParams {
             viewport: c.viewport,
             epsilon: c.epsilon,
             light: Default::default(),
+            wind: forest_format::wind::Wind::CALM,
         }
     }
 }
@@ -70,6 +74,7 @@ impl FrameParams {
         self.light
             .validate()
             .map_err(|e| CameraError(format!("light: {e}")))?;
+        self.wind.validate().map_err(CameraError)?;
         Ok(())
     }
 
@@ -225,6 +230,7 @@ mod tests {
             viewport: (800, 600),
             epsilon: 4.0,
             light: Default::default(),
+            wind: forest_format::wind::Wind::CALM,
         };
         assert!(f.validate().is_ok());
         assert!((f.forward() - c.forward()).length() < 1e-5);

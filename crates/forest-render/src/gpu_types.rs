@@ -71,9 +71,24 @@ pub struct GpuCamera {
     /// `x`: the lowest receiver (world height, metres): no shadow falls below it; `y`: the
     /// longest sweep (metres), whatever the sun's height; `z`, `w` unused.
     pub caster_floor: [f32; 4],
+    /// The frame's wind ([`forest_format::wind::Wind::uniform`]): the unit direction it blows
+    /// towards (world x, z), its mean speed (m/s; 0: calm, nothing moves) and gustiness.
+    pub wind: [f32; 4],
+    /// `x`: the wind's instant (seconds); `y`, `z`, `w` unused.
+    pub wind_time: [f32; 4],
 }
 
 impl GpuCamera {
+    /// Write the frame's wind into the camera.
+    pub fn set_wind(&mut self, w: &forest_format::wind::Wind) {
+        [self.wind, self.wind_time] = w.uniform();
+    }
+
+    /// The wind's uniform vectors, as [`forest_format::wind::swayed`] takes them.
+    pub fn wind_uniform(&self) -> [[f32; 4]; 2] {
+        [self.wind, self.wind_time]
+    }
+
     /// Write the frame's light into the camera.
     pub fn set_light(&mut self, l: &forest_format::shading::Lighting) {
         let d = l.sun_dir.normalize_or(glam::Vec3::Y);

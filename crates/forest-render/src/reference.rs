@@ -180,7 +180,8 @@ fn xyz(v: [f32; 4]) -> Vec3 {
 
 fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> bool {
     let c = to_world(inst, xyz(sp.sphere));
-    let r = sp.sphere[3] * inst.scale;
+    let height = ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3);
+    let r = sp.sphere[3] * inst.scale + forest_format::wind::reach(&cam.wind_uniform(), height);
     cam.planes
         .iter()
         .all(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] >= -r)

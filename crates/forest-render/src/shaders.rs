@@ -46,9 +46,12 @@ pub const COUNT_OFF_WGSL: &str = include_str!("../shaders/count_off.wgsl");
 pub const COUNT_ON_WGSL: &str = include_str!("../shaders/count_on.wgsl");
 /// The overdraw view's heat map (a module of its own).
 pub const OVERDRAW_WGSL: &str = include_str!("../shaders/overdraw.wgsl");
+/// Where the frame's wind moves a tree's points (`swayed`, `wind_reach`; in a module that
+/// declares `camera`).
+pub const WIND_WGSL: &str = include_str!("../shaders/wind.wgsl");
 
 /// The runtime's modules by the names `#import` lines give.
-pub const MODULES: [(&str, &str); 15] = [
+pub const MODULES: [(&str, &str); 16] = [
     ("common", COMMON_WGSL),
     ("ground", GROUND_WGSL),
     ("environment", ENVIRONMENT_WGSL),
@@ -64,6 +67,7 @@ pub const MODULES: [(&str, &str); 15] = [
     ("count_off", COUNT_OFF_WGSL),
     ("count_on", COUNT_ON_WGSL),
     ("overdraw", OVERDRAW_WGSL),
+    ("wind", WIND_WGSL),
 ];
 
 /// Why a shader module could not be composed.

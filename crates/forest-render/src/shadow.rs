@@ -501,6 +501,8 @@ pub fn light_camera_for(
     l.set_light(light);
     l.forms = view.forms;
     l.form_eye = view.form_eye;
+    // The trees cast where the view draws them, moved by the same wind.
+    (l.wind, l.wind_time) = (view.wind, view.wind_time);
     (l.casters, l.caster_floor) = caster_planes(view, c, opts, floor);
     l
 }

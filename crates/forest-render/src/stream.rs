@@ -199,7 +199,9 @@ impl QuadStream {
                 (self.opts.depth_format, compare),
             ));
         }
-        let g = light.camera(self.drawn_options());
+        let mut g = light.camera(self.drawn_options());
+        // The trees cast where they are drawn, moved by the stream's wind.
+        g.set_wind(&self.inputs.wind());
         self.inputs.upload_cameras(queue, &[g]);
         Ok(())
     }

@@ -1,14 +1,14 @@
 //! The frame API: one prepared view of a forest, whichever method draws it.
 //!
 //! ```text
-//! set_background / set_light / set_forms / receive_host_shadows / set_host_cascades
+//! set_background / set_light / set_wind / set_forms / receive_host_shadows / set_host_cascades
 //!         (state, kept until changed)
 //! per frame: prepare (the one upload) ─► encode_compute ─► render (host's pass) ─► resolve_times
 //!            or: render_frame (headless: all of it into a cleared target, submitted)
 //! ```
 //!
 //! [`FrameInputs`] is what every form of a forest writes into its camera uniform each frame
-//! (the light, which trees it draws, the host's shadow receivers) and the uniform's buffer with
+//! (the light, the wind, which trees it draws, the host's shadow receivers) and the uniform's buffer with
 //! its upload counter. A drawing form (the quad stream; the geometry renderer of
 //! `forest-baselines`) holds one and implements [`Form`], its own passes; [`ForestView`], the
 //! frame API the front ends drive, follows for every form from that, once. A method made of
@@ -32,6 +32,7 @@ pub type HostMaps<'a> = (&'a wgpu::TextureView, u32, bool);
 pub struct FrameInputs {
     camera: wgpu::Buffer,
     light: forest_format::shading::Lighting,
+    wind: forest_format::wind::Wind,
     forms: [f32; 4],
     background: Background,
     depth_clear: f32,
@@ -59,6 +60,7 @@ impl FrameInputs {
             no_shadows: crate::receivers::no_shadows(device, &shadow_layout),
             camera,
             light: opts.lighting,
+            wind: forest_format::wind::Wind::CALM,
             forms,
             background: opts.background,
             depth_clear: opts.depth_clear(),
@@ -134,11 +136,17 @@ impl FrameInputs {
             .unwrap_or(&self.no_shadows)
     }
 
-    /// The frame's camera `g` with the inputs filled in: which trees, the light, and the
-    /// host's cascades when its shadows are received.
+    /// The wind of the frames written next.
+    pub fn wind(&self) -> forest_format::wind::Wind {
+        self.wind
+    }
+
+    /// The frame's camera `g` with the inputs filled in: which trees, the light, the wind, and
+    /// the host's cascades when its shadows are received.
     pub fn fill(&self, g: &mut GpuCamera) {
         g.forms = self.forms;
         g.set_light(&self.light);
+        g.set_wind(&self.wind);
         if let Some(h) = &self.host_shadows {
             h.write(g);
         }
@@ -228,6 +236,12 @@ pub trait ForestView {
     fn set_light(&mut self, light: forest_format::shading::Lighting) -> Result<(), RenderError>;
     /// The light frames are shaded with.
     fn light(&self) -> forest_format::shading::Lighting;
+    /// The wind of the frames written from the next [`Self::set_camera`] on (a
+    /// [`Self::prepare`] takes its frame's own wind): every method and every shadow caster
+    /// moves its trees by it ([`forest_format::wind`]). Refused when a value is out of range.
+    fn set_wind(&mut self, wind: forest_format::wind::Wind) -> Result<(), RenderError>;
+    /// The wind frames are drawn in.
+    fn wind(&self) -> forest_format::wind::Wind;
     /// Gather pipeline statistics from the next frame on, where the device has
     /// `PIPELINE_STATISTICS_QUERY` (off by default; see [`crate::work`]).
     fn set_pipeline_statistics(&mut self, on: bool);
@@ -324,6 +338,16 @@ impl<F: Form> ForestView for F {
         self.inputs().light
     }
 
+    fn set_wind(&mut self, wind: forest_format::wind::Wind) -> Result<(), RenderError> {
+        wind.validate().map_err(RenderError::Parameter)?;
+        self.inputs_mut().wind = wind;
+        Ok(())
+    }
+
+    fn wind(&self) -> forest_format::wind::Wind {
+        self.inputs().wind
+    }
+
     fn set_pipeline_statistics(&mut self, on: bool) {
         self.inputs_mut().statistics = on;
     }
@@ -364,6 +388,7 @@ impl<F: Form> ForestView for F {
     fn prepare(&mut self, queue: &wgpu::Queue, frame: &FrameParams) -> Result<(), RenderError> {
         frame.validate()?;
         self.inputs_mut().light = frame.light;
+        self.inputs_mut().wind = frame.wind;
         self.write_frame(queue, frame.to_gpu());
         Ok(())
     }

@@ -215,6 +215,7 @@ fn frame_at(eye: Vec3, at: Vec3, args: &Args) -> FrameParams {
         viewport: (w, h),
         epsilon: args.settings.epsilon,
         light: Default::default(),
+        wind: forest_format::wind::Wind::CALM,
     }
 }
 

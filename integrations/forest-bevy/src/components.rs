@@ -99,3 +99,12 @@ impl ForestMethod {
         }
     }
 }
+
+/// The wind the forests sway in: where it blows (an azimuth in Bevy's world, degrees from +Z
+/// towards +X), its mean speed (m/s) and gustiness ([`forest_format::wind::Wind`]; its
+/// `time` is ignored: Bevy's [`Time`] is the clock, wrapped within
+/// [`forest_format::wind::MAX_TIME`]). Every method and every shadow caster moves its trees
+/// by it. Without the resource the air is calm; a wind out of range is reported in
+/// [`crate::ForestStats`] and the forest is drawn calm.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct ForestWind(pub forest_format::wind::Wind);

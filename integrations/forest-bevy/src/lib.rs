@@ -7,7 +7,8 @@
 //! transparent objects and post-processing see them. Bevy's first visible
 //! `DirectionalLight`, its ambient light and the camera's exposure light the trees
 //! ([`light`]); a camera's `DistanceFog` becomes their haze. The trees cast into that light's
-//! shadow cascades and receive them ([`shadows`]). [`ForestStats`] holds each view's counters.
+//! shadow cascades and receive them ([`shadows`]). A [`ForestWind`] resource sways them on
+//! Bevy's clock. [`ForestStats`] holds each view's counters.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -53,7 +54,7 @@ use bevy::prelude::*;
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 
 pub use assets::{AtlasLoader, ForestAsset, ForestAtlas, ForestLoader, LoadError};
-pub use components::{ForestCamera, ForestMethod, ForestScene};
+pub use components::{ForestCamera, ForestMethod, ForestScene, ForestWind};
 pub use stats::{ForestStats, ForestViewStats};
 pub use terrain::{TerrainMeshError, terrain_mesh};
 

@@ -139,6 +139,24 @@ pub fn atmosphere(fog: Option<(Vec3, Falloff)>, sky: Vec3, exposure: f32) -> Atm
     }
 }
 
+/// `wind` (in Bevy's world) as a forest placed by `forest_from_world` feels it: its direction
+/// turned into the forest's space (its azimuth measured there), speed, gustiness and time as
+/// they are. A direction the transform makes vertical keeps its azimuth.
+pub fn wind_in_forest(
+    wind: forest_format::wind::Wind,
+    forest_from_world: bevy::math::Mat4,
+) -> forest_format::wind::Wind {
+    let d = wind.direction();
+    let turned = forest_from_world.transform_vector3(Vec3::new(d.x, 0.0, d.y));
+    if turned.x.hypot(turned.z) < 1e-6 {
+        return wind;
+    }
+    forest_format::wind::Wind {
+        towards_deg: turned.x.atan2(turned.z).to_degrees(),
+        ..wind
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -220,5 +238,26 @@ mod tests {
             0.0,
         );
         assert!(dark.horizon.iter().all(|c| c.is_finite()));
+    }
+
+    /// A forest turned a quarter about +Y and moved feels the world's wind in its own space:
+    /// the direction it feels, turned back into the world, is the wind's; speed, gusts and
+    /// time unchanged.
+    #[test]
+    fn the_wind_turns_into_the_forests_space() {
+        use forest_format::wind::Wind;
+        let wind = Wind::new(90.0, 12.0).at(3.5);
+        let world_from_forest = bevy::math::Mat4::from_rotation_translation(
+            bevy::math::Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            Vec3::new(100.0, 5.0, -40.0),
+        );
+        let felt = wind_in_forest(wind, world_from_forest.inverse());
+        let d = felt.direction();
+        let back = world_from_forest.transform_vector3(Vec3::new(d.x, 0.0, d.y));
+        assert!((back - Vec3::X).length() < 1e-5, "{back}");
+        assert_eq!((felt.speed, felt.gustiness, felt.time), (12.0, wind.gustiness, 3.5));
+        // Unturned: the same azimuth.
+        let same = wind_in_forest(wind, bevy::math::Mat4::from_translation(Vec3::ONE));
+        assert!((same.towards_deg - 90.0).abs() < 1e-4);
     }
 }

@@ -126,14 +126,22 @@ pub fn projection(size: (u32, u32)) -> Mat4 {
 }
 
 /// The frame parameters of a camera at `eye` looking at `target`, under the default sun (the
-/// host's own light would go in `light`: the forest is lit at run time).
-pub fn frame(eye: Vec3, target: Vec3, size: (u32, u32), epsilon: f32) -> FrameParams {
+/// host's own light would go in `light`: the forest is lit at run time), in `wind` (its
+/// `time` the host's clock: the trees move).
+pub fn frame(
+    eye: Vec3,
+    target: Vec3,
+    size: (u32, u32),
+    epsilon: f32,
+    wind: forest_format::wind::Wind,
+) -> FrameParams {
     FrameParams {
         view: glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y),
         proj: projection(size),
         viewport: size,
         epsilon,
         light: Default::default(),
+        wind,
     }
 }
 

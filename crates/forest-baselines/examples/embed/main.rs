@@ -108,7 +108,7 @@ pub fn headless_with(
         epsilon,
         shadows,
     )?;
-    let frame = host::frame(eye, target, size, epsilon);
+    let frame = host::frame(eye, target, size, epsilon, forest_format::wind::Wind::CALM);
     host.draw(&ctx.device, &ctx.queue, &out.colour_view, &frame)?;
     let img = out.read(&ctx);
     ctx.check_errors()?;
@@ -189,9 +189,18 @@ impl App {
         let (Some(eye), Some(target)) = (self.eye, self.target) else {
             return Ok(());
         };
-        let angle = self.start.elapsed().as_secs_f32() * 0.1;
-        let target = eye + glam::Quat::from_rotation_y(angle) * (target - eye);
-        let frame = host::frame(eye, target, (config.width, config.height), self.epsilon);
+        let seconds = self.start.elapsed().as_secs_f32();
+        let target = eye + glam::Quat::from_rotation_y(seconds * 0.1) * (target - eye);
+        // A fresh breeze on the host's clock (wrapped within the wind's range): the trees sway.
+        let wind =
+            forest_format::wind::Wind::new(60.0, 8.0).at(seconds % forest_format::wind::MAX_TIME);
+        let frame = host::frame(
+            eye,
+            target,
+            (config.width, config.height),
+            self.epsilon,
+            wind,
+        );
         host.draw(&ctx.device, &ctx.queue, &view, &frame)?;
         window.pre_present_notify();
         ctx.queue.present(texture);

@@ -78,6 +78,8 @@ pub fn shared() -> Vec<Expect> {
                 ("form_eye", offset_of!(GpuCamera, form_eye)),
                 ("casters", offset_of!(GpuCamera, casters)),
                 ("caster_floor", offset_of!(GpuCamera, caster_floor)),
+                ("wind", offset_of!(GpuCamera, wind)),
+                ("wind_time", offset_of!(GpuCamera, wind_time)),
             ],
         ),
         (

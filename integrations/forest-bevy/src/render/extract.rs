@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use bevy::render::Extract;
 
 use crate::assets::ForestAsset;
-use crate::components::{ForestCamera, ForestScene};
+use crate::components::{ForestCamera, ForestScene, ForestWind};
 use crate::light;
 
 /// A forest as extracted this frame.
@@ -49,6 +49,8 @@ pub struct Extracted {
     pub cameras: HashMap<Entity, ExtractedForestCamera>,
     /// The first directional light, in world space.
     pub sun: Option<light::Sun>,
+    /// The wind at this frame's instant, in world space (calm without [`ForestWind`]).
+    pub wind: forest_format::wind::Wind,
 }
 
 fn linear(c: Color) -> Vec3 {
@@ -87,6 +89,7 @@ pub fn extract(
     >,
     global_ambient: Extract<Option<Res<GlobalAmbientLight>>>,
     suns: Extract<Query<(&DirectionalLight, &GlobalTransform, &InheritedVisibility)>>,
+    (wind, time): (Extract<Option<Res<ForestWind>>>, Extract<Res<Time>>),
 ) {
     out.forests.clear();
     out.cameras.clear();
@@ -126,6 +129,10 @@ pub fn extract(
             },
         );
     }
+    out.wind = wind.as_ref().map_or(forest_format::wind::Wind::CALM, |w| {
+        let clock = time.elapsed_secs_f64() % f64::from(forest_format::wind::MAX_TIME);
+        w.0.at(clock as f32)
+    });
     out.sun = suns
         .iter()
         .find(|(_, _, v)| v.get())

@@ -241,6 +241,7 @@ pub fn prepare_forests(
             let lit = Lit {
                 sun: extracted.sun,
                 cascades: &cascades,
+                wind: extracted.wind,
             };
             let record =
                 state.prepare_forest(&ctx, &frame, forest, &scene, &lit, &mut live_casters);
@@ -264,6 +265,8 @@ pub fn prepare_forests(
 struct Lit<'a> {
     sun: Option<light::Sun>,
     cascades: &'a [shadows::HostCascade],
+    /// The wind, in world space.
+    wind: forest_format::wind::Wind,
 }
 
 impl ForestRenderState {
@@ -462,6 +465,7 @@ impl ForestRenderState {
             ..s
         });
         let lighting = light::lighting(sun, cam.ambient, view.camera.exposure);
+        let wind = light::wind_in_forest(lit.wind, forest_from_world);
         let view_from_world = view.world_from_view.inverse();
         let frame = FrameParams {
             view: light::mat_to_forest(view_from_world * forest.world_from_forest),
@@ -469,6 +473,7 @@ impl ForestRenderState {
             viewport: view.viewport,
             epsilon: cam.settings.epsilon,
             light: lighting,
+            wind,
         };
         poll_counters(ctx, v, note);
         if let Some(last) = &v.last {
@@ -482,7 +487,7 @@ impl ForestRenderState {
             let key = (view.main, forest.entity, c.layer);
             let light = shadows::light_params(c, lighting.sun_dir, frame.eye());
             let (asset, res) = (forest.asset, c.resolution);
-            if self.cast(ctx, key, asset, scene, res, sharpen, &light, &mut record) {
+            if self.cast(ctx, key, asset, scene, res, sharpen, (&light, wind), &mut record) {
                 live_casters.insert(key);
                 self.casts
                     .entry(view.main)
@@ -500,7 +505,7 @@ impl ForestRenderState {
 
     /// The stream casting a forest into one cascade layer (`key`) of a view, (re)built for
     /// another asset or map size, cast with the aspect sharpening the view draws its quads
-    /// with, its light written. Whether it casts this frame; the quads it cast in a recent
+    /// with, its light written and its trees moved by the view's wind. Whether it casts this frame; the quads it cast in a recent
     /// frame are added to `record`, and what went wrong is said there.
     #[allow(clippy::too_many_arguments)]
     fn cast(
@@ -511,7 +516,7 @@ impl ForestRenderState {
         scene: &Arc<GpuScene>,
         resolution: u32,
         sharpen: Option<u32>,
-        light: &forest_render::shadow::LightParams,
+        (light, wind): (&forest_render::shadow::LightParams, forest_format::wind::Wind),
         record: &mut ForestViewStats,
     ) -> bool {
         let opts = RendererOptions {
@@ -543,6 +548,10 @@ impl ForestRenderState {
         let Some(caster) = self.casters.get_mut(&key) else {
             return false;
         };
+        if let Err(e) = caster.stream.set_wind(wind) {
+            record.error = Some(format!("shadow caster: {e}"));
+            return false;
+        }
         if let Err(e) = caster.stream.set_sharpen_override(sharpen) {
             record.error = Some(format!("shadow caster: {e}"));
             return false;

@@ -428,6 +428,7 @@ fn reference_over(
         viewport: SIZE,
         epsilon,
         light,
+        wind: forest_format::wind::Wind::CALM,
     };
     let msaa = (samples > 1).then(|| {
         let make = |format| {
