@@ -15,7 +15,7 @@ execs=${1:-1000000}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(forest_binary forest_json camera_path nodes atlas obj gltf image)
+  targets=(forest_binary forest_json camera_path nodes atlas obj gltf image terrain model_bin results_csv wind)
 fi
 
 if ! command -v cargo-afl >/dev/null; then
@@ -59,7 +59,7 @@ done
   echo "| target | executions | execs/s | crashes | hangs | corpus | edge coverage | timeout s | seconds | date |"
   echo "|---|---|---|---|---|---|---|---|---|---|"
   # A target run now gets its new row; one not run keeps its row from the last table.
-  for t in forest_binary forest_json camera_path nodes atlas obj gltf image terrain; do
+  for t in forest_binary forest_json camera_path nodes atlas obj gltf image terrain model_bin results_csv wind; do
     if [ -f "out/fuzz/$t.row" ]; then
       cat "out/fuzz/$t.row"
     else

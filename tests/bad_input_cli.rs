@@ -599,3 +599,90 @@ fn no_output_lands_inside_an_atlas() {
         );
     }
 }
+
+/// A bad wind is named with its bound, by every command that draws, before any work.
+#[test]
+fn winds_are_named_with_their_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (atlas, forest_file) = bush_forest(d, false);
+    let png = d.join("x.png").display().to_string();
+    let atlas = atlas.display().to_string();
+    let results = d.join("results").display().to_string();
+    let cases: [(&[&str], &[&str]); 9] = [
+        (
+            &["--wind", "90,-1"],
+            &["--wind 90,-1", "expected 0 to 50 m/s"],
+        ),
+        (
+            &["--wind", "90,1e9"],
+            &["wind speed 1000000000", "0 to 50 m/s"],
+        ),
+        (
+            &["--wind", "90,nan"],
+            &["--wind", "\"nan\" is not a finite speed"],
+        ),
+        (
+            &["--wind", "abc,5"],
+            &["--wind", "not a finite number of degrees"],
+        ),
+        (
+            &["--wind", "inf,5"],
+            &["--wind", "not a finite number of degrees"],
+        ),
+        (&["--wind", "90"], &["--wind", "expected TOWARDS,SPEED"]),
+        (
+            &["--wind-gustiness", "-0.5"],
+            &["--wind-gustiness -0.5", "0 (steady) to 1"],
+        ),
+        (
+            &["--wind-time", "1e9"],
+            &["--wind-time 1000000000", "±1e5 s"],
+        ),
+        (&["--wind-time", "nan"], &["--wind-time NaN", "±1e5 s"]),
+    ];
+    for (wind, causes) in cases {
+        let mut a = vec!["render", &forest_file, "-o", &png, "--size", "32x24"];
+        a.extend(wind);
+        refused(&a, d, causes);
+        let mut a = vec!["bench", "table1", "--species", &atlas, "--frames", "1"];
+        a.extend(wind);
+        a.extend(["--out", &results]);
+        refused(&a, d, causes);
+    }
+    let walk = d.join("walk.json");
+    std::fs::write(
+        &walk,
+        r#"{"version":1,"fov_deg":60,"keys":[{"eye":[0,2,20],"target":[0,2,0]},{"eye":[0,2,20],"target":[0,2,0]}]}"#,
+    )
+    .unwrap();
+    let frames = d.join("frames");
+    std::fs::create_dir(&frames).unwrap();
+    let view = |extra: &[&str]| cli::view_frames_args(&forest_file, &walk, &frames, extra);
+    for (extra, cause) in [
+        (&["--wind", "0,51"][..], "expected 0 to 50 m/s"),
+        (
+            &["--frame-rate", "0"][..],
+            "--frame-rate 0: expected 1 to 1000",
+        ),
+        (&["--frame-rate", "nan"][..], "--frame-rate NaN"),
+    ] {
+        refused(&strs(&view(extra)), d, &[cause]);
+    }
+    // A path running past the wind's clock: refused before its first frame.
+    refused(
+        &strs(&view(&[
+            "--wind",
+            "0,5",
+            "--wind-time",
+            "99999.5",
+            "--frame-rate",
+            "1",
+        ])),
+        d,
+        &[
+            "--wind-time 99999.5 with 2 keys",
+            "the last key's wind time",
+        ],
+    );
+}

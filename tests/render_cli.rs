@@ -15,6 +15,7 @@ fn bake_scene_render_end_to_end() {
     an_atlas_without_its_model(d);
     fragment_counts_and_the_overdraw_view(d);
     view_plays_a_path_back(d);
+    wind_moves_rendered_and_viewed_frames(d);
     bad_inputs_are_refused(d);
 }
 
@@ -301,18 +302,7 @@ fn view_plays_a_path_back(d: &std::path::Path) {
     std::fs::create_dir(&frames).unwrap();
     // `forest view` of the forest along the walk into the frames folder, with `extra`.
     let forest_file = p("f.forest");
-    let view_frames = |extra: &[&str]| {
-        let mut a = vec![
-            "view",
-            &forest_file,
-            "--path",
-            walk.to_str().unwrap(),
-            "--frames",
-            frames.to_str().unwrap(),
-        ];
-        a.extend(extra);
-        forest(&a)
-    };
+    let view_frames = |extra: &[&str]| cli::view_frames(&forest_file, &walk, &frames, extra);
     let models = format!("{},{}", model("bush"), model("aspen"));
     for method in ["quads", "lods"] {
         let text = ok(&view_frames(&[
@@ -356,6 +346,72 @@ fn view_plays_a_path_back(d: &std::path::Path) {
     std::fs::write(&walk, "{\"version\":1,\"fov_deg\":60,\"keys\":[]}").unwrap();
     let e = err(&view_frames(&[]));
     assert!(e.contains("no keys"), "{e}");
+}
+
+/// `--wind` moves what `render` draws (a calm one draws the same bytes as none), and
+/// `view --frames` animates it: a still camera's frames change from key to key in wind only.
+fn wind_moves_rendered_and_viewed_frames(d: &std::path::Path) {
+    let p = |n: &str| d.join(n).display().to_string();
+    let forest_file = p("f.forest");
+    let shot = |name: &str, wind: &[&str]| {
+        let out = p(name);
+        let mut a = vec![
+            "render",
+            &forest_file,
+            "-o",
+            &out,
+            "--eye",
+            "0,3,25",
+            "--target",
+            "0,4,0",
+            "--size",
+            "64x48",
+            "--method",
+            "geometry",
+        ];
+        a.extend(wind);
+        ok(&forest(&a));
+        std::fs::read(&out).unwrap()
+    };
+    let still = shot("still.png", &[]);
+    assert_eq!(
+        shot("calm.png", &["--wind", "120,0", "--wind-time", "3"]),
+        still
+    );
+    let windy = shot("windy.png", &["--wind", "120,15", "--wind-time", "3"]);
+    assert_ne!(windy, still, "a 15 m/s wind moved nothing");
+    let later = shot("later.png", &["--wind", "120,15", "--wind-time", "3.5"]);
+    assert_ne!(
+        later, windy,
+        "half a second later the wind drew the same image"
+    );
+    // A still camera along a path: the frames change with the wind's clock only.
+    let walk = d.join("still.json");
+    let mut path = forest_format::camera_path::CameraPath::new(60.0);
+    for _ in 0..3 {
+        path.push(
+            glam::Vec3::new(0.0, 3.0, 25.0),
+            glam::Vec3::new(0.0, 4.0, 0.0),
+        );
+    }
+    path.save(&walk).unwrap();
+    let frames = d.join("wind-frames");
+    std::fs::create_dir(&frames).unwrap();
+    let play = |wind: &[&str]| {
+        let mut a = vec!["--size", "64x48"];
+        a.extend(wind);
+        ok(&cli::view_frames(&forest_file, &walk, &frames, &a));
+        (0..3)
+            .map(|i| std::fs::read(frames.join(format!("frame-{i:05}.png"))).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let calm = play(&[]);
+    assert!(calm.windows(2).all(|w| w[0] == w[1]), "calm frames differ");
+    let windy = play(&["--wind", "45,12", "--frame-rate", "10"]);
+    assert!(
+        windy.windows(2).all(|w| w[0] != w[1]),
+        "wind frames stand still"
+    );
 }
 
 /// Bad inputs: one line, non-zero exit, nothing written.

@@ -12,6 +12,25 @@ pub fn forest(args: &[&str]) -> Output {
         .expect("the forest binary runs")
 }
 
+/// The arguments of `forest view FOREST --path PATH --frames FRAMES`, then `extra`.
+pub fn view_frames_args(forest: &str, path: &Path, frames: &Path, extra: &[&str]) -> Vec<String> {
+    let mut a: Vec<String> = ["view", forest, "--path"]
+        .map(String::from)
+        .into_iter()
+        .collect();
+    a.push(path.display().to_string());
+    a.push("--frames".into());
+    a.push(frames.display().to_string());
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a
+}
+
+/// Run `forest view FOREST --path PATH --frames FRAMES`, then `extra`.
+pub fn view_frames(forest_file: &str, path: &Path, frames: &Path, extra: &[&str]) -> Output {
+    let a = view_frames_args(forest_file, path, frames, extra);
+    forest(&a.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
 /// Path of a bundled model.
 pub fn model(s: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

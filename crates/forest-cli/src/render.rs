@@ -15,7 +15,7 @@ use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
-pub use crate::render_args::{LightArgs, MethodArgs, RenderArgs, ShadowArgs};
+pub use crate::render_args::{LightArgs, MethodArgs, RenderArgs, ShadowArgs, WindArgs};
 
 /// Load a forest and its species' atlases ([`forest_render::load_scene`]), with a spinner.
 pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
@@ -52,6 +52,7 @@ pub fn noted(sourced: geometry::SourcedModels) -> PreparedGeometry {
 /// Run `forest render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     args.light.lighting()?;
+    let wind = args.wind.wind()?;
     let mut views: Vec<(String, Vec3, Vec3)> = Vec::new();
     let (forest, species) = load_scene(&args.forest)?;
     let mut settled = args.clone();
@@ -135,6 +136,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut r = ForestRenderer::new(stream, geometry);
     r.set_method(&ctx, method)?;
     r.set_shadows(&ctx.device, args.shadow.options(false)?)?;
+    r.set_wind(wind)?;
     r.set_pipeline_statistics(args.json);
     render_views(args, &ctx, &cameras, |cam, target| {
         let stats = r.render_fitted(&ctx, cam, target)?;

@@ -63,6 +63,8 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub light: LightArgs,
     #[command(flatten)]
+    pub wind: WindArgs,
+    #[command(flatten)]
     pub shadow: ShadowArgs,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
@@ -106,6 +108,48 @@ pub struct LightArgs {
     /// Exposure: every radiance is scaled by it (above 0).
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub exposure: f32,
+}
+
+/// The wind every method and every shadow caster moves the trees by (shared by `forest
+/// render`, `forest view` and the benches; see `forest_format::wind`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct WindArgs {
+    /// Wind as TOWARDS,SPEED: the azimuth it blows towards in degrees (from +Z towards +X, as
+    /// --sun's azimuth) and its mean speed in m/s (0 to 50) [default: calm]
+    #[arg(long, value_parser = forest_format::wind::parse_towards_speed, allow_hyphen_values = true)]
+    pub wind: Option<(f32, f32)>,
+    /// How much gusts vary the wind's speed: 0 (steady) to 1 (from calm to twice the mean).
+    #[arg(long, allow_negative_numbers = true, default_value_t = forest_format::wind::DEFAULT_GUSTINESS)]
+    pub wind_gustiness: f32,
+    /// The instant drawn, in seconds of the wind's clock (within ±1e5; --time is the time of
+    /// day).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
+    pub wind_time: f32,
+}
+
+impl WindArgs {
+    /// The wind asked for (calm without --wind), checked whether or not there is one: the
+    /// error names the option and the bound.
+    pub fn wind(&self) -> Result<forest_format::wind::Wind> {
+        let (towards_deg, speed) = self.wind.unwrap_or((0.0, 0.0));
+        let w = forest_format::wind::Wind {
+            towards_deg,
+            speed,
+            gustiness: self.wind_gustiness,
+            time: self.wind_time,
+        };
+        w.validate().map_err(|e| {
+            let option = if e.contains("gustiness") {
+                format!("--wind-gustiness {}", self.wind_gustiness)
+            } else if e.contains("time") {
+                format!("--wind-time {}", self.wind_time)
+            } else {
+                format!("--wind {towards_deg},{speed}")
+            };
+            anyhow::anyhow!("{option}: {e}")
+        })?;
+        Ok(w)
+    }
 }
 
 /// The sun's shadows (shared by `forest render` and `forest view`).

@@ -35,6 +35,10 @@ pub struct ViewArgs {
     /// Render the path headless to DIR/frame-00000.png, … and exit.
     #[arg(long, requires = "path")]
     pub frames: Option<PathBuf>,
+    /// Keys per second of the headless frames (--frames): key i is drawn at the wind's
+    /// instant --wind-time + i / RATE, so the frames are an animation of the wind.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 30.0)]
+    pub frame_rate: f32,
     /// Where R saves a recorded camera path (interactive mode).
     #[arg(long, default_value = "camera-path.json")]
     pub record: PathBuf,
@@ -57,6 +61,8 @@ pub struct ViewArgs {
     pub m: MethodArgs,
     #[command(flatten)]
     pub light: crate::render::LightArgs,
+    #[command(flatten)]
+    pub wind: crate::render::WindArgs,
     #[command(flatten)]
     pub shadow: crate::render::ShadowArgs,
 }
@@ -124,6 +130,13 @@ fn viewer_options(format: wgpu::TextureFormat, light: Lighting) -> RendererOptio
 /// Run `forest view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
     let light = args.light.lighting()?;
+    let wind = args.wind.wind()?;
+    if !(args.frame_rate.is_finite() && (1.0..=1000.0).contains(&args.frame_rate)) {
+        anyhow::bail!(
+            "--frame-rate {}: expected 1 to 1000 keys per second",
+            args.frame_rate
+        );
+    }
     let mut args_models = args.m.clone();
     let forest_file = match &args.forest {
         Some(f) => f.clone(),
@@ -161,13 +174,28 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     crate::guard::extension(&args.record, "--record", "a camera path (JSON)", &["json"])?;
     crate::guard::not_in_atlas(&args.screenshots, "screenshot folder")?;
     let Some(frames) = &args.frames else {
-        return interactive(args, &forest_file, &args_models, light);
+        return interactive(args, &forest_file, &args_models, light, wind);
     };
     let path_file = args
         .path
         .as_ref()
         .expect("clap requires --path with --frames");
     let path = CameraPath::load(path_file)?;
+    // The wind's instant of the last key, checked before any frame is drawn.
+    let last = path.keys.len().saturating_sub(1);
+    forest_format::wind::Wind {
+        time: wind.time + last as f32 / args.frame_rate,
+        ..wind
+    }
+    .validate()
+    .map_err(|e| {
+        anyhow::anyhow!(
+            "--wind-time {} with {} keys at --frame-rate {}: the last key's {e}",
+            wind.time,
+            path.keys.len(),
+            args.frame_rate
+        )
+    })?;
     if frames.exists() && !frames.is_dir() {
         bail!(
             "frames folder {} is a file, not a folder: name a folder for the frames",
@@ -224,6 +252,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let method = args_models.chosen(mesh_method)?;
     r.set_method(&ctx, method)?;
     r.set_shadows(&ctx.device, args.shadow.options(true)?)?;
+    r.set_wind(wind)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
     // The overdraw view: each frame counted (drawn twice more) and its heat map drawn over it.
     let counter = match args.debug_view {
@@ -237,6 +266,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     };
     let mut total_ms = 0.0;
     for (i, key) in path.keys.iter().enumerate() {
+        // The wind's instant of this key (checked: a long path may run past the clock's bound).
+        r.set_wind(forest_format::wind::Wind {
+            time: wind.time + i as f32 / args.frame_rate,
+            ..wind
+        })?;
         let cam = Camera {
             eye: Vec3::from_array(key.eye),
             target: Vec3::from_array(key.target),
@@ -276,7 +310,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 }
 
 /// The window: walk through the forest with every method at hand.
-fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Lighting) -> Result<()> {
+fn interactive(
+    args: &ViewArgs,
+    forest_file: &Path,
+    m: &MethodArgs,
+    light: Lighting,
+    wind: forest_format::wind::Wind,
+) -> Result<()> {
     let (forest, species) = load_scene(forest_file)?;
     let mut m = m.clone();
     m.settle(forest_file, &forest);
@@ -342,6 +382,7 @@ fn interactive(args: &ViewArgs, forest_file: &Path, m: &MethodArgs, light: Light
         debug_view: args.debug_view,
         hour: args.light.time.unwrap_or(12.0),
         shadows: args.shadow.options(true)?,
+        wind,
         path,
         record_to: args.record.clone(),
         screenshots: args.screenshots.clone(),

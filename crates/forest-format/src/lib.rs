@@ -44,6 +44,7 @@ pub mod node;
 pub mod nodes_codec;
 pub mod noise;
 pub mod opacity;
+pub mod results_csv;
 pub mod shading;
 pub mod slab;
 pub mod species;

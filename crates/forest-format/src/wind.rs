@@ -261,6 +261,29 @@ pub fn swayed(w: &[[f32; 4]; 2], p: Vec3, tree: &SwayedTree) -> Vec3 {
     }
 }
 
+/// Parse a wind given as `TOWARDS,SPEED` (as `--wind` takes it): the azimuth it blows
+/// towards in degrees and the mean speed in m/s, both finite numbers (the bounds are
+/// [`Wind::validate`]'s, which names them).
+pub fn parse_towards_speed(s: &str) -> Result<(f32, f32), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [towards, speed] = parts.as_slice() else {
+        return Err(format!(
+            "{s:?}: expected TOWARDS,SPEED (degrees, m/s), e.g. 60,8"
+        ));
+    };
+    let num = |x: &str, what: &str| {
+        x.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{x:?} is not a finite {what}"))
+    };
+    Ok((
+        num(towards, "number of degrees")?,
+        num(speed, "speed in m/s")?,
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

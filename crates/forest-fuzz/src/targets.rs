@@ -64,7 +64,7 @@ pub const TARGETS: &[Target] = &[
         name: "atlas",
         run: atlas,
         bound: IMAGE_BOUND,
-        covers: "atlas folder: manifest, colour, alpha and surface mosaics, nodes (`Atlas::load`)",
+        covers: "atlas folder: manifest, colour, alpha and surface mosaics, nodes, opacity volume (`Atlas::load`), and its `model.bin` checked against it (`PreparedModel::check_atlas`)",
     },
     Target {
         name: "obj",
@@ -83,6 +83,24 @@ pub const TARGETS: &[Target] = &[
         run: terrain,
         bound: IMAGE_BOUND,
         covers: "height field for `scene --terrain` (first byte: 0 a 16-bit PNG, else an EXR; then the file)",
+    },
+    Target {
+        name: "model_bin",
+        run: model_bin,
+        bound: DATA_BOUND,
+        covers: "an atlas's `model.bin` alone (`PreparedModel::decode`)",
+    },
+    Target {
+        name: "results_csv",
+        run: results_csv,
+        bound: DATA_BOUND,
+        covers: "`accuracy.csv` as `bench accuracy --redraw` reads it (`results_csv::read_accuracy`)",
+    },
+    Target {
+        name: "wind",
+        run: wind,
+        bound: DATA_BOUND,
+        covers: "`--wind`, `--wind-gustiness`, `--wind-time` and the displacement they give (`wind::parse_towards_speed`, `Wind::validate`, `Wind::swayed` within `Wind::reach`)",
     },
     Target {
         name: "image",
@@ -113,9 +131,10 @@ fn nodes(data: &[u8]) -> bool {
     forest_format::nodes_codec::decode(data).is_ok()
 }
 
-/// Files: manifest, colour mosaic, alpha mosaic, nodes, surface mosaic, opacity volume.
+/// Files: manifest, colour mosaic, alpha mosaic, nodes, surface mosaic, opacity volume, and
+/// `model.bin` (none when empty), which must be the atlas's.
 fn atlas(data: &[u8]) -> bool {
-    let files = crate::split_files(data, 6);
+    let files = crate::split_files(data, 7);
     let read = |name: &str| -> Result<Vec<u8>, forest_format::FormatError> {
         Ok(match name {
             MANIFEST_FILE => files[0],
@@ -127,7 +146,15 @@ fn atlas(data: &[u8]) -> bool {
         }
         .to_vec())
     };
-    Atlas::from_files(Path::new("fuzz.atlas"), &read).is_ok()
+    let Ok(atlas) = Atlas::from_files(Path::new("fuzz.atlas"), &read) else {
+        return false;
+    };
+    if files[6].is_empty() {
+        return true;
+    }
+    forest_format::model::PreparedModel::decode(files[6], Path::new("fuzz.atlas/model.bin"))
+        .and_then(|m| m.check_atlas(Path::new("fuzz.atlas"), &atlas.manifest))
+        .is_ok()
 }
 
 thread_local! {
@@ -191,4 +218,80 @@ fn image(data: &[u8]) -> bool {
     let img = img.into_rgba8();
     img.width() as u64 * img.height() as u64 > 1 << 16
         || forest_metrics::compare(&img, &img).is_ok()
+}
+
+/// An atlas's `model.bin` alone (the atlas target checks one against its atlas).
+fn model_bin(data: &[u8]) -> bool {
+    forest_format::model::PreparedModel::decode(data, Path::new("fuzz.atlas/model.bin")).is_ok()
+}
+
+/// An `accuracy.csv` (the command line reads it as UTF-8 text).
+fn results_csv(data: &[u8]) -> bool {
+    std::str::from_utf8(data)
+        .is_ok_and(|text| forest_format::results_csv::read_accuracy(text).is_ok())
+}
+
+/// Lines: `--wind`'s value, `--wind-gustiness`, `--wind-time`, then a tree and points as
+/// numbers (foot x z, height, crown radius, seed, then x y z of each point). A wind that
+/// passes its checks must move every point of the tree by a finite amount within the reach
+/// its culls grow bounds by; a violation panics (a crash the fuzzer records).
+fn wind(data: &[u8]) -> bool {
+    use forest_format::wind::{SwayedTree, Wind, parse_towards_speed};
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    let mut lines = text.lines();
+    let Ok((towards_deg, speed)) = parse_towards_speed(lines.next().unwrap_or_default()) else {
+        return false;
+    };
+    let mut number = || lines.next().and_then(|l| l.trim().parse::<f32>().ok());
+    let (Some(gustiness), Some(time)) = (number(), number()) else {
+        return false;
+    };
+    let w = Wind {
+        towards_deg,
+        speed,
+        gustiness,
+        time,
+    };
+    if w.validate().is_err() {
+        return false;
+    }
+    let rest: Vec<f32> = lines
+        .flat_map(str::split_whitespace)
+        .filter_map(|v| v.parse().ok())
+        .filter(|v: &f32| v.is_finite())
+        .take(3 * 64 + 5)
+        .collect();
+    let at = |i: usize, default: f32| rest.get(i).copied().unwrap_or(default);
+    // A tree as forests hold them: feet within the coordinate bound, sizes in metres.
+    let bound = forest_format::limits::MAX_COORDINATE;
+    let foot = glam::Vec3::new(
+        at(0, 0.0).clamp(-bound, bound),
+        0.0,
+        at(1, 0.0).clamp(-bound, bound),
+    );
+    let height = at(2, 10.0).abs().clamp(0.01, 200.0);
+    let radius = at(3, 4.0).abs().clamp(0.01, 200.0);
+    let tree = SwayedTree {
+        foot,
+        height,
+        radius,
+        seed: at(4, 0.0).abs().min(u32::MAX as f32) as u32,
+    };
+    let reach = w.reach(height);
+    for p in rest.get(5..).unwrap_or_default().chunks_exact(3) {
+        // Points of the tree: within its bounding sphere about the foot.
+        let local = glam::Vec3::new(p[0], p[1], p[2]).clamp_length_max(height.max(radius));
+        let q = foot + local;
+        let moved = w.swayed(q, &tree);
+        let d = (moved - q).length();
+        // Rounding: a few ulps of the coordinates (1 m at 1e7 m from the origin).
+        let ulps = 4.0 * f32::EPSILON * q.abs().max_element().max(moved.abs().max_element());
+        assert!(
+            moved.is_finite() && d <= reach * (1.0 + 1e-3) + 1e-3 + ulps,
+            "{w:?}, {tree:?}: {q} moved {d} m, reach {reach} m"
+        );
+    }
+    true
 }

@@ -125,3 +125,18 @@ fn gltf() {
 fn terrain() {
     smoke("terrain", 9);
 }
+
+#[test]
+fn model_bin() {
+    smoke("model_bin", 10);
+}
+
+#[test]
+fn results_csv() {
+    smoke("results_csv", 11);
+}
+
+#[test]
+fn wind() {
+    smoke("wind", 12);
+}

@@ -110,22 +110,7 @@ pub fn views(
     ]
 }
 
-/// Columns of `accuracy.csv`.
-const COLUMNS: [&str; 8] = [
-    "method",
-    "param",
-    "view",
-    "frame_ms",
-    "flip_mean",
-    "ssim",
-    "psnr",
-    "primitives",
-];
-
-/// Columns of `accuracy.csv`: [`COLUMNS`], then the work columns.
-fn columns() -> Vec<&'static str> {
-    COLUMNS.iter().copied().chain(super::WORK_COLUMNS).collect()
-}
+use forest_format::results_csv::{ACCURACY_COLUMNS as COLUMNS, accuracy_columns as columns};
 
 /// Seed of the walkthrough cameras.
 pub const WALK_SEED: u64 = 0x3a1f_2c77;
@@ -628,166 +613,12 @@ pub fn redraw(b: &Bench) -> Result<Section> {
 }
 
 /// The table of an `accuracy.csv` (`text`, read from `path`, which errors name), each row
-/// checked by [`check_row`]; files written before the work columns or the exact fragment
-/// counts were added are read as they are.
+/// checked ([`forest_format::results_csv::read_accuracy`]).
 fn read_table(text: &str, path: &Path) -> Result<Table> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    // Files written before the work columns were added have the first columns only.
-    // Or before the exact fragment counts: the first ten work columns.
-    let all = columns();
-    let before_exact = &all[..COLUMNS.len() + 10];
-    let mut table = Table::new(&all);
-    if header == COLUMNS {
-        table = Table::new(&COLUMNS);
-    } else if header == before_exact {
-        table = Table::new(before_exact);
-    } else if header != table.header {
-        anyhow::bail!("{}: unexpected columns {header:?}", path.display());
-    }
-    for (i, l) in lines.enumerate().filter(|(_, l)| !l.is_empty()) {
-        let row: Vec<String> = l.split(',').map(str::to_string).collect();
-        if row.len() != table.header.len() {
-            anyhow::bail!("{}: a row with {} cells: {l}", path.display(), row.len());
-        }
-        check_row(&table.header, &row)
-            .with_context(|| format!("{}, line {}", path.display(), i + 2))?;
-        table.push(row);
-    }
-    Ok(table)
-}
-
-/// A row of `accuracy.csv` as `--redraw` takes it: its names usable in file names (views and
-/// methods name the charts), every figure empty (not measured) or a finite number in its
-/// range: shares and FLIP in 0 to 1, SSIM in −1 to 1, the rest 0 or more.
-fn check_row(header: &[&str], row: &[String]) -> Result<()> {
-    for (name, cell) in header.iter().zip(row) {
-        match *name {
-            "method" | "param" | "view" => check_name(name, cell)?,
-            "work_source" => {}
-            _ if cell.is_empty() => {}
-            _ => {
-                let v: f64 = cell
-                    .trim()
-                    .parse()
-                    .map_err(|_| anyhow::anyhow!("{name} is {cell:?}, not a number"))?;
-                let (lo, hi) = match *name {
-                    "flip_mean" | "transparent_share" | "hidden_share" => (0.0, 1.0),
-                    "ssim" => (-1.0, 1.0),
-                    _ => (0.0, f64::INFINITY),
-                };
-                if !v.is_finite() || v < lo || v > hi {
-                    let range = if hi.is_finite() {
-                        format!("{lo} to {hi}")
-                    } else {
-                        format!("a finite {lo} or more")
-                    };
-                    anyhow::bail!("{name} is {cell}: expected {range}");
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// A name from a results file that becomes part of a chart's file name: not empty (but a
-/// method's parameter may be), no path separator, control character or leading dot.
-fn check_name(what: &str, name: &str) -> Result<()> {
-    let bad = name.starts_with('.')
-        || name
-            .chars()
-            .any(|c| c == '/' || c == '\\' || c.is_control())
-        || (name.is_empty() && what != "param");
-    if bad {
-        anyhow::bail!(
-            "{what} {name:?} cannot name a chart file: no '/', '\\', control characters or \
-             leading '.'"
-        );
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn row(view: &str, frame_ms: &str, flip: &str) -> Vec<String> {
-        let mut r: Vec<String> = columns().iter().map(|_| String::new()).collect();
-        r[0] = "quads".into();
-        r[2] = view.into();
-        r[3] = frame_ms.into();
-        r[4] = flip.into();
-        r
-    }
-
-    /// `--redraw` takes finite figures in their ranges and names the cell otherwise; names
-    /// that would leave the results folder as chart paths are refused.
-    #[test]
-    fn redrawn_rows_are_checked_cell_by_cell() {
-        let header = columns();
-        assert!(check_row(&header, &row("inside", "1.5", "0.2")).is_ok());
-        assert!(check_row(&header, &row("inside", "1e308", "0")).is_ok());
-        for (view, ms, flip, cause) in [
-            ("inside", "NaN", "0.2", "frame_ms is NaN"),
-            ("inside", "abc", "0.2", "not a number"),
-            ("inside", "-5", "0.2", "frame_ms is -5"),
-            ("inside", "inf", "0.2", "frame_ms is inf"),
-            ("inside", "1", "1.5", "flip_mean is 1.5: expected 0 to 1"),
-            ("x/y", "1", "0.2", "cannot name a chart file"),
-            ("../../escaped", "1", "0.2", "cannot name a chart file"),
-            ("", "1", "0.2", "cannot name a chart file"),
-        ] {
-            let e = check_row(&header, &row(view, ms, flip))
-                .unwrap_err()
-                .to_string();
-            assert!(e.contains(cause), "{view} {ms} {flip}: {e}");
-        }
-    }
-
-    /// A cell as a hostile results file may hold it: any float as Rust prints it (NaN,
-    /// infinities, subnormals, ±1e308), its spellings, words, empty, separators.
-    fn cell() -> impl proptest::strategy::Strategy<Value = String> {
-        use proptest::prelude::*;
-        prop_oneof![
-            any::<f64>().prop_map(|v| v.to_string()),
-            any::<f64>().prop_map(|v| format!("{v:e}")),
-            (0.0f64..1.0).prop_map(|v| v.to_string()),
-            prop::sample::select(vec![
-                "", "NaN", "inf", "-inf", "abc", "1e999", "-0", " 1", "."
-            ])
-            .prop_map(String::from),
-            r"[a-z./\\\x00-\x1f]{0,6}",
-        ]
-    }
-
-    proptest::proptest! {
-        #![proptest_config(proptest::test_runner::Config::with_cases(256))]
-
-        /// Any table of hostile cells is read or refused, never with a panic; what is read
-        /// holds finite figures in their ranges and names usable as file names.
-        #[test]
-        fn any_csv_is_read_checked_or_refused(
-            rows in proptest::collection::vec(proptest::collection::vec(cell(), columns().len()), 0..5),
-            short in proptest::bool::ANY,
-        ) {
-            let header = columns();
-            let mut text = header.join(",") + "\n";
-            for r in &rows {
-                let cells = if short { &r[..r.len() - 1] } else { &r[..] };
-                text += &(cells.join(",") + "\n");
-            }
-            if let Ok(table) = read_table(&text, Path::new("accuracy.csv")) {
-                for row in &table.rows {
-                    for (name, c) in header.iter().zip(row) {
-                        if matches!(*name, "method" | "param" | "view") {
-                            proptest::prop_assert!(!c.contains('/') && !c.starts_with('.'));
-                        } else if *name != "work_source" && !c.is_empty() {
-                            let v: f64 = c.trim().parse().unwrap();
-                            proptest::prop_assert!(v.is_finite(), "{name} = {c}");
-                        }
-                    }
-                }
-            }
-        }
-    }
+    let t = forest_format::results_csv::read_accuracy(text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(Table {
+        header: t.header,
+        rows: t.rows,
+    })
 }

@@ -96,6 +96,9 @@ pub struct BenchArgs {
     /// suite draws frames with and without them whatever this says).
     #[command(flatten)]
     pub shadow: crate::render::ShadowArgs,
+    /// The wind every suite's frames are drawn in (calm unless `--wind`).
+    #[command(flatten)]
+    pub wind: crate::render::WindArgs,
 }
 
 /// What every suite works with.
@@ -127,6 +130,8 @@ pub struct Bench {
     pub methods: Vec<String>,
     /// The sun's shadows every suite's renderers draw (`--shadows`), or none.
     pub shadows: Option<forest_render::shadow::ShadowOptions>,
+    /// The wind every suite's renderers draw in (`--wind`).
+    pub wind: forest_format::wind::Wind,
 }
 
 /// Every method at its default parameters, in the order the suites report them.
@@ -227,6 +232,7 @@ impl Bench {
             views: args.views.clone(),
             methods: args.methods.clone(),
             shadows: args.shadow.options(false)?,
+            wind: args.wind.wind()?,
         })
     }
 
@@ -379,9 +385,11 @@ impl Bench {
         self.shadowed(ForestRenderer::new(stream, geo))
     }
 
-    /// `r` drawing the shadows the suites were asked for (`--shadows`).
+    /// `r` drawing the shadows the suites were asked for (`--shadows`), in their wind
+    /// (`--wind`).
     pub fn shadowed(&self, mut r: ForestRenderer) -> Result<ForestRenderer> {
         r.set_shadows(&self.ctx.device, self.shadows)?;
+        r.set_wind(self.wind)?;
         Ok(r)
     }
 
@@ -527,34 +535,7 @@ pub struct ViewWork {
     pub counts: FragmentCounts,
 }
 
-/// Columns of the work a frame asked of the GPU, appended to the suites' tables (see
-/// [`forest_render::work`]): recorded dispatches and draws; vertex and fragment shader
-/// invocations, rasterised primitives and compute invocations from pipeline-statistics
-/// queries (empty where the adapter has none; lavapipe counts fragments per 4×4 stamp, GPUs
-/// per 2×2 quad); MB of buffers and textures the frame can touch; the pixels the trees cover
-/// (alpha of the method's transparent render) and stamp fragments per covered pixel. Then the
-/// exact counts ([`forest_render::fragments`]): tree fragment invocations per covered pixel
-/// (mean, median, 95th percentile over covered pixels), the 2×2-quad lanes a GPU would run
-/// per covered pixel, and the shares of invocations that showed nothing (transparent) or were
-/// shown behind an opaque fragment (hidden).
-pub const WORK_COLUMNS: [&str; 16] = [
-    "dispatches",
-    "draws",
-    "vertex_invocations",
-    "primitives_rasterised",
-    "fragment_invocations",
-    "compute_invocations",
-    "gpu_mb",
-    "covered_pixels",
-    "fragments_per_covered_pixel",
-    "work_source",
-    "exact_fragments_per_covered_pixel",
-    "exact_median",
-    "exact_p95",
-    "quad_lanes_per_covered_pixel",
-    "transparent_share",
-    "hidden_share",
-];
+pub use forest_format::results_csv::WORK_COLUMNS;
 
 /// The [`WORK_COLUMNS`] cells of views' work: means over the views (one view: its counts),
 /// fragments per covered pixel as a ratio of sums, the exact counts of all views' pixels

@@ -21,6 +21,12 @@ impl Viewer {
         let terrain = self.terrain.as_ref();
         let ground = |x, z| forest_format::terrain::ground_height(terrain, x, z);
         self.walker.step(&self.keys, dt, ground);
+        // The wind's clock runs in real time (a stall is not skipped: the trees catch up),
+        // wrapped so that it stays within the wind's bound.
+        let span = 2.0 * forest_format::wind::MAX_TIME;
+        self.wind.time = (self.wind.time + elapsed + forest_format::wind::MAX_TIME)
+            .rem_euclid(span)
+            - forest_format::wind::MAX_TIME;
         let cam = self.camera();
         if let (Some(p), Some(i)) = (&self.path, self.playing) {
             // One key per frame; at the end, control returns at the last key.
@@ -57,6 +63,7 @@ impl Viewer {
                 };
                 g.renderer.set_light(light)?;
             }
+            g.renderer.set_wind(self.wind)?;
             g.renderer.set_pipeline_statistics(self.count_work);
             // A counter the device cannot hold (a window past its storage limit) is said on
             // the HUD, and the view goes back to off.

@@ -1,5 +1,5 @@
 //! The viewer's egui HUD: frame and pass times, counters, quads per level, the ε slider, the
-//! time-of-day slider, the method and debug-view switches, the key list.
+//! time-of-day slider, the wind's speed, direction and gustiness, the method and debug-view switches, the key list.
 
 use forest_baselines::methods::Method;
 use forest_render::options::DebugView;
@@ -106,6 +106,15 @@ impl Viewer {
                 if hours.changed() {
                     self.hour_changed = true;
                 }
+                ui.add(
+                    egui::Slider::new(&mut self.wind.speed, 0.0..=30.0)
+                        .text("wind (m/s, mean; G / Shift+G)"),
+                );
+                ui.add(
+                    egui::Slider::new(&mut self.wind.towards_deg, 0.0..=360.0)
+                        .text("wind towards (° from +Z to +X)"),
+                );
+                ui.add(egui::Slider::new(&mut self.wind.gustiness, 0.0..=1.0).text("gustiness"));
                 ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
                 ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
                 ui.checkbox(

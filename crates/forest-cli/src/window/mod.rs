@@ -4,7 +4,8 @@
 //!
 //! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
 //! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–6 pick a method, `[` and
-//! `]` halve and double ε, V cycles the debug views, H hides the HUD, F12 saves a screenshot, R
+//! `]` halve and double ε, V cycles the debug views, G and Shift+G make the wind stronger and
+//! weaker, H hides the HUD, F12 saves a screenshot, R
 //! starts and stops recording a camera path, P plays the `--path` back, Esc quits.
 //!
 //! On stdout the viewer says when its first frame is on screen and where each screenshot went
@@ -48,14 +49,35 @@ pub const HOURS: (f32, f32) = (6.0, 18.0);
 /// The sun's elevation at noon under the time-of-day control (degrees).
 pub const NOON_ELEVATION: f32 = 65.0;
 
+/// The wind speeds the G key steps through (m/s, mean): calm, light air, breeze, fresh
+/// breeze, strong breeze, gale.
+pub const WIND_STEPS: [f32; 6] = [0.0, 2.0, 5.0, 9.0, 13.0, 18.0];
+
+/// The next wind speed of [`WIND_STEPS`] above (`up`) or below `speed`, staying at the ends.
+pub fn wind_step(speed: f32, up: bool) -> f32 {
+    if up {
+        WIND_STEPS
+            .into_iter()
+            .find(|s| *s > speed + 1e-3)
+            .unwrap_or(WIND_STEPS[WIND_STEPS.len() - 1].max(speed))
+    } else {
+        WIND_STEPS
+            .into_iter()
+            .rev()
+            .find(|s| *s < speed - 1e-3)
+            .unwrap_or(0.0)
+    }
+}
+
 /// Range of the ε slider and the [ / ] keys (pixels).
 pub const EPSILON_RANGE: (f32, f32) = (0.5, 64.0);
 
 /// The key list shown on screen.
-pub const KEYS: [&str; 4] = [
+pub const KEYS: [&str; 5] = [
     "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
     "F: walk/fly · 1-6: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
     "T / Shift+T: time of day one hour later / earlier (sun, its colour and the sky)",
+    "G / Shift+G: wind one step stronger / weaker (calm, breeze … gale)",
     "F12: screenshot · R: record path · P: play --path · Esc: quit",
 ];
 
@@ -118,6 +140,9 @@ pub struct Settings {
     pub hour: f32,
     /// The sun's shadows (`None`: off).
     pub shadows: Option<forest_render::shadow::ShadowOptions>,
+    /// The wind the viewer starts in; its time is where the wind's clock starts (seconds),
+    /// and the clock then runs in real time.
+    pub wind: forest_format::wind::Wind,
     /// A camera path to play from the start (P replays it).
     pub path: Option<CameraPath>,
     /// Where R saves a recorded path.
@@ -144,6 +169,9 @@ pub struct Viewer {
     /// Whether `hour` changed since the renderer's light was last set.
     hour_changed: bool,
     shadows: Option<forest_render::shadow::ShadowOptions>,
+    /// The wind drawn (its time is the wind's clock, advanced each frame by the real time
+    /// elapsed and wrapped within [`forest_format::wind::MAX_TIME`]).
+    wind: forest_format::wind::Wind,
     extent: f32,
     fov_deg: f32,
     methods: Vec<Method>,
@@ -206,6 +234,7 @@ impl Viewer {
             epsilon: st.epsilon,
             hour: st.hour.clamp(HOURS.0, HOURS.1),
             shadows: st.shadows,
+            wind: st.wind,
             hour_changed: false,
             extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),
@@ -446,6 +475,12 @@ impl Viewer {
                 self.hour = (self.hour + step).clamp(HOURS.0, HOURS.1);
                 self.hour_changed = true;
             }
+            KeyCode::KeyG => {
+                let shift = self.keys.contains(&KeyCode::ShiftLeft)
+                    || self.keys.contains(&KeyCode::ShiftRight);
+                self.wind.speed = wind_step(self.wind.speed, !shift);
+                self.say(format!("wind {:.0} m/s", self.wind.speed));
+            }
             KeyCode::Digit1 => self.set_method(0)?,
             KeyCode::Digit2 => self.set_method(1)?,
             KeyCode::Digit3 => self.set_method(2)?,
@@ -662,6 +697,24 @@ pub fn offered(chosen: Method, geometry: bool, hybrid: Hybrid) -> Vec<Method> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_wind_key_steps_through_the_speeds_and_stops_at_the_ends() {
+        let mut s = 0.0;
+        let mut seen = vec![s];
+        for _ in 0..WIND_STEPS.len() + 2 {
+            s = wind_step(s, true);
+            seen.push(s);
+        }
+        assert_eq!(&seen[..WIND_STEPS.len()], &WIND_STEPS);
+        assert_eq!(s, WIND_STEPS[WIND_STEPS.len() - 1]);
+        // A speed between steps goes to the neighbouring step; above the last it stays.
+        assert_eq!(wind_step(6.0, true), 9.0);
+        assert_eq!(wind_step(6.0, false), 5.0);
+        assert_eq!(wind_step(30.0, true), 30.0);
+        assert_eq!(wind_step(30.0, false), 18.0);
+        assert_eq!(wind_step(0.0, false), 0.0);
+    }
 
     #[test]
     fn offered_methods_keep_their_order_with_the_named_parameters() {

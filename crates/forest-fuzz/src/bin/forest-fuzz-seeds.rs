@@ -289,6 +289,16 @@ fn main() {
         let atlas = dir.join(format!("s{i}.atlas"));
         out.atlas.save(&atlas).expect("the seed atlas saves");
         let read = |f: &str| std::fs::read(atlas.join(f)).expect("reading the seed atlas");
+        // The first atlas with its prepared model (checked against it), the second without.
+        let model = if i == 0 {
+            let mesh = forest_bake::Mesh::load(&dir.join("model.obj")).expect("the seed loads");
+            forest_bake::model::prepare(&mesh, None).encode()
+        } else {
+            Vec::new()
+        };
+        if !model.is_empty() {
+            write("model_bin", "seed-0", &model);
+        }
         write(
             "atlas",
             &format!("seed-{i}"),
@@ -299,8 +309,38 @@ fn main() {
                 &read(forest_format::atlas::NODES_FILE),
                 &read(forest_format::atlas::SURFACE_FILE),
                 &read(forest_format::atlas::OPACITY_FILE),
+                &model,
             ]),
         );
+    }
+
+    // Results tables as `bench accuracy --redraw` reads them: every layout it knows.
+    let all = forest_format::results_csv::accuracy_columns();
+    let row = |n: usize| {
+        let mut cells: Vec<String> = (0..n).map(|k| format!("{}", k as f32 * 0.01)).collect();
+        cells[0] = "quads".into();
+        cells[1] = "eps=2".into();
+        cells[2] = "inside".into();
+        if n > 17 {
+            cells[17] = "recorded commands".into();
+        }
+        cells.join(",")
+    };
+    for (i, n) in [all.len(), 18, 8].into_iter().enumerate() {
+        let text = format!("{}\n{}\n{}\n", all[..n].join(","), row(n), row(n));
+        write("results_csv", &format!("seed-{i}.csv"), text.as_bytes());
+    }
+
+    // Winds as the options give them, with a tree and points of it.
+    for (i, text) in [
+        "60,8\n0.5\n12.25\n3 -7 12 4 17\n0 12 0 3 8 1 -2 4 0",
+        "270,30\n1\n-99999\n1e6 -1e6 40 10 4294967295\n4 40 -4 0 0 0 0 -1 0",
+        "0,0\n0\n0\n",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        write("wind", &format!("seed-{i}"), text.as_bytes());
     }
 
     // Images as `compare` reads them: RGBA and grey PNG, 16-bit PNG, JPEG.

@@ -71,8 +71,9 @@ fn falloff(f: &FogFalloff) -> light::Falloff {
     }
 }
 
-/// ExtractSchedule: the forests, the cameras that draw them, the sun and ambient light.
-#[allow(clippy::type_complexity)]
+/// ExtractSchedule: the forests, the cameras that draw them, the sun and ambient light, the
+/// wind on Bevy's clock.
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn extract(
     mut out: ResMut<Extracted>,
     forests: Extract<Query<(Entity, &ForestScene, &GlobalTransform, &InheritedVisibility)>>,
