@@ -35,7 +35,12 @@ for t in 7.5 12; do
   $forest render out/forest-100k.forest -o "out/render/forest-$t.png" --view hill --time "$t" \
     --size 800x600 --shadows on
 done
+# The forest in a breeze: 3 s at 12 frames per second from inside, an animated PNG. Every tree
+# and its shadow move; the hybrid's two forms move alike.
+$forest render out/forest-100k.forest -o out/render/forest-wind.png --view inside \
+  --size 480x270 --shadows on --wind 60,9 --animate 3 --frame-rate 12
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png,"
-echo "  at 7:30 and noon: out/render/forest-7.5.png, out/render/forest-12.png"
+echo "  at 7:30 and noon: out/render/forest-7.5.png, out/render/forest-12.png,"
+echo "  in wind (an animated PNG): out/render/forest-wind.png"
 echo "Atlases: out/atlases/, contact sheets: out/contact/"

@@ -650,6 +650,37 @@ fn winds_are_named_with_their_bound() {
         a.extend(["--out", &results]);
         refused(&a, d, causes);
     }
+    // --animate's length and rate, the clock it runs past, and a count asked of it.
+    for (extra, cause) in [
+        (
+            &["--animate", "0"][..],
+            "--animate 0: expected more than 0 and at most 60",
+        ),
+        (&["--animate", "1e9"][..], "--animate 1000000000"),
+        (&["--animate", "nan"][..], "--animate NaN"),
+        (
+            &["--animate", "1", "--frame-rate", "0"][..],
+            "--frame-rate 0: expected 1 to 60",
+        ),
+        (
+            &["--animate", "2", "--wind", "0,5", "--wind-time", "99999.5"][..],
+            "the last frame's wind time",
+        ),
+        (&["--animate", "1", "--fragments"][..], "count fragments"),
+    ] {
+        let mut a = vec![
+            "render",
+            &forest_file,
+            "-o",
+            &png,
+            "--size",
+            "32x24",
+            "--view",
+            "inside",
+        ];
+        a.extend(extra);
+        refused(&a, d, &[cause]);
+    }
     let walk = d.join("walk.json");
     std::fs::write(
         &walk,

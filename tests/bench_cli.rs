@@ -66,6 +66,16 @@ fn every_table_has_its_columns(results: &Path) {
     assert!(header("stability.csv").starts_with("case,method,flip_mean,flicker,pops"));
     assert!(header("storage.csv").starts_with("method,species,disk_bytes,gpu_bytes"));
     assert_eq!(
+        header("wind.csv"),
+        "case,distance_m,method,flip_static,flip_wind,wind_over_static,motion_px,\
+         motion_over_reference,change_over_reference,flicker_frames,frame_ms_calm,frame_ms_wind,\
+         time_ratio"
+    );
+    assert_eq!(
+        header("wind_switch.csv"),
+        "species,switch_m,crown_motion_px,worst_disagreement_px"
+    );
+    assert_eq!(
         header("fidelity.csv"),
         "variant,species,camera,distance_radii,elevation_deg,azimuth_deg,between_directions,\
          epsilon,quads,flip_mean,iou,frame_ms"
@@ -109,6 +119,7 @@ fn every_table_has_its_columns(results: &Path) {
 fn every_method_is_in_the_tables(results: &Path) {
     let accuracy = std::fs::read_to_string(results.join("accuracy.csv")).unwrap();
     let stability = std::fs::read_to_string(results.join("stability.csv")).unwrap();
+    let wind = std::fs::read_to_string(results.join("wind.csv")).unwrap();
     for m in [
         "quads",
         "impostor",
@@ -125,6 +136,14 @@ fn every_method_is_in_the_tables(results: &Path) {
             stability.lines().any(|l| l.contains(&format!(",{m},"))),
             "{m}"
         );
+        // In wind, on each of the four seeded cameras.
+        for case in ["near", "mid", "far", "switch"] {
+            assert!(
+                wind.lines()
+                    .any(|l| l.starts_with(&format!("{case},")) && l.contains(&format!(",{m},"))),
+                "wind: {m} at {case}"
+            );
+        }
     }
 }
 

@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
+mod animation;
 mod bake;
 mod bench;
 mod compare;

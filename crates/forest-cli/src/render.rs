@@ -53,6 +53,7 @@ pub fn noted(sourced: geometry::SourcedModels) -> PreparedGeometry {
 pub fn run(args: &RenderArgs) -> Result<()> {
     args.light.lighting()?;
     let wind = args.wind.wind()?;
+    let animation = args.animation(&wind)?;
     let mut views: Vec<(String, Vec3, Vec3)> = Vec::new();
     let (forest, species) = load_scene(&args.forest)?;
     let mut settled = args.clone();
@@ -138,7 +139,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     r.set_shadows(&ctx.device, args.shadow.options(false)?)?;
     r.set_wind(wind)?;
     r.set_pipeline_statistics(args.json);
-    render_views(args, &ctx, &cameras, |cam, target| {
+    render_views(args, &ctx, &cameras, animation, |cam, target, instant| {
+        if let Some(t) = instant {
+            r.set_wind(forest_format::wind::Wind { time: t, ..wind })?;
+        }
         let stats = r.render_fitted(&ctx, cam, target)?;
         let (json, line) = report(args, &ctx, &r, &stats);
         let counted = count(
@@ -288,14 +292,39 @@ fn render_views(
     args: &RenderArgs,
     ctx: &GpuContext,
     cameras: &[(String, Camera)],
-    mut frame: impl FnMut(&Camera, &Target) -> Result<ViewReport>,
+    animation: Option<(u32, f32)>,
+    mut frame: impl FnMut(&Camera, &Target, Option<f32>) -> Result<ViewReport>,
 ) -> Result<()> {
     let (sw, sh) = rendered_viewport(args);
     let target = Target::new(ctx, sw, sh);
     for (name, cam) in cameras {
         let mut cam = *cam;
         cam.viewport = (sw, sh);
-        let mut report = frame(&cam, &target)?;
+        if let Some((frames, step)) = animation {
+            // The wind's frames, one after another into one animated PNG.
+            let out = output_for(&args.output, name, cameras.len());
+            let start = args.wind.wind_time;
+            let mut line = String::new();
+            crate::animation::write_apng(&out, args.size, frames, step, |i| {
+                let report = frame(&cam, &target, Some(start + i as f32 * step))?;
+                ctx.check_errors()?;
+                line = report.line;
+                let img = target.read(ctx);
+                Ok(if args.supersample > 1 {
+                    forest_baselines::geometry::downsample(&img, args.supersample)
+                } else {
+                    img
+                })
+            })?;
+            println!(
+                "{name}: {frames} frames at {} Hz, the last {line} ({}) -> {}",
+                args.frame_rate,
+                ctx.adapter_info.name,
+                out.display()
+            );
+            continue;
+        }
+        let mut report = frame(&cam, &target, None)?;
         if let Some((counter, counts)) = &report.counted {
             if args.overdraw() {
                 overdraw_view(ctx, &target, counter);

@@ -66,6 +66,13 @@ pub struct RenderArgs {
     pub wind: WindArgs,
     #[command(flatten)]
     pub shadow: ShadowArgs,
+    /// Write an animation of the wind instead of a still: SECONDS of frames from
+    /// --wind-time on, at --frame-rate, as an animated PNG (APNG) at the output path.
+    #[arg(long, allow_negative_numbers = true)]
+    pub animate: Option<f32>,
+    /// Frames per second of --animate (1 to 60).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 15.0)]
+    pub frame_rate: f32,
     /// Render at N×N times the size and box-filter down (the supersampled reference uses 4).
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub supersample: u32,
@@ -87,11 +94,64 @@ impl RenderArgs {
         self.fragments || self.overdraw()
     }
 
+    /// The frames of --animate and the delay between them (seconds): none for a still.
+    /// Checked: at most [`MAX_ANIMATION_FRAMES`], every instant within the wind's clock
+    /// (`wind` is --wind's), and nothing asked of a still's counts.
+    pub(crate) fn animation(&self, wind: &forest_format::wind::Wind) -> Result<Option<(u32, f32)>> {
+        let Some(seconds) = self.animate else {
+            return Ok(None);
+        };
+        if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_ANIMATION_SECONDS) {
+            anyhow::bail!(
+                "--animate {seconds}: expected more than 0 and at most {MAX_ANIMATION_SECONDS} \
+                 seconds"
+            );
+        }
+        if !(self.frame_rate.is_finite() && (1.0..=60.0).contains(&self.frame_rate)) {
+            anyhow::bail!(
+                "--frame-rate {}: expected 1 to 60 frames per second",
+                self.frame_rate
+            );
+        }
+        let frames = (seconds * self.frame_rate).ceil().max(1.0) as u32;
+        if frames > MAX_ANIMATION_FRAMES {
+            anyhow::bail!(
+                "--animate {seconds} at --frame-rate {}: {frames} frames, at most \
+                 {MAX_ANIMATION_FRAMES}",
+                self.frame_rate
+            );
+        }
+        let step = 1.0 / self.frame_rate;
+        forest_format::wind::Wind {
+            time: wind.time + (frames - 1) as f32 * step,
+            ..*wind
+        }
+        .validate()
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "--animate {seconds} from --wind-time {}: the last frame's {e}",
+                wind.time
+            )
+        })?;
+        if self.counts_fragments() {
+            anyhow::bail!(
+                "--animate draws frames in time: count fragments (--fragments, --debug-view \
+                 overdraw) on a still"
+            );
+        }
+        Ok(Some((frames, step)))
+    }
+
     /// Whether the PNG is the overdraw view.
     pub(crate) fn overdraw(&self) -> bool {
         self.debug_view == "overdraw"
     }
 }
+
+/// The longest `--animate` (seconds).
+pub const MAX_ANIMATION_SECONDS: f32 = 60.0;
+/// The most frames `--animate` writes.
+pub const MAX_ANIMATION_FRAMES: u32 = 3600;
 
 /// The light every method shades with (shared by `forest render`, `forest view` and the
 /// benches): the sun's direction and the exposure. Nothing of it is baked.

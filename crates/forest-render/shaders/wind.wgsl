@@ -6,11 +6,13 @@
 #import common
 
 const WIND_TAU: f32 = 6.2831855;
-// forest_format::wind::BEND, MAX_LEAN, FLUTTER, MAX_RELATIVE_HEIGHT.
+// forest_format::wind::BEND, MAX_LEAN, FLUTTER, MAX_RELATIVE_HEIGHT, GUST_PERIODS (a test
+// compares them).
 const WIND_BEND: f32 = 2.5e-4;
 const WIND_MAX_LEAN: f32 = 0.2;
 const WIND_FLUTTER: f32 = 0.004;
 const WIND_MAX_RELATIVE_HEIGHT: f32 = 1.5;
+const WIND_GUST_PERIODS: vec2<f32> = vec2<f32>(4.6, 2.1);
 
 // PCG's output permutation (forest_format::wind::hash).
 fn wind_hash(x: u32) -> u32 {
@@ -33,8 +35,10 @@ fn wind_lean(u: f32) -> f32 {
 fn wind_gusts(dir: vec2<f32>, speed: f32, time: f32, at: vec2<f32>) -> f32 {
     let s = dot(at, dir) - speed * time;
     let c = dot(at, vec2<f32>(-dir.y, dir.x));
-    return 0.6 * sin(WIND_TAU * s / 37.0 + 0.9 * sin(WIND_TAU * c / 53.0))
-        + 0.4 * sin(WIND_TAU * s / 17.0 + 2.1 + 0.7 * sin(WIND_TAU * c / 29.0));
+    let long = max(speed * WIND_GUST_PERIODS.x, 37.0);
+    let short = max(speed * WIND_GUST_PERIODS.y, 17.0);
+    return 0.6 * sin(WIND_TAU * s / long + 0.9 * sin(WIND_TAU * c / 53.0))
+        + 0.4 * sin(WIND_TAU * s / short + 2.1 + 0.7 * sin(WIND_TAU * c / 29.0));
 }
 
 // The farthest any point of a tree `height` metres tall moves in the frame's wind (metres).

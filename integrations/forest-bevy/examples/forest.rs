@@ -10,7 +10,8 @@
 //! cargo run --release --ignore-rust-version --example forest [-- PATH.forest]
 //! ```
 //! Keys: W A S D fly, Q E down and up, arrows turn, shift faster; J L turn the sun, I K
-//! raise and lower it; M switches method; [ ] halve and double ε. The title bar shows the
+//! raise and lower it; G and Shift+G make the wind stronger and weaker (it starts at a
+//! breeze, 5 m/s); M switches method; [ ] halve and double ε. The title bar shows the
 //! method, ε, quads, triangles and frame time (or why the method cannot draw). With
 //! `SCREENSHOT=PATH.png` in the environment it saves a frame once the forest is drawn, and
 //! exits (0) as soon as the file is written.
@@ -21,7 +22,8 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
 use forest_bevy::{
-    ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats, terrain_mesh,
+    ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats, ForestWind,
+    terrain_mesh,
 };
 
 /// The sun's azimuth and elevation, degrees.
@@ -73,6 +75,8 @@ fn main() -> AppExit {
     }))
     .add_plugins(ForestPlugin)
     .insert_resource(SunAngles(30.0, 35.0))
+    // Every tree moves in it, in every method and in its shadows, on Bevy's clock.
+    .insert_resource(ForestWind(forest_format::wind::Wind::new(60.0, 5.0)))
     .insert_resource(ClearColor(fog))
     .insert_resource(GlobalAmbientLight {
         color: Color::srgb(0.75, 0.85, 1.0),
@@ -230,7 +234,28 @@ fn sun(
     }
 }
 
-fn switch(keys: Res<ButtonInput<KeyCode>>, mut cams: Query<&mut ForestCamera>) {
+/// The wind speeds G and Shift+G step through (m/s): calm, light air, breeze, fresh breeze,
+/// strong breeze, gale.
+const WIND_STEPS: [f32; 6] = [0.0, 2.0, 5.0, 9.0, 13.0, 18.0];
+
+fn switch(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut cams: Query<&mut ForestCamera>,
+    mut wind: ResMut<ForestWind>,
+) {
+    if keys.just_pressed(KeyCode::KeyG) {
+        let i = WIND_STEPS
+            .iter()
+            .position(|s| *s >= wind.0.speed)
+            .unwrap_or(WIND_STEPS.len() - 1);
+        let weaker = keys.pressed(KeyCode::ShiftLeft) || keys.pressed(KeyCode::ShiftRight);
+        let next = if weaker {
+            i.saturating_sub(1)
+        } else {
+            (i + 1).min(WIND_STEPS.len() - 1)
+        };
+        wind.0.speed = WIND_STEPS[next];
+    }
     for mut c in &mut cams {
         // Every method but full geometry (every tree of a large forest as its model takes
         // seconds a frame on a CPU).
@@ -251,6 +276,7 @@ fn switch(keys: Res<ButtonInput<KeyCode>>, mut cams: Query<&mut ForestCamera>) {
 fn title(
     stats: Res<ForestStats>,
     time: Res<Time>,
+    wind: Res<ForestWind>,
     cams: Query<(Entity, &ForestCamera)>,
     mut windows: Query<&mut Window>,
 ) {
@@ -258,13 +284,14 @@ fn title(
         return;
     };
     window.title = format!(
-        "forest in Bevy: {} ε {} px, {} quads, {} triangles, {:.1} ms (M method, [ ] ε, IJKL \
-         sun){}",
+        "forest in Bevy: {} ε {} px, {} quads, {} triangles, {:.1} ms, wind {} m/s (M method, \
+         [ ] ε, IJKL sun, G wind){}",
         c.method.name(),
         c.epsilon,
         stats.quads(camera),
         stats.triangles(camera),
         time.delta_secs() * 1000.0,
+        wind.0.speed,
         // A method the forest cannot draw (atlases baked without models) says why.
         stats
             .error(camera)

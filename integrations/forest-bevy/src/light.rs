@@ -255,7 +255,10 @@ mod tests {
         let d = felt.direction();
         let back = world_from_forest.transform_vector3(Vec3::new(d.x, 0.0, d.y));
         assert!((back - Vec3::X).length() < 1e-5, "{back}");
-        assert_eq!((felt.speed, felt.gustiness, felt.time), (12.0, wind.gustiness, 3.5));
+        assert_eq!(
+            (felt.speed, felt.gustiness, felt.time),
+            (12.0, wind.gustiness, 3.5)
+        );
         // Unturned: the same azimuth.
         let same = wind_in_forest(wind, bevy::math::Mat4::from_translation(Vec3::ONE));
         assert!((same.towards_deg - 90.0).abs() < 1e-4);

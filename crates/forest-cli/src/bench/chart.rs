@@ -21,6 +21,18 @@ pub struct Series {
     pub front: bool,
 }
 
+impl Series {
+    /// A series joined by a line, named `name`, with `points` (data units).
+    pub fn line(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            line: true,
+            front: false,
+        }
+    }
+}
+
 /// A 2D chart.
 #[derive(Clone, Debug, Default)]
 pub struct Chart {

@@ -115,12 +115,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 .map(|(s, v)| (f64::from(s.1), f64::from(mean(v))))
                 .collect();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            Series {
-                name: m.name().into(),
-                points,
-                line: true,
-                ..Default::default()
-            }
+            Series::line(m.name(), points)
         })
         .collect();
     b.chart(

@@ -15,6 +15,7 @@ mod shadows;
 mod stability;
 mod storage;
 mod table1;
+mod wind;
 
 use forest_render::ForestView;
 use std::cell::OnceCell;
@@ -36,7 +37,7 @@ use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 use forest_scene::generate::{GenerateParams, generate};
 
 /// The suites, in the order `all` runs them.
-pub const SUITES: [&str; 10] = [
+pub const SUITES: [&str; 11] = [
     "storage",
     "shadowing",
     "lighting",
@@ -47,17 +48,18 @@ pub const SUITES: [&str; 10] = [
     "stability",
     "budget",
     "fidelity",
+    "wind",
 ];
 
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Suite: storage, shadowing, lighting, shadows, table1, path, accuracy, stability,
-    /// budget, fidelity, or all. Every run
+    /// budget, fidelity, wind, or all. Every run
     /// updates REPORT.md with the sections of all suites run into the results folder so far.
     #[arg(value_parser = [
         "storage", "shadowing", "lighting", "shadows", "table1", "path", "accuracy", "stability",
-        "budget", "fidelity", "all",
+        "budget", "fidelity", "wind", "all",
     ])]
     pub suite: String,
     /// Species atlases (comma-separated).
@@ -669,6 +671,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "stability" => stability::run(&b)?,
             "budget" => budget::run(&b)?,
             "fidelity" => fidelity::run(&b)?,
+            "wind" => wind::run(&b)?,
             _ => unreachable!("clap checks the suite"),
         };
         report::write(&b, s, &section, !(s == "accuracy" && args.redraw))?;

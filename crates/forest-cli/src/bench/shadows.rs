@@ -125,12 +125,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             y_label: "frame time ratio, shadows on / off".into(),
             series: ratios
                 .into_iter()
-                .map(|(name, points)| Series {
-                    name,
-                    points,
-                    line: true,
-                    front: false,
-                })
+                .map(|(name, points)| Series::line(name, points))
                 .collect(),
             ..Default::default()
         },

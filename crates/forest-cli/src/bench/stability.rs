@@ -124,11 +124,7 @@ pub fn run(b: &Bench) -> Result<Section> {
     let mut table = Table::new(&["case", "method", "flip_mean", "flicker", "pops", "frame_ms"]);
     let mut series: Vec<Series> = methods
         .iter()
-        .map(|m| Series {
-            name: m.name().into(),
-            line: true,
-            ..Default::default()
-        })
+        .map(|m| Series::line(m.name(), Vec::new()))
         .collect();
     for (ci, (case, in_cluster, camera)) in cases(&forest, side, viewport).into_iter().enumerate() {
         let r = &mut renderers[usize::from(in_cluster)];

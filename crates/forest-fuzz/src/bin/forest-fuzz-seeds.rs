@@ -263,17 +263,22 @@ fn main() {
         ]),
     );
 
-    // Atlases baked from the OBJ seed, JPEG and PNG colour.
-    for obj in
-        ["model.obj", "model.mtl", "leaf.png"]
-            .iter()
-            .zip([OBJ.as_bytes(), MTL.as_bytes(), &leaf])
+    // Atlases baked from the OBJ seed, JPEG and PNG colour, and from the plain OBJ with its
+    // prepared model (the smallest model.bin: no textures, so its fixed-size billboards and
+    // opacity volume compress to little and the fuzzer runs fast).
+    for obj in ["model.obj", "model.mtl", "leaf.png", "plain.obj"]
+        .iter()
+        .zip([OBJ.as_bytes(), MTL.as_bytes(), &leaf, OBJ_PLAIN.as_bytes()])
     {
         std::fs::write(dir.join(obj.0), obj.1).expect("writing the model");
     }
-    for (i, colour) in [ColourEncoding::Jpeg { quality: 80 }, ColourEncoding::Png]
-        .into_iter()
-        .enumerate()
+    for (i, (source, colour)) in [
+        ("model.obj", ColourEncoding::Jpeg { quality: 80 }),
+        ("model.obj", ColourEncoding::Png),
+        ("plain.obj", ColourEncoding::Png),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let params = BakeParams {
             directions: 2,
@@ -284,21 +289,19 @@ fn main() {
             colour,
             ..BakeParams::default()
         };
-        let out = forest_bake::bake_file(&dir.join("model.obj"), &params, &|_, _| {})
+        let out = forest_bake::bake_file(&dir.join(source), &params, &|_, _| {})
             .expect("the seed model bakes");
         let atlas = dir.join(format!("s{i}.atlas"));
         out.atlas.save(&atlas).expect("the seed atlas saves");
         let read = |f: &str| std::fs::read(atlas.join(f)).expect("reading the seed atlas");
-        // The first atlas with its prepared model (checked against it), the second without.
-        let model = if i == 0 {
-            let mesh = forest_bake::Mesh::load(&dir.join("model.obj")).expect("the seed loads");
-            forest_bake::model::prepare(&mesh, None).encode()
+        let model = if source == "plain.obj" {
+            let mesh = forest_bake::Mesh::load(&dir.join(source)).expect("the seed loads");
+            let model = forest_bake::model::prepare(&mesh, None).encode();
+            write("model_bin", "seed-0", &model);
+            model
         } else {
             Vec::new()
         };
-        if !model.is_empty() {
-            write("model_bin", "seed-0", &model);
-        }
         write(
             "atlas",
             &format!("seed-{i}"),

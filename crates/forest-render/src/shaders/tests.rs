@@ -66,3 +66,35 @@ fn every_runtime_module_composes() {
         );
     }
 }
+
+/// The number(s) a `const NAME: TYPE = …;` line of `wgsl` gives (a scalar, or a vector's
+/// components).
+fn wgsl_const(wgsl: &str, name: &str) -> Vec<f32> {
+    let line = wgsl
+        .lines()
+        .find(|l| l.starts_with(&format!("const {name}:")))
+        .unwrap_or_else(|| panic!("no const {name}"));
+    let value = line.split_once('=').unwrap().1.trim().trim_end_matches(';');
+    let value = value
+        .find('(')
+        .map_or(value, |i| &value[i + 1..value.len() - 1]);
+    value
+        .split(',')
+        .map(|x| x.trim().parse().unwrap_or_else(|_| panic!("{name}: {x:?}")))
+        .collect()
+}
+
+#[test]
+fn the_wind_shader_has_the_cpu_models_constants() {
+    use forest_format::wind;
+    for (name, value) in [
+        ("WIND_TAU", vec![std::f32::consts::TAU]),
+        ("WIND_BEND", vec![wind::BEND]),
+        ("WIND_MAX_LEAN", vec![wind::MAX_LEAN]),
+        ("WIND_FLUTTER", vec![wind::FLUTTER]),
+        ("WIND_MAX_RELATIVE_HEIGHT", vec![wind::MAX_RELATIVE_HEIGHT]),
+        ("WIND_GUST_PERIODS", wind::GUST_PERIODS.to_vec()),
+    ] {
+        assert_eq!(wgsl_const(WIND_WGSL, name), value, "{name}");
+    }
+}

@@ -487,7 +487,16 @@ impl ForestRenderState {
             let key = (view.main, forest.entity, c.layer);
             let light = shadows::light_params(c, lighting.sun_dir, frame.eye());
             let (asset, res) = (forest.asset, c.resolution);
-            if self.cast(ctx, key, asset, scene, res, sharpen, (&light, wind), &mut record) {
+            if self.cast(
+                ctx,
+                key,
+                asset,
+                scene,
+                res,
+                sharpen,
+                (&light, wind),
+                &mut record,
+            ) {
                 live_casters.insert(key);
                 self.casts
                     .entry(view.main)
@@ -516,7 +525,10 @@ impl ForestRenderState {
         scene: &Arc<GpuScene>,
         resolution: u32,
         sharpen: Option<u32>,
-        (light, wind): (&forest_render::shadow::LightParams, forest_format::wind::Wind),
+        (light, wind): (
+            &forest_render::shadow::LightParams,
+            forest_format::wind::Wind,
+        ),
         record: &mut ForestViewStats,
     ) -> bool {
         let opts = RendererOptions {
