@@ -2,6 +2,7 @@
 
 mod common;
 
+use forest_format::wind::Wind;
 use forest_render::ForestView;
 use forest_render::options::RendererOptions;
 use forest_render::reference;
@@ -47,9 +48,13 @@ fn compare(
     stream.render_frame(ctx, cam, target).unwrap();
     let gpu = stream.read_quads(ctx);
     let stats = stream.read_stats(ctx);
+    // The camera uniform as the stream fills it: the reference's culls grow each sphere by
+    // the wind's reach as the GPU's do.
+    let mut uniform = cam.to_gpu();
+    uniform.set_wind(&stream.wind());
     let cpu = reference::run_with(
         &stream.scene.tables,
-        &cam.to_gpu(),
+        &uniform,
         stream.capacity.quads,
         stream.iterations(),
     );
@@ -105,10 +110,21 @@ fn compare(
 
 /// The shared cameras and the coarse view over a forest of `trees` of `species`.
 fn check_species(species: &[SpeciesData], trees: u32, max_quads: Option<u32>) -> Vec<Summary> {
+    check_in_wind(species, trees, max_quads, Wind::CALM)
+}
+
+/// [`check_species`] in `wind`.
+fn check_in_wind(
+    species: &[SpeciesData],
+    trees: u32,
+    max_quads: Option<u32>,
+    wind: Wind,
+) -> Vec<Summary> {
     let ctx = common::ctx();
     let forest = common::forest(trees);
     let scene = GpuScene::new(&ctx, species, &forest).unwrap();
     let (mut stream, target) = common::small_stream(&ctx, scene, max_quads);
+    stream.set_wind(wind).unwrap();
     let side = forest.extent();
     let mut views = common::cameras(side);
     views.push(("horizon_coarse", coarse_view(side)));
@@ -146,6 +162,28 @@ fn gpu_stream_equals_the_cpu_reference() {
     // plain quads behind the composited ones.
     let coarse = get("horizon_coarse");
     assert!(coarse.composites > 0 && coarse.refined > 0, "{coarse:?}");
+}
+
+/// In a storm the culls grow every sphere by the wind's reach, on the GPU as in the reference:
+/// the streams still equal quad for quad, and the grown spheres keep trees the calm culls
+/// drop (trees swayed into view).
+#[test]
+fn in_a_storm_the_gpu_stream_equals_the_cpu_reference() {
+    let storm = Wind {
+        gustiness: 1.0,
+        ..Wind::new(130.0, 35.0).at(7.25)
+    };
+    let calm = check(300, None);
+    let windy = check_in_wind(&common::species(), 300, None, storm);
+    eprintln!("{windy:?}");
+    assert!(windy.iter().all(|x| x.overflow == 0));
+    let visible = |s: &[Summary]| s.iter().map(|x| x.visible).sum::<u32>();
+    assert!(
+        visible(&windy) > visible(&calm),
+        "the storm's reach kept no more trees: {} against {} calm",
+        visible(&windy),
+        visible(&calm)
+    );
 }
 
 /// Trees standing on hills: the cull's bounding spheres, the presorts and the refinement

@@ -3,6 +3,7 @@
 
 mod common;
 
+use forest_format::wind::{SwayedTree, Wind};
 use forest_render::ForestView;
 use forest_render::options::{Background, RendererOptions};
 use forest_render::shadow::{ShadowOptions, cameras};
@@ -86,7 +87,11 @@ fn light_view_streams_equal_the_cpu_reference() {
 /// Ground points (x, z) the shadow of one tree (`atlas`) covers under a sun in direction
 /// `sun`: pixels darker with shadows than without, seen by a camera high above the origin;
 /// one screen pixel's width on the ground and the ground's shadow-map texel (metres).
-fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f32, f32) {
+fn shadow_points(
+    atlas: &forest_format::Atlas,
+    sun: Vec3,
+    wind: Wind,
+) -> (Vec<(f32, f32)>, f32, f32) {
     let ctx = common::ctx();
     let forest = forest_format::forest::Forest::new(
         vec!["pine".into()],
@@ -114,6 +119,7 @@ fn shadow_points(atlas: &forest_format::Atlas, sun: Vec3) -> (Vec<(f32, f32)>, f
         ..Default::default()
     };
     let mut stream = QuadStream::new(&ctx.device, scene, &opts).unwrap();
+    stream.set_wind(wind).unwrap();
     let target = forest_render::target::Target::new(&ctx, size, size);
     let mut cam = common::camera(Vec3::new(0.0, 60.0, 0.01), Vec3::ZERO, 2.0);
     cam.viewport = (size, size);
@@ -184,11 +190,9 @@ fn bake_15(obj: &std::path::Path) -> (forest_format::Atlas, f32) {
     (atlas, texel)
 }
 
-/// One opaque square card, 2 m across, lying 3 m above flat ground: under a low and a high
-/// sun its shadow's edges lie where the card's edges project along the sun, within a texel of
-/// the shadow map, a texel of the atlas and a pixel of the image that measures them.
-#[test]
-fn a_cards_shadow_lands_where_the_sun_projects_it() {
+/// The card of the card tests: one opaque square, 2 m across, lying 3 m above the foot, baked
+/// as [`bake_15`] does.
+fn card() -> (forest_format::Atlas, f32) {
     let dir = common::root().join("target/test-output/card");
     std::fs::create_dir_all(&dir).unwrap();
     let obj = dir.join("card.obj");
@@ -197,20 +201,116 @@ fn a_cards_shadow_lands_where_the_sun_projects_it() {
         "v -1 3 -1\nv 1 3 -1\nv 1 3 1\nv -1 3 1\nf 1 2 3\nf 1 3 4\nf 3 2 1\nf 4 3 1\n",
     )
     .unwrap();
-    let (atlas, atlas_texel) = bake_15(&obj);
+    bake_15(&obj)
+}
+
+/// The bounds (x min, x max, z min, z max) of ground points, metres.
+fn bounds(pts: &[(f32, f32)]) -> [f32; 4] {
+    pts.iter().fold(
+        [f32::MAX, f32::MIN, f32::MAX, f32::MIN],
+        |[x0, x1, z0, z1], p| [x0.min(p.0), x1.max(p.0), z0.min(p.1), z1.max(p.1)],
+    )
+}
+
+/// The card in a storm, at two instants: its shadow's edges lie where the card's corners,
+/// moved by the wind's CPU model (the tree as every method sees the instance: its foot, the
+/// top and radius of the baked bounding sphere, instance 0), project along the sun, within
+/// the calm test's tolerance and the wind's bending of the card's inside between its corners;
+/// the two instants (the card bent least and most in 20 s of a gusty storm) give shadows
+/// measurably apart, and the drawn shadow follows.
+#[test]
+fn a_swaying_cards_shadow_lands_where_the_moved_card_projects() {
+    let (atlas, atlas_texel) = card();
+    let sphere = atlas.manifest.bounding_sphere;
+    let tree = SwayedTree::from_sphere(Vec3::ZERO, 1.0, sphere.center.y, sphere.radius, 0);
+    let sun = forest_format::shading::Lighting::with_sun(35.0, 50.0).sun_dir;
+    let storm = Wind {
+        gustiness: 1.0,
+        ..Wind::new(75.0, 35.0)
+    };
+    // The instants of the first 20 s (every 0.1 s) when the card's middle is bent least and
+    // most along the wind, by the CPU model.
+    let along = |t: f32| {
+        let w = storm.at(t);
+        let d = w.direction();
+        let moved = w.swayed(Vec3::new(0.0, 3.0, 0.0), &tree);
+        moved.x * d.x + moved.z * d.y
+    };
+    let instants: Vec<f32> = (0..200).map(|i| i as f32 * 0.1).collect();
+    let least = instants
+        .iter()
+        .copied()
+        .min_by(|a, b| along(*a).total_cmp(&along(*b)));
+    let most = instants
+        .iter()
+        .copied()
+        .max_by(|a, b| along(*a).total_cmp(&along(*b)));
+    let mut seen = Vec::new();
+    for time in [least.unwrap(), most.unwrap()] {
+        let wind = storm.at(time);
+        // The moved corners' projections along the sun onto the ground.
+        let projected: Vec<(f32, f32)> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(x, z)| {
+                let p = wind.swayed(Vec3::new(x, 3.0, z), &tree);
+                let g = p - sun * (p.y / sun.y);
+                (g.x, g.z)
+            })
+            .collect();
+        let want = bounds(&projected);
+        let (pts, pixel, texel) = shadow_points(&atlas, sun, wind);
+        assert!(pts.len() > 50, "t {time} s: {} shadowed pixels", pts.len());
+        let got = bounds(&pts);
+        // The card's middle, moved, against the mean of its corners: how far the wind bends
+        // the inside away from the corners' straight lines (quads follow their corners).
+        let middle = wind.swayed(Vec3::new(0.0, 3.0, 0.0), &tree);
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(x, z)| wind.swayed(Vec3::new(x, 3.0, z), &tree))
+            .sum::<Vec3>()
+            / 4.0;
+        let bend = (middle - corners).length() / sun.y;
+        let tolerance = texel + atlas_texel + pixel + bend;
+        for (i, what) in ["x min", "x max", "z min", "z max"].iter().enumerate() {
+            assert!(
+                (got[i] - want[i]).abs() <= tolerance,
+                "t {time} s: the shadow's {what} edge at {:.3} m, the moved card's projects to \
+                 {:.3} m (± {tolerance:.3})",
+                got[i],
+                want[i]
+            );
+        }
+        seen.push((want, got, tolerance));
+    }
+    // The wind moved the card's shadow between the instants by more than the two
+    // tolerances together: each drawn shadow is its own instant's and not the other's.
+    let (a, b) = (&seen[0], &seen[1]);
+    let moved = (0..4).map(|i| (a.0[i] - b.0[i]).abs()).fold(0.0, f32::max);
+    assert!(
+        moved > a.2 + b.2,
+        "the storm moved the card's shadow only {moved:.3} m between the instants"
+    );
+    let followed = (0..4).map(|i| (a.1[i] - b.1[i]).abs()).fold(0.0, f32::max);
+    assert!(
+        followed > moved * 0.5,
+        "drawn {followed:.3} m, moved {moved:.3} m"
+    );
+}
+
+/// One opaque square card, 2 m across, lying 3 m above flat ground: under a low and a high
+/// sun its shadow's edges lie where the card's edges project along the sun, within a texel of
+/// the shadow map, a texel of the atlas and a pixel of the image that measures them.
+#[test]
+fn a_cards_shadow_lands_where_the_sun_projects_it() {
+    let (atlas, atlas_texel) = card();
     let atlas = &atlas;
     for (az, el) in [(35.0f32, 30.0f32), (200.0, 65.0)] {
         let sun = forest_format::shading::Lighting::with_sun(az, el).sun_dir;
-        let (pts, pixel, texel) = shadow_points(atlas, sun);
+        let (pts, pixel, texel) = shadow_points(atlas, sun, Wind::CALM);
         assert!(pts.len() > 50, "sun {sun}: {} shadowed pixels", pts.len());
         // The card's shadow: the square moved 3 m along the sun's ray down to the ground.
         let shift = -3.0 * Vec3::new(sun.x, 0.0, sun.z) / sun.y;
-        let (x0, x1) = pts
-            .iter()
-            .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-        let (z0, z1) = pts
-            .iter()
-            .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        let [x0, x1, z0, z1] = bounds(&pts);
         let tolerance = texel + atlas_texel + pixel;
         for (what, got, want) in [
             ("x min", x0, shift.x - 1.0),
@@ -250,7 +350,7 @@ fn a_trees_shadow_falls_where_its_silhouette_projects_along_the_sun() {
     );
     let mesh = forest_bake::Mesh::load(&pine).unwrap();
     for sun in [dirs[0], dirs[dirs.len() - 1]] {
-        let (pts, pixel, _) = shadow_points(atlas, sun);
+        let (pts, pixel, _) = shadow_points(atlas, sun, Wind::CALM);
         assert!(
             pts.len() > 50,
             "sun {sun}: only {} shadowed pixels",
