@@ -309,12 +309,7 @@ fn render_views(
                 let report = frame(&cam, &target, Some(start + i as f32 * step))?;
                 ctx.check_errors()?;
                 line = report.line;
-                let img = target.read(ctx);
-                Ok(if args.supersample > 1 {
-                    forest_baselines::geometry::downsample(&img, args.supersample)
-                } else {
-                    img
-                })
+                Ok(read_downsampled(&target, ctx, args.supersample))
             })?;
             println!(
                 "{name}: {frames} frames at {} Hz, the last {line} ({}) -> {}",
@@ -466,11 +461,17 @@ fn finish_view(
 
 /// Read the target back, box-filter it down by `supersample`, and write a PNG atomically.
 fn save(target: &Target, ctx: &GpuContext, supersample: u32, out: &Path) -> Result<()> {
-    let mut img = target.read(ctx);
+    write_png(&read_downsampled(target, ctx, supersample), out)
+}
+
+/// The target read back and box-filtered down by `supersample` (the image a view writes).
+fn read_downsampled(target: &Target, ctx: &GpuContext, supersample: u32) -> image::RgbaImage {
+    let img = target.read(ctx);
     if supersample > 1 {
-        img = forest_baselines::geometry::downsample(&img, supersample);
+        forest_baselines::geometry::downsample(&img, supersample)
+    } else {
+        img
     }
-    write_png(&img, out)
 }
 
 /// Write a PNG atomically (temporary name, then rename).

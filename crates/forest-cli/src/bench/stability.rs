@@ -135,10 +135,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             .iter()
             .map(|c| reference(b, r, c))
             .collect::<Result<Vec<_>>>()?;
-        let ref_ff: Vec<f32> = refs
-            .windows(2)
-            .map(|w| forest_metrics::compare(&w[0], &w[1]).map(|m| m.flip_mean))
-            .collect::<Result<_, _>>()?;
+        let ref_ff = consecutive_flips(&refs)?;
         for (mi, &method) in methods.iter().enumerate() {
             // Very small λ is the stochastic case: there, simplify hard.
             let method = match (case.starts_with('e'), method) {
@@ -158,10 +155,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 times.push(t);
                 imgs.push(img);
             }
-            let ff: Vec<f32> = imgs
-                .windows(2)
-                .map(|w| forest_metrics::compare(&w[0], &w[1]).map(|m| m.flip_mean))
-                .collect::<Result<_, _>>()?;
+            let ff = consecutive_flips(&imgs)?;
             let n = ff.len().max(1) as f32;
             let flicker = ff.iter().sum::<f32>() / n - ref_ff.iter().sum::<f32>() / n;
             let pops = ff
@@ -238,4 +232,12 @@ pub fn run(b: &Bench) -> Result<Section> {
         table,
         charts: vec!["stability".into()],
     })
+}
+
+/// Mean FLIP between each pair of consecutive frames (one fewer than the frames).
+pub(super) fn consecutive_flips(frames: &[image::RgbaImage]) -> Result<Vec<f32>> {
+    frames
+        .windows(2)
+        .map(|w| Ok(forest_metrics::compare(&w[0], &w[1])?.flip_mean))
+        .collect()
 }

@@ -126,13 +126,6 @@ fn cases(b: &Bench, forest: &Forest, side: f32, viewport: (u32, u32), seed: u64)
     ]
 }
 
-/// Mean FLIP between consecutive images.
-fn changes(imgs: &[image::RgbaImage]) -> Result<Vec<f32>> {
-    imgs.windows(2)
-        .map(|w| Ok(forest_metrics::compare(&w[0], &w[1])?.flip_mean))
-        .collect()
-}
-
 fn mean(v: &[f32]) -> f32 {
     v.iter().sum::<f32>() / v.len().max(1) as f32
 }
@@ -289,7 +282,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             r.set_wind(at(f))?;
             refs.push(reference(b, &mut r, &cam)?);
         }
-        let ref_changes = changes(&refs)?;
+        let ref_changes = super::stability::consecutive_flips(&refs)?;
         let ref_motion = motion(&refs);
         for (mi, &method) in methods.iter().enumerate() {
             r.set_wind(Wind::CALM)?;
@@ -307,7 +300,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 flips.push(forest_metrics::compare(rf, &img)?.flip_mean);
                 imgs.push(img);
             }
-            let own = changes(&imgs)?;
+            let own = super::stability::consecutive_flips(&imgs)?;
             let flip_wind = mean(&flips);
             let moved = motion(&imgs);
             let motion = moved / ref_motion.max(1e-9);
