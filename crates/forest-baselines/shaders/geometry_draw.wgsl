@@ -19,6 +19,7 @@
 #import shadow
 #import count
 #import wind
+#import tint
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -79,6 +80,12 @@ fn geo_form(id: u32, inst: Instance, lod: u32) -> vec4<u32> {
         range = lod_range(lod, lod_shares(method, camera.forms, sp, d, unit, id));
     }
     return vec4<u32>(id, quad_share(camera.forms, d, unit, id), range);
+}
+
+// The albedo `a` (translucency `tau`) of instance `id` in its own colour (tint.wgsl).
+fn geo_tree_albedo(a: vec3<f32>, tau: f32, id: u32) -> vec3<f32> {
+    let inst = instances[id];
+    return tree_albedo(a, tau, tint_key(id, inst.colour), geo_species[inst.species].colour);
 }
 
 // Whether a pixel of a tree is not this draw's: the quads own it (the transition band), or
@@ -168,6 +175,7 @@ fn fs_geo(in: GeoOut) -> @location(0) vec4<f32> {
     if (in.contrast.a < 1.0) {
         albedo = in.contrast.rgb + in.contrast.a * (albedo - in.contrast.rgb);
     }
+    albedo = geo_tree_albedo(albedo, m.kd.a, in.form.x);
     var n = normalize(in.normal);
     var sky = in.sky.x;
     if (dot(n, in.to_eye) < 0.0) {
@@ -268,7 +276,8 @@ fn fs_billboard(in: BillboardOut) -> @location(0) vec4<f32> {
     let v = sun_transmittance_coarse(opacity, opacity_sampler, in.species, in.sphere,
                                      in.sun_obj.w, start, in.sun_obj.xyz);
     let vis = v * tree_shadow(in.world, in.tree);
-    let out = hazed(vec4<f32>(shade_light(t.rgb, n, vis, g.z, g.w), 1.0), in.world);
+    let albedo = geo_tree_albedo(t.rgb, g.w, in.form.x);
+    let out = hazed(vec4<f32>(shade_light(albedo, n, vis, g.z, g.w), 1.0), in.world);
     count_shown(in.clip, out.a);
     count_depth(in.clip);
     return out;

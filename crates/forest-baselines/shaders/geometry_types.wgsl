@@ -54,6 +54,8 @@ struct GeoSpecies {
     lod1_from: f32,
     lod2_from: f32,
     pad0: u32,
+    // The species' colours in the forest (tint.wgsl).
+    colour: TreeColour,
 }
 
 // The method and its parameters (forest_render::geometry::MeshMethod).

@@ -3,7 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// A species of the geometry-based methods (96 bytes; `GeoSpecies` in
+/// A species of the geometry-based methods (176 bytes; `GeoSpecies` in
 /// `shaders/geometry_types.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -34,6 +34,9 @@ pub struct GpuGeoSpecies {
     pub lod_from: [f32; 2],
     /// Padding to 16 bytes.
     pub pad: u32,
+    /// The species' colours in the forest ([`forest_format::colour::TreeColour`]; set when the
+    /// models are uploaded for a forest).
+    pub colour: forest_format::colour::TreeColour,
 }
 
 /// The mip bias that makes every lookup read a texture's finest level (WGSL clamps biases to

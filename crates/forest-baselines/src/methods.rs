@@ -454,6 +454,15 @@ impl ForestView for ForestRenderer {
         self.stream.wind()
     }
 
+    /// Both forms' season, so that the hybrid's two forms colour a tree alike.
+    fn set_season(&mut self, season: Option<f32>) -> Result<(), RenderError> {
+        self.forms_mut().try_for_each(|f| f.set_season(season))
+    }
+
+    fn season(&self) -> Option<f32> {
+        self.stream.season()
+    }
+
     fn set_pipeline_statistics(&mut self, on: bool) {
         self.forms_mut().for_each(|f| f.set_pipeline_statistics(on));
     }

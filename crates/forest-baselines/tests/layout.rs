@@ -48,6 +48,7 @@ fn geometry_structs_match_the_host() {
                 ("lod1_from", offset_of!(GpuGeoSpecies, lod_from)),
                 ("lod2_from", offset_of!(GpuGeoSpecies, lod_from) + 4),
                 ("pad0", offset_of!(GpuGeoSpecies, pad)),
+                ("colour", offset_of!(GpuGeoSpecies, colour)),
             ],
         ),
         (

@@ -15,7 +15,7 @@ use forest_render::target::{TARGET_FORMAT, Target};
 use forest_render::{Camera, GpuContext, QuadStream};
 use glam::Vec3;
 
-pub use crate::render_args::{LightArgs, MethodArgs, RenderArgs, ShadowArgs, WindArgs};
+pub use crate::render_args::{LightArgs, MethodArgs, RenderArgs, SeasonArgs, ShadowArgs, WindArgs};
 
 /// Load a forest and its species' atlases ([`forest_render::load_scene`]), with a spinner.
 pub fn load_scene(path: &Path) -> Result<(Forest, Vec<SpeciesData>)> {
@@ -138,6 +138,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     r.set_method(&ctx, method)?;
     r.set_shadows(&ctx.device, args.shadow.options(false)?)?;
     r.set_wind(wind)?;
+    r.set_season(args.season.season)?;
     r.set_pipeline_statistics(args.json);
     render_views(args, &ctx, &cameras, animation, |cam, target, instant| {
         if let Some(t) = instant {

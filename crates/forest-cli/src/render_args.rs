@@ -65,6 +65,8 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub wind: WindArgs,
     #[command(flatten)]
+    pub season: SeasonArgs,
+    #[command(flatten)]
     pub shadow: ShadowArgs,
     /// Write an animation of the wind instead of a still: SECONDS of frames from
     /// --wind-time on, at --frame-rate, as an animated PNG (APNG) at the output path.
@@ -210,6 +212,17 @@ impl WindArgs {
         })?;
         Ok(w)
     }
+}
+
+/// The season every method colours the leaves in (shared by `forest render`, `forest view`
+/// and the benches; see `forest_format::colour`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct SeasonArgs {
+    /// The season the leaves are drawn in: a number from 0 to 1 (spring 0, summer 0.33,
+    /// autumn 0.67, late autumn 1) or a name (spring, summer, autumn, late-autumn); each tree
+    /// of a varied forest is a little ahead or behind [default: none, the models' own colours]
+    #[arg(long, value_parser = forest_format::colour::parse_season, allow_hyphen_values = true)]
+    pub season: Option<f32>,
 }
 
 /// The sun's shadows (shared by `forest render` and `forest view`).

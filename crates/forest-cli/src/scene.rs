@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use forest_format::AtlasManifest;
+use forest_format::colour::{Colouring, SpeciesColour};
 use forest_format::terrain::{Terrain, TerrainParams};
 use forest_scene::generate::{GenerateParams, GroundRules, generate, species_height};
 
@@ -60,6 +61,16 @@ pub struct SceneArgs {
     /// tree grows [default: 0.92].
     #[arg(long, allow_negative_numbers = true)]
     pub treeline: Option<f32>,
+    /// How much each tree's colour varies from the others of its species: 0 (every tree of a
+    /// species alike, as before variation) to 3; 1 is natural. The variation comes from a
+    /// hash of each tree, so it costs no byte per tree.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    pub variation: f32,
+    /// Species whose leaves stay green through the seasons and vary less (comma-separated
+    /// atlas names without `.atlas`, or `auto`: every species whose name holds pine, spruce,
+    /// fir, cedar, cypress, juniper or yew).
+    #[arg(long, value_delimiter = ',', default_value = "auto")]
+    pub evergreen: Vec<String>,
     /// Output: binary forest, or JSON when the name ends in .json.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -242,6 +253,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         species.push(stored_path(s, &args.output)?);
     }
     let (species_scale, size_lines) = species_scales(args, &manifests)?;
+    let colouring = colouring(args)?;
     // Millions of trees take seconds to place and sort: say so while it runs.
     let spinner = indicatif::ProgressBar::new_spinner();
     if args.trees >= 100_000 {
@@ -283,6 +295,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         ..GenerateParams::default()
     })
     .map_err(anyhow::Error::msg)?;
+    let forest = forest.with_colouring(colouring);
     // What `render` would refuse is refused here, before anything is written.
     forest.check(&args.output)?;
     forest_format::species::check(&forest, &manifests.iter().collect::<Vec<_>>(), &args.output)?;
@@ -297,6 +310,24 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         forest.presort.directions.len(),
         args.output.display()
     );
+    if let Some(c) = &forest.colouring {
+        let evergreen: Vec<&str> = args
+            .species
+            .iter()
+            .zip(&c.species)
+            .filter(|(_, s)| **s == SpeciesColour::EVERGREEN)
+            .map(|(p, _)| p.to_str().unwrap_or("?"))
+            .collect();
+        println!(
+            "  colour variation {} (evergreen: {})",
+            c.amount,
+            if evergreen.is_empty() {
+                "none".to_string()
+            } else {
+                evergreen.join(", ")
+            }
+        );
+    }
     if let Some(t) = &forest.terrain {
         let (lo, hi) = t.height_range();
         let ([x0, _], [x1, _]) = t.bounds();
@@ -312,6 +343,45 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         println!("{l}");
     }
     Ok(())
+}
+
+/// The forest's colouring from `--variation` and `--evergreen`; the error names the option
+/// and the bound.
+fn colouring(args: &SceneArgs) -> Result<Colouring> {
+    let amount = args.variation;
+    if !(0.0..=forest_format::colour::MAX_AMOUNT).contains(&amount) {
+        bail!(
+            "--variation {amount}: expected 0 (none) to {} (1 is natural)",
+            forest_format::colour::MAX_AMOUNT
+        );
+    }
+    let names: Vec<String> = args.species.iter().map(|p| species_name(p)).collect();
+    let auto = args.evergreen.iter().any(|e| e == "auto");
+    for e in args
+        .evergreen
+        .iter()
+        .filter(|e| *e != "auto" && !e.is_empty())
+    {
+        if !names.contains(e) {
+            bail!(
+                "--evergreen {e}: no species of that name (the species are {})",
+                names.join(", ")
+            );
+        }
+    }
+    let species = names
+        .iter()
+        .map(|n| {
+            if args.evergreen.contains(n) {
+                SpeciesColour::EVERGREEN
+            } else if auto {
+                SpeciesColour::by_name(n)
+            } else {
+                SpeciesColour::DECIDUOUS
+            }
+        })
+        .collect();
+    Ok(Colouring::new(amount, species))
 }
 
 /// Each species' foot ([`forest_format::model::footprint_radius`] of its model, recorded in

@@ -64,6 +64,8 @@ pub struct ViewArgs {
     #[command(flatten)]
     pub wind: crate::render::WindArgs,
     #[command(flatten)]
+    pub season: crate::render::SeasonArgs,
+    #[command(flatten)]
     pub shadow: crate::render::ShadowArgs,
 }
 
@@ -253,6 +255,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     r.set_method(&ctx, method)?;
     r.set_shadows(&ctx.device, args.shadow.options(true)?)?;
     r.set_wind(wind)?;
+    r.set_season(args.season.season)?;
     let target = Target::new(&ctx, args.size.0, args.size.1);
     // The overdraw view: each frame counted (drawn twice more) and its heat map drawn over it.
     let counter = match args.debug_view {

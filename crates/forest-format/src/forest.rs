@@ -5,10 +5,16 @@
 //!   little-endian [`Instance`] records, then the presort directions and orders. Compact enough
 //!   for 1M instances (24 bytes per instance plus 4 bytes per instance per presort direction).
 //!   Version 2 appends the terrain (see [`Terrain::write_to`]); a forest without terrain is
-//!   written as version 1, which both versions' readers read.
+//!   written as version 1, which both versions' readers read. Version 3, written only for a
+//!   forest with a colouring ([`Colouring`]), appends a flags word (1: terrain, 2: colouring),
+//!   the terrain if flagged, then `TINT`: the amount, per species 16 `f32`s
+//!   ([`SpeciesColour`]: hue, saturation, brightness, bark, then spring's, autumn's and late
+//!   autumn's tint and strength), a count (0 or the instances) and that many explicit values.
 //! - **JSON** (`.json`), for small hand-made scenes: `{"species": [...], "instances": [{"species":
 //!   0, "position": [x, y, z], "rotation_deg": 0, "scale": 1}]}`, optionally `"terrain": {"size":
-//!   [nx, nz], "origin": [x, z], "spacing": s, "heights": [...]}`; presorts are computed on load.
+//!   [nx, nz], "origin": [x, z], "spacing": s, "heights": [...]}`, and `"colour": {"amount": 1,
+//!   "species": [...]}` (each a [`SpeciesColour`]) with an instance's explicit value as its
+//!   `"colour": 0.42`; presorts are computed on load.
 //!
 //! Writers go through a temporary name and a rename; readers check every count and value.
 
@@ -18,13 +24,19 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::colour::{Colouring, SpeciesColour};
 use crate::directions::hemisphere_directions;
 use crate::error::FormatError;
 use crate::terrain::Terrain;
 
 /// Binary forest format version (2: with a terrain; a forest without one is written as 1).
-pub const FOREST_VERSION: u32 = 2;
+pub const FOREST_VERSION: u32 = 3;
 const TERRAIN_MAGIC: &[u8; 4] = b"TERR";
+const COLOUR_MAGIC: &[u8; 4] = b"TINT";
+/// Version 3's flags word: a terrain follows.
+const FLAG_TERRAIN: u32 = 1;
+/// Version 3's flags word: a colouring follows.
+const FLAG_COLOUR: u32 = 2;
 const MAGIC: &[u8; 4] = b"FRST";
 /// Default number of presort directions.
 pub const DEFAULT_PRESORT_DIRECTIONS: u32 = 15;
@@ -108,6 +120,10 @@ pub struct Forest {
     pub presort: Presort,
     /// The ground the trees stand on (`None`: flat at y = 0).
     pub terrain: Option<Terrain>,
+    /// How the trees' colours vary, per tree and through the seasons (`None`: every tree
+    /// keeps its model's colours; a season still turns the leaves, by the species' names,
+    /// without a spread).
+    pub colouring: Option<Colouring>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -119,6 +135,8 @@ struct JsonInstance {
     rotation_deg: f32,
     #[serde(default = "one")]
     scale: f32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    colour: Option<f32>,
 }
 fn one() -> f32 {
     1.0
@@ -133,6 +151,15 @@ struct JsonForest {
     presort_directions: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     terrain: Option<JsonTerrain>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    colour: Option<JsonColour>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonColour {
+    amount: f32,
+    species: Vec<SpeciesColour>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -153,6 +180,31 @@ impl Forest {
             instances,
             presort,
             terrain: None,
+            colouring: None,
+        }
+    }
+
+    /// The forest with its trees coloured by `colouring`.
+    pub fn with_colouring(mut self, colouring: Colouring) -> Self {
+        self.colouring = Some(colouring);
+        self
+    }
+
+    /// Species `k`'s colours as every method's shaders read them: its colouring at the
+    /// forest's amount; without a colouring, no variation and the seasons of its name
+    /// ([`SpeciesColour::by_name`]).
+    pub fn tree_colour(&self, k: usize) -> crate::colour::TreeColour {
+        match &self.colouring {
+            Some(c) => c
+                .species
+                .get(k)
+                .map_or(crate::colour::TreeColour::NONE, |s| s.gpu(c.amount)),
+            None => self
+                .species
+                .get(k)
+                .map_or(crate::colour::TreeColour::NONE, |n| {
+                    SpeciesColour::by_name(n).gpu(0.0)
+                }),
         }
     }
 
@@ -207,6 +259,10 @@ impl Forest {
         if let Some(t) = &self.terrain {
             t.check()
                 .map_err(|e| FormatError::invalid(path, format!("terrain: {e}")))?;
+        }
+        if let Some(c) = &self.colouring {
+            c.check(self.species.len(), self.instances.len())
+                .map_err(|e| FormatError::invalid(path, e))?;
         }
         let p = &self.presort;
         if p.directions.is_empty() || p.directions.len() != p.orders.len() {
@@ -278,7 +334,29 @@ impl Forest {
                     format!("presort_directions = {k}: must be 1 to 256"),
                 ));
             }
-            let forest = Self::new(j.species, instances, k);
+            let explicit: Vec<f32> = j
+                .instances
+                .iter()
+                .map(|i| i.colour.unwrap_or(-1.0))
+                .collect();
+            let any_explicit = j.instances.iter().any(|i| i.colour.is_some());
+            let mut forest = Self::new(j.species, instances, k);
+            match (j.colour, any_explicit) {
+                (Some(c), _) => {
+                    forest.colouring = Some(Colouring {
+                        amount: c.amount,
+                        species: c.species,
+                        explicit: if any_explicit { explicit } else { Vec::new() },
+                    })
+                }
+                (None, true) => {
+                    return Err(FormatError::invalid(
+                        path,
+                        "instances give a \"colour\" but the forest has no \"colour\" section",
+                    ));
+                }
+                (None, false) => {}
+            }
             match j.terrain {
                 Some(t) => forest.with_terrain(Terrain {
                     size: t.size,
@@ -303,11 +381,18 @@ impl Forest {
                 instances: self
                     .instances
                     .iter()
-                    .map(|i| JsonInstance {
+                    .enumerate()
+                    .map(|(k, i)| JsonInstance {
                         species: i.species,
                         position: i.position,
                         rotation_deg: i.rotation.to_degrees(),
                         scale: i.scale,
+                        colour: self
+                            .colouring
+                            .as_ref()
+                            .and_then(|c| c.explicit.get(k))
+                            .filter(|v| **v >= 0.0)
+                            .copied(),
                     })
                     .collect(),
                 presort_directions: Some(self.presort.directions.len() as u32),
@@ -316,6 +401,10 @@ impl Forest {
                     origin: t.origin,
                     spacing: t.spacing,
                     heights: t.heights.clone(),
+                }),
+                colour: self.colouring.as_ref().map(|c| JsonColour {
+                    amount: c.amount,
+                    species: c.species.clone(),
                 }),
             };
             serde_json::to_vec_pretty(&j).expect("a forest serialises")
@@ -329,7 +418,11 @@ impl Forest {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::new();
         out.extend_from_slice(MAGIC);
-        let version: u32 = if self.terrain.is_some() { 2 } else { 1 };
+        let version: u32 = match (&self.colouring, &self.terrain) {
+            (Some(_), _) => 3,
+            (None, Some(_)) => 2,
+            (None, None) => 1,
+        };
         out.extend_from_slice(&version.to_le_bytes());
         out.extend_from_slice(&(self.species.len() as u32).to_le_bytes());
         for s in &self.species {
@@ -345,9 +438,26 @@ impl Forest {
         for o in &self.presort.orders {
             out.extend_from_slice(bytemuck::cast_slice(o));
         }
+        if version == 3 {
+            let flags = if self.terrain.is_some() {
+                FLAG_TERRAIN | FLAG_COLOUR
+            } else {
+                FLAG_COLOUR
+            };
+            out.extend_from_slice(&flags.to_le_bytes());
+        }
         if let Some(t) = &self.terrain {
             out.extend_from_slice(TERRAIN_MAGIC);
             t.write_to(&mut out);
+        }
+        if let Some(c) = &self.colouring {
+            out.extend_from_slice(COLOUR_MAGIC);
+            out.extend_from_slice(&c.amount.to_le_bytes());
+            for s in &c.species {
+                out.extend_from_slice(bytemuck::cast_slice(&species_colour_words(s)));
+            }
+            out.extend_from_slice(&(c.explicit.len() as u32).to_le_bytes());
+            out.extend_from_slice(bytemuck::cast_slice(&c.explicit));
         }
         out
     }
@@ -389,9 +499,25 @@ impl Forest {
         for _ in 0..k {
             orders.push(bytemuck::pod_collect_to_vec(r.take(n * 4)?));
         }
-        let terrain = if version >= 2 {
+        let flags = match version {
+            1 => 0,
+            2 => FLAG_TERRAIN,
+            _ => {
+                let f = r.u32()?;
+                if f & !(FLAG_TERRAIN | FLAG_COLOUR) != 0 || f & FLAG_COLOUR == 0 {
+                    return Err(format!(
+                        "version 3 flags {f:#x}: 1 (terrain) and 2 (colouring, required) are the \
+                         only ones"
+                    ));
+                }
+                f
+            }
+        };
+        let terrain = if flags & FLAG_TERRAIN != 0 {
             if r.take(4)? != TERRAIN_MAGIC {
-                return Err("a version 2 forest without its TERR section".into());
+                return Err(format!(
+                    "a version {version} forest without its TERR section"
+                ));
             }
             let t = Terrain::read_from(|n| r.take(n).map(<[u8]>::to_vec))
                 .map_err(|e| format!("terrain: {e}"))?;
@@ -399,11 +525,35 @@ impl Forest {
         } else {
             None
         };
+        let colouring = if flags & FLAG_COLOUR != 0 {
+            if r.take(4)? != COLOUR_MAGIC {
+                return Err("a version 3 forest without its TINT section".into());
+            }
+            let amount = r.f32()?;
+            let words: Vec<f32> = bytemuck::pod_collect_to_vec(r.take(ns * 64)?);
+            let species = words.chunks_exact(16).map(species_colour).collect();
+            let m = r.u32()? as usize;
+            if m != 0 && m != n {
+                return Err(format!(
+                    "{m} explicit colour values for {n} instances (must be 0 or one each)"
+                ));
+            }
+            let explicit = bytemuck::pod_collect_to_vec(r.take(m * 4)?);
+            Some(Colouring {
+                amount,
+                species,
+                explicit,
+            })
+        } else {
+            None
+        };
         if r.at != bytes.len() {
             return Err(format!(
                 "{} bytes of trailing data after the {}",
                 bytes.len() - r.at,
-                if terrain.is_some() {
+                if colouring.is_some() {
+                    "colouring"
+                } else if terrain.is_some() {
                     "terrain"
                 } else {
                     "presorts"
@@ -415,6 +565,7 @@ impl Forest {
             instances,
             presort: Presort { directions, orders },
             terrain,
+            colouring,
         })
     }
 
@@ -475,6 +626,37 @@ impl Reader<'_> {
     fn u32(&mut self) -> Result<u32, String> {
         Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
     }
+    fn f32(&mut self) -> Result<f32, String> {
+        self.u32().map(f32::from_bits)
+    }
+}
+
+/// A species' colours as the binary form's 16 words.
+fn species_colour_words(s: &SpeciesColour) -> [f32; 16] {
+    let k = |k: crate::colour::SeasonKey| [k.tint[0], k.tint[1], k.tint[2], k.strength];
+    let mut w = [0.0; 16];
+    w[..4].copy_from_slice(&[s.hue_deg, s.saturation, s.brightness, s.bark]);
+    w[4..8].copy_from_slice(&k(s.spring));
+    w[8..12].copy_from_slice(&k(s.autumn));
+    w[12..].copy_from_slice(&k(s.late_autumn));
+    w
+}
+
+/// [`species_colour_words`] read back (`w` holds 16 words).
+fn species_colour(w: &[f32]) -> SpeciesColour {
+    let k = |o: usize| crate::colour::SeasonKey {
+        tint: [w[o], w[o + 1], w[o + 2]],
+        strength: w[o + 3],
+    };
+    SpeciesColour {
+        hue_deg: w[0],
+        saturation: w[1],
+        brightness: w[2],
+        bark: w[3],
+        spring: k(4),
+        autumn: k(8),
+        late_autumn: k(12),
+    }
 }
 
 /// Write `bytes` to `path` through a temporary sibling and a rename.
@@ -532,6 +714,74 @@ mod tests {
             assert!((a.rotation - b.rotation).abs() < 1e-5);
             assert_eq!(a.position, b.position);
         }
+    }
+
+    #[test]
+    fn a_colouring_round_trips_and_old_forests_keep_their_bytes() {
+        use crate::colour::{Colouring, SpeciesColour};
+        let plain = sample();
+        let mut colouring = Colouring::new(
+            0.7,
+            vec![SpeciesColour::DECIDUOUS, SpeciesColour::EVERGREEN],
+        );
+        let f = plain.clone().with_colouring(colouring.clone());
+        let bytes = f.to_bytes();
+        assert_eq!(bytes[4..8], 3u32.to_le_bytes());
+        // The colouring costs its species' records and no byte per tree.
+        assert_eq!(bytes.len(), plain.to_bytes().len() + 4 + 4 + 4 + 2 * 64 + 4);
+        assert_eq!(Forest::from_bytes(&bytes).unwrap(), f);
+        // With a terrain and explicit values (4 bytes per tree), in both forms.
+        colouring.explicit = (0..50)
+            .map(|k| if k % 3 == 0 { 0.5 } else { -1.0 })
+            .collect();
+        let terrain = Terrain {
+            size: [2, 2],
+            origin: [-20.0, -15.0],
+            spacing: 40.0,
+            heights: vec![0.0, 1.0, 2.0, 3.0],
+        };
+        let f = plain.with_terrain(terrain).with_colouring(colouring);
+        assert_eq!(Forest::from_bytes(&f.to_bytes()).unwrap(), f);
+        let dir = tempfile::tempdir().unwrap();
+        let json = dir.path().join("f.json");
+        f.save(&json).unwrap();
+        let back = Forest::load(&json).unwrap();
+        assert_eq!(back.colouring, f.colouring);
+        // Bad sections are named.
+        let err = |b: &[u8]| Forest::from_bytes(b).unwrap_err();
+        let bytes = f.to_bytes();
+        assert!(err(&bytes[..bytes.len() - 3]).contains("truncated"));
+        let mut extra = bytes.clone();
+        extra.push(0);
+        assert!(
+            err(&extra).contains("after the colouring"),
+            "{}",
+            err(&extra)
+        );
+        let at = plain_len_with_presorts(&f);
+        let mut flags = bytes.clone();
+        flags[at..at + 4].copy_from_slice(&4u32.to_le_bytes());
+        assert!(err(&flags).contains("flags 0x4"), "{}", err(&flags));
+        let mut nan = f.clone();
+        nan.colouring.as_mut().unwrap().species[1].hue_deg = f32::NAN;
+        let path = dir.path().join("nan.forest");
+        let e = Forest::parse(&path, &nan.to_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("species 1's colour: hue_deg is NaN"), "{e}");
+        // An instance's value without a colouring is refused in JSON.
+        let j = r#"{"species": ["a"], "instances": [{"species": 0, "position": [0, 0, 0],
+            "colour": 0.5}]}"#;
+        let e = Forest::parse(&json, j.as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("no \"colour\" section"), "{e}");
+    }
+
+    /// Where a forest's bytes after its presorts start.
+    fn plain_len_with_presorts(f: &Forest) -> usize {
+        let names: usize = f.species.iter().map(|s| 4 + s.len()).sum();
+        let n = f.instances.len();
+        let k = f.presort.directions.len();
+        12 + names + 4 + 24 * n + 4 + 12 * k + 4 * k * n
     }
 
     #[test]

@@ -34,6 +34,7 @@ pub mod atlas;
 pub mod atomic;
 pub mod bounded;
 pub mod camera_path;
+pub mod colour;
 pub mod cutout;
 pub mod directions;
 pub mod error;

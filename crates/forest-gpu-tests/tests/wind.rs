@@ -15,7 +15,6 @@ use forest_render::options::{Atmosphere, Background};
 use forest_render::target::Target;
 use forest_render::{Camera, ForestView, GpuContext};
 use glam::Vec3;
-use wgpu::util::DeviceExt;
 
 /// A compute module evaluating `swayed` and `wind_reach` for each input.
 const HARNESS: &str = r#"
@@ -40,30 +39,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 /// The GPU's `swayed` point and `wind_reach` for each tree and point under `wind`.
 fn gpu_swayed(ctx: &GpuContext, wind: &Wind, samples: &[(Vec3, SwayedTree)]) -> Vec<[f32; 4]> {
-    let src = forest_render::shaders::Composer::runtime()
-        .with_module("harness", HARNESS)
-        .compose(&["harness"])
-        .unwrap();
-    let d = &ctx.device;
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("wind harness"),
-        source: wgpu::ShaderSource::Wgsl(src.into()),
-    });
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("wind harness"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let mut cam = GpuCamera::default();
     cam.set_wind(wind);
-    let camera = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::bytes_of(&cam),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
     let data: Vec<[f32; 4]> = samples
         .iter()
         .flat_map(|(p, t)| {
@@ -74,57 +51,13 @@ fn gpu_swayed(ctx: &GpuContext, wind: &Wind, samples: &[(Vec3, SwayedTree)]) -> 
             ]
         })
         .collect();
-    let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&data),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (samples.len() * 16) as u64;
-    let output = d.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let read = d.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: camera.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: output.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&output, 0, &read, 0, size);
-    ctx.queue.submit([enc.finish()]);
-    read.slice(..)
-        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let out = bytemuck::cast_slice(&read.slice(..).get_mapped_range().unwrap()).to_vec();
-    assert_eq!(ctx.take_errors(), Vec::<String>::new());
-    out
+    common::run_harness(
+        ctx,
+        HARNESS,
+        bytemuck::bytes_of(&cam),
+        &[bytemuck::cast_slice(&data)],
+        samples.len(),
+    )
 }
 
 #[test]

@@ -62,6 +62,9 @@ struct Camera {
     // gustiness; wind_time.x the instant (seconds).
     wind: vec4<f32>,
     wind_time: vec4<f32>,
+    // The frame's season (forest_format::colour): x 1 when leaves follow the seasons' ramp (0:
+    // the models' own colours), y where on it (0 spring to 1 late autumn).
+    season: vec4<f32>,
 }
 
 // Whether a caster's bounding sphere (world centre `c`, radius `r`) can shadow the light
@@ -235,7 +238,20 @@ struct Instance {
     cos_rot: f32,
     sin_rot: f32,
     species: u32,
-    pad: u32,
+    // 0: the tree's colour comes from the hash of its index; else its explicit value's code.
+    colour: u32,
+}
+
+// A species' colours in the forest (forest_format::colour::TreeColour; see tint.wgsl):
+// amplitudes of the hue turn (radians), saturation, brightness and bark brightness; x of
+// phase: the season's spread between trees; the spring, autumn and late-autumn keys (tint
+// rgb, strength w).
+struct TreeColour {
+    amplitude: vec4<f32>,
+    phase: vec4<f32>,
+    spring: vec4<f32>,
+    autumn: vec4<f32>,
+    late_autumn: vec4<f32>,
 }
 
 struct Species {
@@ -259,6 +275,7 @@ struct Species {
     switch_unit: f32,
     // Optical depth per voxel length of the species' opacity-volume code 1.0 (0: none).
     opacity_depth: f32,
+    colour: TreeColour,
 }
 
 // One direction frame: dir, right, up (xyz of each), object space.

@@ -37,6 +37,7 @@
 #import shadow
 #import count
 #import wind
+#import tint
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
@@ -427,7 +428,11 @@ fn lit_texel(in: Fragment, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
     let n = normalize(local.x * in.frame_right + local.y * in.frame_up + local.z * frame_dir);
     let sky = min(g.z * inv, 1.0);
     let tau = min(g.w * inv, 1.0);
-    return vec4<f32>(shade_light(c.rgb * inv, n, in.sun_vis, sky, tau) * c.a, c.a);
+    // The tree's own colour (share.z: its instance).
+    let inst = instances[in.share.z];
+    let a = tree_albedo(c.rgb * inv, tau, tint_key(in.share.z, inst.colour),
+                        species[inst.species].colour);
+    return vec4<f32>(shade_light(a, n, in.sun_vis, sky, tau) * c.a, c.a);
 }
 
 // Debug views (camera.debug_view, see forest_render::options::DebugView): 0 off, 1 levels, 2 blend weights,

@@ -28,6 +28,10 @@ pub struct FrameParams {
     /// The frame's wind, which moves every tree ([`forest_format::wind`]); it rides in the
     /// camera uniform too.
     pub wind: forest_format::wind::Wind,
+    /// The frame's season, 0 (spring) to 1 (late autumn), which turns the leaves of every
+    /// tree ([`forest_format::colour`]); `None`: the models' own colours. It rides in the
+    /// camera uniform too.
+    pub season: Option<f32>,
 }
 
 impl From<&Camera> for FrameParams {
@@ -41,6 +45,7 @@ impl From<&Camera> for FrameParams {
             epsilon: c.epsilon,
             light: Default::default(),
             wind: forest_format::wind::Wind::CALM,
+            season: None,
         }
     }
 }
@@ -75,6 +80,7 @@ impl FrameParams {
             .validate()
             .map_err(|e| CameraError(format!("light: {e}")))?;
         self.wind.validate().map_err(CameraError)?;
+        forest_format::colour::check_season(self.season).map_err(CameraError)?;
         Ok(())
     }
 
@@ -108,6 +114,7 @@ impl FrameParams {
             self.epsilon,
         );
         g.set_light(&self.light);
+        g.set_season(self.season);
         g
     }
 }
@@ -231,6 +238,7 @@ mod tests {
             epsilon: 4.0,
             light: Default::default(),
             wind: forest_format::wind::Wind::CALM,
+            season: None,
         };
         assert!(f.validate().is_ok());
         assert!((f.forward() - c.forward()).length() < 1e-5);

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 
 /// The camera, the frame's light and its sun's shadow cascades: the only data written to the
-/// GPU per frame (736 bytes; a stream with shadows writes one per light view after it, in the
+/// GPU per frame (752 bytes; a stream with shadows writes one per light view after it, in the
 /// same write, see [`crate::shadow`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -76,6 +76,10 @@ pub struct GpuCamera {
     pub wind: [f32; 4],
     /// `x`: the wind's instant (seconds); `y`, `z`, `w` unused.
     pub wind_time: [f32; 4],
+    /// The frame's season ([`forest_format::colour`]): `x` 1 when the leaves follow the
+    /// seasons' ramp (0: the models' own colours), `y` where on it (0 spring to 1 late
+    /// autumn); `z`, `w` unused.
+    pub season: [f32; 4],
 }
 
 impl GpuCamera {
@@ -87,6 +91,24 @@ impl GpuCamera {
     /// The wind's uniform vectors, as [`forest_format::wind::swayed`] takes them.
     pub fn wind_uniform(&self) -> [[f32; 4]; 2] {
         [self.wind, self.wind_time]
+    }
+
+    /// Write the frame's season into the camera (`None`: the models' own colours).
+    pub fn set_season(&mut self, season: Option<f32>) {
+        self.season = match season {
+            Some(s) => [1.0, s, 0.0, 0.0],
+            None => [0.0; 4],
+        };
+    }
+
+    /// The season the camera carries, as [`forest_format::colour::tree_albedo`] takes it
+    /// (negative: none).
+    pub fn season_position(&self) -> f32 {
+        if self.season[0] > 0.0 {
+            self.season[1]
+        } else {
+            -1.0
+        }
     }
 
     /// Write the frame's light into the camera.
@@ -114,11 +136,12 @@ pub struct GpuInstance {
     pub sin_rot: f32,
     /// Species index.
     pub species: u32,
-    /// Padding.
-    pub pad: u32,
+    /// The tree's colour code: 0 for the hash of its index, else its explicit value's
+    /// ([`forest_format::colour::explicit_code`]).
+    pub colour: u32,
 }
 
-/// Per-species table entry (64 bytes).
+/// Per-species table entry (144 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuSpecies {
@@ -151,6 +174,8 @@ pub struct GpuSpecies {
     /// Optical depth per voxel length of the species' opacity-volume code 255
     /// ([`forest_format::atlas::OpacityInfo::max_depth`]; 0: no self-shadowing).
     pub opacity_depth: f32,
+    /// The species' colours in the forest ([`forest_format::colour::TreeColour`]).
+    pub colour: forest_format::colour::TreeColour,
 }
 
 /// A sampling direction's frame (48 bytes; `w` unused).

@@ -119,6 +119,7 @@ impl SceneTables {
                 resolution: m.params.resolution,
                 switch_unit: crate::forms::switch_unit(m),
                 opacity_depth: m.opacity.max_depth,
+                colour: forest.tree_colour(k),
             });
             t.frames.extend(m.directions.iter().map(|f| GpuFrame {
                 dir: f.dir.extend(0.0).to_array(),
@@ -164,13 +165,14 @@ pub fn gpu_instances(forest: &Forest) -> Vec<GpuInstance> {
     forest
         .instances
         .iter()
-        .map(|i| GpuInstance {
+        .enumerate()
+        .map(|(k, i)| GpuInstance {
             position: i.position,
             scale: i.scale,
             cos_rot: i.rotation.cos(),
             sin_rot: i.rotation.sin(),
             species: i.species,
-            pad: 0,
+            colour: forest.colouring.as_ref().map_or(0, |c| c.code(k)),
         })
         .collect()
 }

@@ -49,9 +49,12 @@ pub const OVERDRAW_WGSL: &str = include_str!("../shaders/overdraw.wgsl");
 /// Where the frame's wind moves a tree's points (`swayed`, `wind_reach`; in a module that
 /// declares `camera`).
 pub const WIND_WGSL: &str = include_str!("../shaders/wind.wgsl");
+/// Each tree's own colour and the seasons (`tree_albedo`, `tint_key`; in a module that
+/// declares `camera`; mirrors [`forest_format::colour`]).
+pub const TINT_WGSL: &str = include_str!("../shaders/tint.wgsl");
 
 /// The runtime's modules by the names `#import` lines give.
-pub const MODULES: [(&str, &str); 16] = [
+pub const MODULES: [(&str, &str); 17] = [
     ("common", COMMON_WGSL),
     ("ground", GROUND_WGSL),
     ("environment", ENVIRONMENT_WGSL),
@@ -68,6 +71,7 @@ pub const MODULES: [(&str, &str); 16] = [
     ("count_on", COUNT_ON_WGSL),
     ("overdraw", OVERDRAW_WGSL),
     ("wind", WIND_WGSL),
+    ("tint", TINT_WGSL),
 ];
 
 /// Why a shader module could not be composed.

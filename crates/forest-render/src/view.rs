@@ -33,6 +33,7 @@ pub struct FrameInputs {
     camera: wgpu::Buffer,
     light: forest_format::shading::Lighting,
     wind: forest_format::wind::Wind,
+    season: Option<f32>,
     forms: [f32; 4],
     background: Background,
     depth_clear: f32,
@@ -61,6 +62,7 @@ impl FrameInputs {
             camera,
             light: opts.lighting,
             wind: forest_format::wind::Wind::CALM,
+            season: None,
             forms,
             background: opts.background,
             depth_clear: opts.depth_clear(),
@@ -147,6 +149,7 @@ impl FrameInputs {
         g.forms = self.forms;
         g.set_light(&self.light);
         g.set_wind(&self.wind);
+        g.set_season(self.season);
         if let Some(h) = &self.host_shadows {
             h.write(g);
         }
@@ -242,6 +245,13 @@ pub trait ForestView {
     fn set_wind(&mut self, wind: forest_format::wind::Wind) -> Result<(), RenderError>;
     /// The wind frames are drawn in.
     fn wind(&self) -> forest_format::wind::Wind;
+    /// The season of the frames written from the next [`Self::set_camera`] on (a
+    /// [`Self::prepare`] takes its frame's own): 0 (spring) to 1 (late autumn) turns every
+    /// tree's leaves ([`forest_format::colour`]); `None` keeps the models' own colours.
+    /// Refused outside 0 to 1.
+    fn set_season(&mut self, season: Option<f32>) -> Result<(), RenderError>;
+    /// The season frames are drawn in.
+    fn season(&self) -> Option<f32>;
     /// Gather pipeline statistics from the next frame on, where the device has
     /// `PIPELINE_STATISTICS_QUERY` (off by default; see [`crate::work`]).
     fn set_pipeline_statistics(&mut self, on: bool);
@@ -348,6 +358,16 @@ impl<F: Form> ForestView for F {
         self.inputs().wind
     }
 
+    fn set_season(&mut self, season: Option<f32>) -> Result<(), RenderError> {
+        forest_format::colour::check_season(season).map_err(RenderError::Parameter)?;
+        self.inputs_mut().season = season;
+        Ok(())
+    }
+
+    fn season(&self) -> Option<f32> {
+        self.inputs().season
+    }
+
     fn set_pipeline_statistics(&mut self, on: bool) {
         self.inputs_mut().statistics = on;
     }
@@ -389,6 +409,7 @@ impl<F: Form> ForestView for F {
         frame.validate()?;
         self.inputs_mut().light = frame.light;
         self.inputs_mut().wind = frame.wind;
+        self.inputs_mut().season = frame.season;
         self.write_frame(queue, frame.to_gpu());
         Ok(())
     }

@@ -142,6 +142,7 @@ pub fn frame(
         epsilon,
         light: Default::default(),
         wind,
+        season: None,
     }
 }
 

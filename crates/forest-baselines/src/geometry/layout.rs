@@ -50,7 +50,9 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     };
     vec![
         buffer(0, S::VERTEX_FRAGMENT, uniform),
-        buffer(1, S::VERTEX, read),
+        // The instances and species (9) are read by the fragment stage too, for each tree's
+        // colour (tint.wgsl).
+        buffer(1, S::VERTEX_FRAGMENT, read),
         buffer(2, S::VERTEX, read),
         buffer(3, S::VERTEX, read),
         buffer(4, S::FRAGMENT, read),
@@ -65,7 +67,7 @@ pub fn draw_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         texture(7),
         // The environment: the terrain's grid is read by `vs_terrain`.
         buffer(8, S::VERTEX_FRAGMENT, uniform),
-        buffer(9, S::VERTEX, read),
+        buffer(9, S::VERTEX_FRAGMENT, read),
         // The method: its texture bias is read by `fs_geo`.
         buffer(10, S::VERTEX_FRAGMENT, uniform),
         buffer(11, S::VERTEX, read),

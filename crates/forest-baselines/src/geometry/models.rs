@@ -161,6 +161,15 @@ impl GpuModels {
             figures,
         } = prepared;
         let capacity = checked_capacity(ctx, prepared, forest)?;
+        // Each species in the forest's colours.
+        let geo_species: &Vec<_> = &geo_species
+            .iter()
+            .enumerate()
+            .map(|(k, s)| crate::gpu_types::GpuGeoSpecies {
+                colour: forest.tree_colour(k),
+                ..*s
+            })
+            .collect();
         let device = &ctx.device;
         let terrain = GpuTerrain::new(device, forest.terrain.as_ref())?;
         let instances = forest_render::scene::gpu_instances(forest);

@@ -166,6 +166,7 @@ impl PreparedGeometry {
                 opacity_depth: m.opacity.max_depth,
                 lod_from: s.lod_from,
                 pad: 0,
+                colour: forest_format::colour::TreeColour::NONE,
             });
             let mut start = first as usize;
             for c in counts {

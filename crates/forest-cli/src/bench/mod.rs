@@ -101,6 +101,10 @@ pub struct BenchArgs {
     /// The wind every suite's frames are drawn in (calm unless `--wind`).
     #[command(flatten)]
     pub wind: crate::render::WindArgs,
+    /// The season every suite's frames are drawn in (the models' own colours unless
+    /// `--season`).
+    #[command(flatten)]
+    pub season: crate::render::SeasonArgs,
 }
 
 /// What every suite works with.
@@ -134,6 +138,8 @@ pub struct Bench {
     pub shadows: Option<forest_render::shadow::ShadowOptions>,
     /// The wind every suite's renderers draw in (`--wind`).
     pub wind: forest_format::wind::Wind,
+    /// The season of every frame (`None`: the models' own colours).
+    pub season: Option<f32>,
 }
 
 /// Every method at its default parameters, in the order the suites report them.
@@ -235,6 +241,7 @@ impl Bench {
             methods: args.methods.clone(),
             shadows: args.shadow.options(false)?,
             wind: args.wind.wind()?,
+            season: args.season.season,
         })
     }
 
@@ -392,6 +399,7 @@ impl Bench {
     pub fn shadowed(&self, mut r: ForestRenderer) -> Result<ForestRenderer> {
         r.set_shadows(&self.ctx.device, self.shadows)?;
         r.set_wind(self.wind)?;
+        r.set_season(self.season)?;
         Ok(r)
     }
 

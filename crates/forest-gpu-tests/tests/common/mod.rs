@@ -415,3 +415,85 @@ pub fn transparent_stream(
         forest_render::target::Target::new(ctx, 160, 120),
     )
 }
+
+/// Run the compute entry point `main` of the runtime's modules with `harness` added (its
+/// bindings in group 0: the uniform `uniform` at 0, the storage buffers `inputs` at 1, 2, …,
+/// and after them the output array of `count` `vec4<f32>`) over `count` invocations
+/// (workgroups of 64), and read the output back. Any wgpu error fails the test.
+pub fn run_harness(
+    ctx: &GpuContext,
+    harness: &str,
+    uniform: &[u8],
+    inputs: &[&[u8]],
+    count: usize,
+) -> Vec<[f32; 4]> {
+    use wgpu::BufferUsages as U;
+    use wgpu::util::DeviceExt;
+    let src = forest_render::shaders::Composer::runtime()
+        .with_module("harness", harness)
+        .compose(&["harness"])
+        .unwrap();
+    let d = &ctx.device;
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("harness"),
+        source: wgpu::ShaderSource::Wgsl(src.into()),
+    });
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("harness"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let init = |bytes: &[u8], usage| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytes,
+            usage,
+        })
+    };
+    let mut buffers = vec![init(uniform, U::UNIFORM)];
+    buffers.extend(inputs.iter().map(|b| init(b, U::STORAGE)));
+    let size = (count * 16) as u64;
+    buffers.push(d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size,
+        usage: U::STORAGE | U::COPY_SRC,
+        mapped_at_creation: false,
+    }));
+    let read = d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size,
+        usage: U::MAP_READ | U::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups((count as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(buffers.last().unwrap(), 0, &read, 0, size);
+    ctx.queue.submit([enc.finish()]);
+    read.slice(..)
+        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
+    d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let out = bytemuck::cast_slice(&read.slice(..).get_mapped_range().unwrap()).to_vec();
+    assert_eq!(ctx.take_errors(), Vec::<String>::new());
+    out
+}

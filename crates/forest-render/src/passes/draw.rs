@@ -34,10 +34,16 @@ pub fn bind_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         },
         count: None,
     };
+    // The instances and species, read by the fragment stage too for each tree's colour
+    // (tint.wgsl).
+    let both = |binding| wgpu::BindGroupLayoutEntry {
+        visibility: vf,
+        ..storage(binding)
+    };
     vec![
         uniform(0),
-        storage(1),
-        storage(2),
+        both(1),
+        both(2),
         storage(3),
         storage(4),
         wgpu::BindGroupLayoutEntry {

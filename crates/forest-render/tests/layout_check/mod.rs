@@ -3,6 +3,7 @@
 
 use std::mem::{offset_of, size_of};
 
+use forest_format::colour::TreeColour;
 use forest_render::gpu_types::*;
 
 /// (WGSL struct name, Rust size, [(member, Rust offset)]).
@@ -80,6 +81,7 @@ pub fn shared() -> Vec<Expect> {
                 ("caster_floor", offset_of!(GpuCamera, caster_floor)),
                 ("wind", offset_of!(GpuCamera, wind)),
                 ("wind_time", offset_of!(GpuCamera, wind_time)),
+                ("season", offset_of!(GpuCamera, season)),
             ],
         ),
         (
@@ -91,7 +93,7 @@ pub fn shared() -> Vec<Expect> {
                 ("cos_rot", offset_of!(GpuInstance, cos_rot)),
                 ("sin_rot", offset_of!(GpuInstance, sin_rot)),
                 ("species", offset_of!(GpuInstance, species)),
-                ("pad", offset_of!(GpuInstance, pad)),
+                ("colour", offset_of!(GpuInstance, colour)),
             ],
         ),
         (
@@ -111,6 +113,18 @@ pub fn shared() -> Vec<Expect> {
                 ("resolution", offset_of!(GpuSpecies, resolution)),
                 ("switch_unit", offset_of!(GpuSpecies, switch_unit)),
                 ("opacity_depth", offset_of!(GpuSpecies, opacity_depth)),
+                ("colour", offset_of!(GpuSpecies, colour)),
+            ],
+        ),
+        (
+            "TreeColour",
+            size_of::<TreeColour>(),
+            vec![
+                ("amplitude", offset_of!(TreeColour, amplitude)),
+                ("phase", offset_of!(TreeColour, phase)),
+                ("spring", offset_of!(TreeColour, spring)),
+                ("autumn", offset_of!(TreeColour, autumn)),
+                ("late_autumn", offset_of!(TreeColour, late_autumn)),
             ],
         ),
         (

@@ -474,6 +474,7 @@ impl ForestRenderState {
             epsilon: cam.settings.epsilon,
             light: lighting,
             wind,
+            season: None,
         };
         poll_counters(ctx, v, note);
         if let Some(last) = &v.last {
