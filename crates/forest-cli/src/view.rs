@@ -386,6 +386,7 @@ fn interactive(
         hour: args.light.time.unwrap_or(12.0),
         shadows: args.shadow.options(true)?,
         wind,
+        season: args.season.season,
         path,
         record_to: args.record.clone(),
         screenshots: args.screenshots.clone(),

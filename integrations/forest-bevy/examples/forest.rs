@@ -11,7 +11,7 @@
 //! ```
 //! Keys: W A S D fly, Q E down and up, arrows turn, shift faster; J L turn the sun, I K
 //! raise and lower it; G and Shift+G make the wind stronger and weaker (it starts at a
-//! breeze, 5 m/s); M switches method; [ ] halve and double ε. The title bar shows the
+//! breeze, 5 m/s); Y steps the season on (spring, summer, autumn, late autumn); M switches method; [ ] halve and double ε. The title bar shows the
 //! method, ε, quads, triangles and frame time (or why the method cannot draw). With
 //! `SCREENSHOT=PATH.png` in the environment it saves a frame once the forest is drawn, and
 //! exits (0) as soon as the file is written.
@@ -22,8 +22,8 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
 use forest_bevy::{
-    ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestStats, ForestWind,
-    terrain_mesh,
+    ForestAsset, ForestCamera, ForestMethod, ForestPlugin, ForestScene, ForestSeason, ForestStats,
+    ForestWind, terrain_mesh,
 };
 
 /// The sun's azimuth and elevation, degrees.
@@ -77,6 +77,8 @@ fn main() -> AppExit {
     .insert_resource(SunAngles(30.0, 35.0))
     // Every tree moves in it, in every method and in its shadows, on Bevy's clock.
     .insert_resource(ForestWind(forest_format::wind::Wind::new(60.0, 5.0)))
+    // Summer; Y turns the leaves through the year, each tree a little ahead or behind.
+    .insert_resource(ForestSeason(1.0 / 3.0))
     .insert_resource(ClearColor(fog))
     .insert_resource(GlobalAmbientLight {
         color: Color::srgb(0.75, 0.85, 1.0),
@@ -241,8 +243,12 @@ const WIND_STEPS: [f32; 6] = [0.0, 2.0, 5.0, 9.0, 13.0, 18.0];
 fn switch(
     keys: Res<ButtonInput<KeyCode>>,
     mut cams: Query<&mut ForestCamera>,
-    mut wind: ResMut<ForestWind>,
+    (mut wind, mut season): (ResMut<ForestWind>, ResMut<ForestSeason>),
 ) {
+    if keys.just_pressed(KeyCode::KeyY) {
+        // Spring, summer, autumn, late autumn, and round again.
+        season.0 = ((season.0 * 3.0).round() + 1.0) % 4.0 / 3.0;
+    }
     if keys.just_pressed(KeyCode::KeyG) {
         let i = WIND_STEPS
             .iter()
@@ -276,7 +282,7 @@ fn switch(
 fn title(
     stats: Res<ForestStats>,
     time: Res<Time>,
-    wind: Res<ForestWind>,
+    (wind, season): (Res<ForestWind>, Res<ForestSeason>),
     cams: Query<(Entity, &ForestCamera)>,
     mut windows: Query<&mut Window>,
 ) {
@@ -285,13 +291,14 @@ fn title(
     };
     window.title = format!(
         "forest in Bevy: {} ε {} px, {} quads, {} triangles, {:.1} ms, wind {} m/s (M method, \
-         [ ] ε, IJKL sun, G wind){}",
+         [ ] ε, IJKL sun, G wind, Y season {:.2}){}",
         c.method.name(),
         c.epsilon,
         stats.quads(camera),
         stats.triangles(camera),
         time.delta_secs() * 1000.0,
         wind.0.speed,
+        season.0,
         // A method the forest cannot draw (atlases baked without models) says why.
         stats
             .error(camera)

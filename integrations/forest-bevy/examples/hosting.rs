@@ -216,6 +216,7 @@ fn frame_at(eye: Vec3, at: Vec3, args: &Args) -> FrameParams {
         epsilon: args.settings.epsilon,
         light: Default::default(),
         wind: forest_format::wind::Wind::CALM,
+        season: None,
     }
 }
 

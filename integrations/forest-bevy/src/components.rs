@@ -108,3 +108,10 @@ impl ForestMethod {
 /// [`crate::ForestStats`] and the forest is drawn calm.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
 pub struct ForestWind(pub forest_format::wind::Wind);
+
+/// The season the forests' leaves are drawn in: 0 (spring) to 1 (late autumn), through summer
+/// (⅓) and autumn (⅔) ([`forest_format::colour`]); each tree of a varied forest is a little
+/// ahead or behind. Without the resource the leaves keep their models' colours; a season out
+/// of range is reported in [`crate::ForestStats`] and the models' colours are drawn.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct ForestSeason(pub f32);

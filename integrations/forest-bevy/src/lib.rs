@@ -54,7 +54,7 @@ use bevy::prelude::*;
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 
 pub use assets::{AtlasLoader, ForestAsset, ForestAtlas, ForestLoader, LoadError};
-pub use components::{ForestCamera, ForestMethod, ForestScene, ForestWind};
+pub use components::{ForestCamera, ForestMethod, ForestScene, ForestSeason, ForestWind};
 pub use stats::{ForestStats, ForestViewStats};
 pub use terrain::{TerrainMeshError, terrain_mesh};
 

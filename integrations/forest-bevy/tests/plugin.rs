@@ -8,7 +8,7 @@ use bevy::asset::AssetLoadFailedEvent;
 use bevy::prelude::*;
 use bevy::render::view::Msaa;
 use common::*;
-use forest_bevy::{ForestAsset, ForestCamera, ForestMethod, ForestStats};
+use forest_bevy::{ForestAsset, ForestCamera, ForestMethod, ForestSeason, ForestStats};
 
 /// Pixels that differ from the clear colour by more than 8 levels in a channel.
 fn covered(img: &image::RgbaImage) -> Vec<bool> {
@@ -272,6 +272,37 @@ fn a_moved_forest_moves_its_trees() {
     assert!(
         apart > 0.05,
         "the moved forest looks unmoved (FLIP {apart})"
+    );
+}
+
+/// A [`ForestSeason`] turns the leaves as `forest-render` does in that season: Bevy's frame
+/// in autumn within FLIP 0.02 of `forest-render`'s, and apart from the summer one.
+#[test]
+fn the_season_turns_the_leaves_as_forest_render_does() {
+    let mut app = app(assets());
+    app.insert_resource(ForestSeason(2.0 / 3.0));
+    let forest = spawn_forest(&mut app, Transform::IDENTITY);
+    let v = View::at(EYE, AT);
+    let (camera, image) = spawn_camera(&mut app, v);
+    settle(&mut app, camera, forest);
+    let bevy = read(&mut app, &image);
+    let light = expected_light(sun_dir());
+    let autumn = common::reference_in(
+        v.eye,
+        v.target,
+        v.epsilon,
+        light,
+        1,
+        ForestMethod::QuadStream,
+        Some(2.0 / 3.0),
+    );
+    let flip = compare_view("autumn", &autumn, &bevy, 0.02);
+    let summer = common::reference(v.eye, v.target, v.epsilon, light, 1);
+    let (apart, _) = forest_metrics::flip(&summer, &bevy).unwrap();
+    println!("autumn: FLIP {flip:.4} against forest-render's autumn, {apart:.4} against summer");
+    assert!(
+        apart > 2.0 * flip.max(0.005),
+        "autumn looks like summer (FLIP {apart}, against autumn {flip})"
     );
 }
 

@@ -64,6 +64,7 @@ impl Viewer {
                 g.renderer.set_light(light)?;
             }
             g.renderer.set_wind(self.wind)?;
+            g.renderer.set_season(self.season)?;
             g.renderer.set_pipeline_statistics(self.count_work);
             // A counter the device cannot hold (a window past its storage limit) is said on
             // the HUD, and the view goes back to off.

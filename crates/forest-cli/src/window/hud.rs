@@ -1,5 +1,5 @@
 //! The viewer's egui HUD: frame and pass times, counters, quads per level, the ε slider, the
-//! time-of-day slider, the wind's speed, direction and gustiness, the method and debug-view switches, the key list.
+//! time-of-day slider, the wind's speed, direction and gustiness, the season, the method and debug-view switches, the key list.
 
 use forest_baselines::methods::Method;
 use forest_render::options::DebugView;
@@ -115,6 +115,17 @@ impl Viewer {
                         .text("wind towards (° from +Z to +X)"),
                 );
                 ui.add(egui::Slider::new(&mut self.wind.gustiness, 0.0..=1.0).text("gustiness"));
+                let mut seasons = self.season.is_some();
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut seasons, "season (Y / Shift+Y)");
+                    let mut s = self.season.unwrap_or(1.0 / 3.0);
+                    ui.add_enabled(
+                        seasons,
+                        egui::Slider::new(&mut s, 0.0..=1.0)
+                            .text("spring · summer · autumn · late"),
+                    );
+                    self.season = seasons.then_some(s);
+                });
                 ui.add(egui::Slider::new(&mut self.walker.speed, 0.5..=200.0).text("speed (m/s)"));
                 ui.checkbox(&mut self.walker.walk, "walk (follow the ground)");
                 ui.checkbox(

@@ -5,7 +5,7 @@
 //! Controls ([`KEYS`]): W/A/S/D move, Q/E down/up (fly mode), right mouse button + drag looks
 //! around, Shift runs, mouse wheel changes speed, F toggles walk/fly, 1–6 pick a method, `[` and
 //! `]` halve and double ε, V cycles the debug views, G and Shift+G make the wind stronger and
-//! weaker, H hides the HUD, F12 saves a screenshot, R
+//! weaker, Y and Shift+Y step the season on and back, H hides the HUD, F12 saves a screenshot, R
 //! starts and stops recording a camera path, P plays the `--path` back, Esc quits.
 //!
 //! On stdout the viewer says when its first frame is on screen and where each screenshot went
@@ -69,15 +69,52 @@ pub fn wind_step(speed: f32, up: bool) -> f32 {
     }
 }
 
+/// The seasons the Y key steps through: the models' own colours, then spring, summer, autumn
+/// and late autumn.
+pub const SEASON_STEPS: [Option<f32>; 5] =
+    [None, Some(0.0), Some(1.0 / 3.0), Some(2.0 / 3.0), Some(1.0)];
+
+/// The season after (`on`) or before `season` in [`SEASON_STEPS`], round the year: a season
+/// between steps goes to the neighbouring step.
+pub fn season_step(season: Option<f32>, on: bool) -> Option<f32> {
+    let n = SEASON_STEPS.len();
+    let key = |s: Option<f32>| s.map_or(-1.0, |v| v);
+    let k = key(season);
+    if on {
+        SEASON_STEPS
+            .into_iter()
+            .find(|s| key(*s) > k + 1e-3)
+            .unwrap_or(SEASON_STEPS[0])
+    } else {
+        SEASON_STEPS
+            .into_iter()
+            .rev()
+            .find(|s| key(*s) < k - 1e-3)
+            .unwrap_or(SEASON_STEPS[n - 1])
+    }
+}
+
+/// How the HUD names a season.
+pub fn season_name(season: Option<f32>) -> String {
+    match season {
+        None => "the models' own colours".into(),
+        Some(s) => forest_format::colour::SEASONS
+            .iter()
+            .find(|(_, v)| (v - s).abs() < 1e-3)
+            .map_or(format!("{s:.2}"), |(n, _)| (*n).to_string()),
+    }
+}
+
 /// Range of the ε slider and the [ / ] keys (pixels).
 pub const EPSILON_RANGE: (f32, f32) = (0.5, 64.0);
 
 /// The key list shown on screen.
-pub const KEYS: [&str; 5] = [
+pub const KEYS: [&str; 6] = [
     "W/A/S/D move · Q/E down/up (fly) · right drag: look · Shift: run · wheel: speed",
     "F: walk/fly · 1-6: method · [ / ]: halve / double ε · V: debug view · H: hide HUD",
     "T / Shift+T: time of day one hour later / earlier (sun, its colour and the sky)",
     "G / Shift+G: wind one step stronger / weaker (calm, breeze … gale)",
+    "Y / Shift+Y: season on / back (own colours, spring, summer, autumn, late autumn)",
     "F12: screenshot · R: record path · P: play --path · Esc: quit",
 ];
 
@@ -143,6 +180,8 @@ pub struct Settings {
     /// The wind the viewer starts in; its time is where the wind's clock starts (seconds),
     /// and the clock then runs in real time.
     pub wind: forest_format::wind::Wind,
+    /// The season the viewer starts in (`None`: the models' own colours).
+    pub season: Option<f32>,
     /// A camera path to play from the start (P replays it).
     pub path: Option<CameraPath>,
     /// Where R saves a recorded path.
@@ -172,6 +211,8 @@ pub struct Viewer {
     /// The wind drawn (its time is the wind's clock, advanced each frame by the real time
     /// elapsed and wrapped within [`forest_format::wind::MAX_TIME`]).
     wind: forest_format::wind::Wind,
+    /// The season drawn (`None`: the models' own colours).
+    season: Option<f32>,
     extent: f32,
     fov_deg: f32,
     methods: Vec<Method>,
@@ -235,6 +276,7 @@ impl Viewer {
             hour: st.hour.clamp(HOURS.0, HOURS.1),
             shadows: st.shadows,
             wind: st.wind,
+            season: st.season,
             hour_changed: false,
             extent: st.extent,
             fov_deg: st.path.as_ref().map_or(60.0, |p| p.fov_deg),
@@ -481,6 +523,12 @@ impl Viewer {
                 self.wind.speed = wind_step(self.wind.speed, !shift);
                 self.say(format!("wind {:.0} m/s", self.wind.speed));
             }
+            KeyCode::KeyY => {
+                let shift = self.keys.contains(&KeyCode::ShiftLeft)
+                    || self.keys.contains(&KeyCode::ShiftRight);
+                self.season = season_step(self.season, !shift);
+                self.say(format!("season: {}", season_name(self.season)));
+            }
             KeyCode::Digit1 => self.set_method(0)?,
             KeyCode::Digit2 => self.set_method(1)?,
             KeyCode::Digit3 => self.set_method(2)?,
@@ -714,6 +762,24 @@ mod tests {
         assert_eq!(wind_step(30.0, true), 30.0);
         assert_eq!(wind_step(30.0, false), 18.0);
         assert_eq!(wind_step(0.0, false), 0.0);
+    }
+
+    #[test]
+    fn the_season_key_goes_round_the_year() {
+        let mut s = None;
+        let mut seen = vec![s];
+        for _ in 0..SEASON_STEPS.len() {
+            s = season_step(s, true);
+            seen.push(s);
+        }
+        assert_eq!(&seen[..SEASON_STEPS.len()], &SEASON_STEPS);
+        assert_eq!(s, None);
+        assert_eq!(season_step(None, false), Some(1.0));
+        assert_eq!(season_step(Some(0.5), true), Some(2.0 / 3.0));
+        assert_eq!(season_step(Some(0.5), false), Some(1.0 / 3.0));
+        assert_eq!(season_step(Some(0.0), false), None);
+        assert_eq!(season_name(Some(2.0 / 3.0)), "autumn");
+        assert_eq!(season_name(Some(0.5)), "0.50");
     }
 
     #[test]

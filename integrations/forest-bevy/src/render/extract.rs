@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use bevy::render::Extract;
 
 use crate::assets::ForestAsset;
-use crate::components::{ForestCamera, ForestScene, ForestWind};
+use crate::components::{ForestCamera, ForestScene, ForestSeason, ForestWind};
 use crate::light;
 
 /// A forest as extracted this frame.
@@ -51,6 +51,8 @@ pub struct Extracted {
     pub sun: Option<light::Sun>,
     /// The wind at this frame's instant, in world space (calm without [`ForestWind`]).
     pub wind: forest_format::wind::Wind,
+    /// The season (`None` without [`ForestSeason`]).
+    pub season: Option<f32>,
 }
 
 fn linear(c: Color) -> Vec3 {
@@ -90,7 +92,11 @@ pub fn extract(
     >,
     global_ambient: Extract<Option<Res<GlobalAmbientLight>>>,
     suns: Extract<Query<(&DirectionalLight, &GlobalTransform, &InheritedVisibility)>>,
-    (wind, time): (Extract<Option<Res<ForestWind>>>, Extract<Res<Time>>),
+    (wind, time, season): (
+        Extract<Option<Res<ForestWind>>>,
+        Extract<Res<Time>>,
+        Extract<Option<Res<ForestSeason>>>,
+    ),
 ) {
     out.forests.clear();
     out.cameras.clear();
@@ -134,6 +140,7 @@ pub fn extract(
         let clock = time.elapsed_secs_f64() % f64::from(forest_format::wind::MAX_TIME);
         w.0.at(clock as f32)
     });
+    out.season = season.as_ref().map(|s| s.0);
     out.sun = suns
         .iter()
         .find(|(_, _, v)| v.get())

@@ -242,6 +242,7 @@ pub fn prepare_forests(
                 sun: extracted.sun,
                 cascades: &cascades,
                 wind: extracted.wind,
+                season: extracted.season,
             };
             let record =
                 state.prepare_forest(&ctx, &frame, forest, &scene, &lit, &mut live_casters);
@@ -267,6 +268,8 @@ struct Lit<'a> {
     cascades: &'a [shadows::HostCascade],
     /// The wind, in world space.
     wind: forest_format::wind::Wind,
+    /// The season (`None`: the models' own colours).
+    season: Option<f32>,
 }
 
 impl ForestRenderState {
@@ -474,7 +477,18 @@ impl ForestRenderState {
             epsilon: cam.settings.epsilon,
             light: lighting,
             wind,
-            season: None,
+            season: lit.season,
+        };
+        // A season out of range is said, and the models' own colours drawn.
+        let frame = match forest_format::colour::check_season(frame.season) {
+            Ok(()) => frame,
+            Err(e) => {
+                record.error = Some(format!("ForestSeason: {e}"));
+                FrameParams {
+                    season: None,
+                    ..frame
+                }
+            }
         };
         poll_counters(ctx, v, note);
         if let Some(last) = &v.last {

@@ -334,6 +334,19 @@ pub fn reference_with(
     samples: u32,
     method: ForestMethod,
 ) -> image::RgbaImage {
+    reference_in(eye, target, epsilon, light, samples, method, None)
+}
+
+/// [`reference_with`] in `season` (`None`: the models' own colours).
+pub fn reference_in(
+    eye: Vec3,
+    target: Vec3,
+    epsilon: f32,
+    light: Lighting,
+    samples: u32,
+    method: ForestMethod,
+    season: Option<f32>,
+) -> image::RgbaImage {
     let clear = Color::srgb(CLEAR[0], CLEAR[1], CLEAR[2]).to_linear();
     let colour = wgpu::Color {
         r: f64::from(clear.red),
@@ -341,7 +354,15 @@ pub fn reference_with(
         b: f64::from(clear.blue),
         a: 1.0,
     };
-    reference_over(eye, target, epsilon, light, samples, colour, method)
+    reference_over(
+        eye,
+        target,
+        epsilon,
+        light,
+        samples,
+        colour,
+        (method, season),
+    )
 }
 
 /// Save Bevy's frame and the reference as `view-NAME.png` and `view-NAME-reference.png`,
@@ -369,7 +390,7 @@ pub fn coverage(eye: Vec3, target: Vec3, epsilon: f32) -> Vec<u8> {
         expected_light(sun_dir()),
         1,
         wgpu::Color::TRANSPARENT,
-        ForestMethod::QuadStream,
+        (ForestMethod::QuadStream, None),
     );
     img.pixels().map(|p| p[3]).collect()
 }
@@ -381,7 +402,7 @@ fn reference_over(
     light: Lighting,
     samples: u32,
     colour: wgpu::Color,
-    method: ForestMethod,
+    (method, season): (ForestMethod, Option<f32>),
 ) -> image::RgbaImage {
     let ctx = GpuContext::headless().expect("a GPU adapter (lavapipe)");
     let dir = assets();
@@ -429,6 +450,7 @@ fn reference_over(
         epsilon,
         light,
         wind: forest_format::wind::Wind::CALM,
+        season,
     };
     let msaa = (samples > 1).then(|| {
         let make = |format| {
