@@ -717,3 +717,88 @@ fn winds_are_named_with_their_bound() {
         ],
     );
 }
+
+#[test]
+fn seasons_and_colour_variations_are_named_with_their_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (atlas, forest_file) = bush_forest(d, false);
+    let png = d.join("x.png").display().to_string();
+    let atlas_arg = atlas.display().to_string();
+    let results = d.join("results").display().to_string();
+    for (season, cause) in [
+        ("1.5", "season 1.5 is outside 0 (spring) to 1 (late autumn)"),
+        ("-0.1", "season -0.1 is outside"),
+        ("nan", "season NaN is outside"),
+        ("winter", "neither a number from 0 to 1 nor one of spring"),
+    ] {
+        let a = [
+            "render",
+            &forest_file,
+            "-o",
+            &png,
+            "--size",
+            "32x24",
+            "--season",
+            season,
+        ];
+        refused(&a, d, &["--season", cause]);
+        let a = [
+            "bench",
+            "table1",
+            "--species",
+            &atlas_arg,
+            "--frames",
+            "1",
+            "--season",
+            season,
+            "--out",
+            &results,
+        ];
+        refused(&a, d, &["--season", cause]);
+    }
+    let out = d.join("g.forest").display().to_string();
+    for (extra, cause) in [
+        (
+            &["--variation", "4"][..],
+            "--variation 4: expected 0 (none) to 3",
+        ),
+        (&["--variation", "nan"][..], "--variation NaN"),
+        (&["--variation", "-1"][..], "--variation -1"),
+        (
+            &["--evergreen", "oak"][..],
+            "--evergreen oak: no species of that name (the species are bush)",
+        ),
+    ] {
+        let mut a = vec!["scene", "--trees", "3", "--species", &atlas_arg, "-o", &out];
+        a.extend(extra);
+        refused(&a, d, &[cause]);
+    }
+    // A forest file's colouring is checked as render loads it.
+    let text = std::fs::read_to_string(&forest_file).unwrap();
+    for (edit, cause) in [
+        (
+            r#""amount": 9.0"#,
+            "colour variation amount 9 is outside 0 to 3",
+        ),
+        (r#""hue_deg": -2.0"#, "species 0's colour: hue_deg is -2"),
+    ] {
+        let key = edit.split(':').next().unwrap();
+        let bad = text
+            .lines()
+            .map(|l| {
+                if l.trim_start().starts_with(key) {
+                    format!("{edit},")
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        assert_ne!(bad, text, "{key} is in the scene's JSON");
+        let path = d.join("bad.json");
+        std::fs::write(&path, bad).unwrap();
+        let p = path.display().to_string();
+        refused(&["render", &p, "-o", &png, "--size", "32x24"], d, &[cause]);
+    }
+}

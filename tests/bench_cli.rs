@@ -76,6 +76,32 @@ fn every_table_has_its_columns(results: &Path) {
         "species,switch_m,crown_motion_px,worst_disagreement_px"
     );
     assert_eq!(
+        header("colour.csv"),
+        "case,method,trees,mean_delta_e,worst_delta_e,within_2,mean_delta_l"
+    );
+    assert_eq!(
+        header("colour_trees.csv"),
+        "view,case,instance,species,distance_m,radius_px,method,delta_e,delta_l"
+    );
+    let colour = std::fs::read_to_string(results.join("colour.csv")).unwrap();
+    for m in [
+        "quads",
+        "impostor",
+        "geometry",
+        "stochastic",
+        "lods",
+        "hybrid",
+    ] {
+        for case in ["own colours", "\"varied, autumn\""] {
+            assert!(
+                colour
+                    .lines()
+                    .any(|l| l.starts_with(&format!("{case},{m},"))),
+                "{case} {m}"
+            );
+        }
+    }
+    assert_eq!(
         header("fidelity.csv"),
         "variant,species,camera,distance_radii,elevation_deg,azimuth_deg,between_directions,\
          epsilon,quads,flip_mean,iou,frame_ms"
@@ -109,7 +135,13 @@ fn every_table_has_its_columns(results: &Path) {
             "{v}"
         );
     }
-    for c in ["fidelity-distance", "fidelity-elevation"] {
+    for c in [
+        "fidelity-distance",
+        "fidelity-elevation",
+        "colour_own",
+        "colour_autumn",
+        "colour_worst_quads",
+    ] {
         assert!(results.join(format!("{c}.png")).is_file(), "{c}.png");
         assert!(results.join(format!("{c}.svg")).is_file(), "{c}.svg");
     }

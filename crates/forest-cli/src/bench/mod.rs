@@ -5,6 +5,7 @@
 mod accuracy;
 mod budget;
 pub mod chart;
+mod colour;
 mod fidelity;
 mod fidelity_variants;
 mod lighting;
@@ -37,7 +38,7 @@ use forest_render::{Camera, GpuContext, GpuScene, QuadStream};
 use forest_scene::generate::{GenerateParams, generate};
 
 /// The suites, in the order `all` runs them.
-pub const SUITES: [&str; 11] = [
+pub const SUITES: [&str; 12] = [
     "storage",
     "shadowing",
     "lighting",
@@ -49,17 +50,18 @@ pub const SUITES: [&str; 11] = [
     "budget",
     "fidelity",
     "wind",
+    "colour",
 ];
 
 /// Arguments of `forest bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Suite: storage, shadowing, lighting, shadows, table1, path, accuracy, stability,
-    /// budget, fidelity, wind, or all. Every run
+    /// budget, fidelity, wind, colour, or all. Every run
     /// updates REPORT.md with the sections of all suites run into the results folder so far.
     #[arg(value_parser = [
         "storage", "shadowing", "lighting", "shadows", "table1", "path", "accuracy", "stability",
-        "budget", "fidelity", "wind", "all",
+        "budget", "fidelity", "wind", "colour", "all",
     ])]
     pub suite: String,
     /// Species atlases (comma-separated).
@@ -105,6 +107,11 @@ pub struct BenchArgs {
     /// `--season`).
     #[command(flatten)]
     pub season: crate::render::SeasonArgs,
+    /// How much each tree of the suites' generated forests differs in colour from the others
+    /// of its species (0 to 3; 1 is natural, as `forest scene` gives by default): 0, the
+    /// default, draws every tree of a species alike, as the suites measured before variation.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
+    pub variation: f32,
 }
 
 /// What every suite works with.
@@ -140,6 +147,8 @@ pub struct Bench {
     pub wind: forest_format::wind::Wind,
     /// The season of every frame (`None`: the models' own colours).
     pub season: Option<f32>,
+    /// The colour variation of the generated forests (0: none).
+    pub variation: f32,
 }
 
 /// Every method at its default parameters, in the order the suites report them.
@@ -179,6 +188,13 @@ impl Bench {
     fn new(args: &BenchArgs) -> Result<Self> {
         if args.frames == 0 {
             bail!("--frames 0: measure at least 1 frame per setting");
+        }
+        if !(0.0..=forest_format::colour::MAX_AMOUNT).contains(&args.variation) {
+            bail!(
+                "--variation {}: expected 0 (none) to {} (1 is natural)",
+                args.variation,
+                forest_format::colour::MAX_AMOUNT
+            );
         }
         // The results never land inside an input: an atlas, a model (given, or found beside
         // the assets), a model's material library or texture, or a folder holding one.
@@ -242,6 +258,7 @@ impl Bench {
             shadows: args.shadow.options(false)?,
             wind: args.wind.wind()?,
             season: args.season.season,
+            variation: args.variation,
         })
     }
 
@@ -316,6 +333,19 @@ impl Bench {
             ..params
         })
         .map_err(anyhow::Error::msg)?;
+        let forest = if self.variation > 0.0 {
+            let species = forest
+                .species
+                .iter()
+                .map(|s| forest_format::colour::SpeciesColour::by_name(s))
+                .collect();
+            forest.with_colouring(forest_format::colour::Colouring::new(
+                self.variation,
+                species,
+            ))
+        } else {
+            forest
+        };
         let manifests: Vec<_> = self.species.iter().map(|s| &s.atlas.manifest).collect();
         forest_format::species::check(&forest, &manifests, Path::new("the bench's forest"))?;
         Ok(forest)
@@ -680,6 +710,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "budget" => budget::run(&b)?,
             "fidelity" => fidelity::run(&b)?,
             "wind" => wind::run(&b)?,
+            "colour" => colour::run(&b)?,
             _ => unreachable!("clap checks the suite"),
         };
         report::write(&b, s, &section, !(s == "accuracy" && args.redraw))?;

@@ -190,6 +190,19 @@ fn main() {
     let json = saved(dir, "f.json", |p| hills.save(p).expect("forest saves"));
     write("forest_json", "seed-2.json", &json);
 
+    // A coloured forest (format version 3) on the terrain, two trees given explicit values.
+    let mut colouring = forest_format::colour::Colouring::new(
+        1.0,
+        vec![forest_format::colour::SpeciesColour::DECIDUOUS; hills.species.len()],
+    );
+    colouring.explicit = (0..hills.instances.len())
+        .map(|k| if k < 2 { 0.25 * k as f32 } else { -1.0 })
+        .collect();
+    let tinted = hills.clone().with_colouring(colouring);
+    write("forest_binary", "seed-3", &tinted.to_bytes());
+    let json = saved(dir, "f.json", |p| tinted.save(p).expect("forest saves"));
+    write("forest_json", "seed-3.json", &json);
+
     // Height fields: a 16-bit PNG and an EXR, behind the target's kind byte.
     let heights_png = saved(dir, "h.png", |p| {
         image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(5, 4, |x, y| {
