@@ -39,8 +39,10 @@ done
 # and its shadow move; the hybrid's two forms move alike.
 $forest render out/forest-100k.forest -o out/render/forest-wind.png --view inside \
   --size 480x270 --shadows on --wind 60,9 --animate 3 --frame-rate 12
+$forest render out/forest-100k.forest -o out/render/forest-autumn.png --view hill --time 10 \
+  --size 800x600 --shadows on --season autumn
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png,"
 echo "  at 7:30 and noon: out/render/forest-7.5.png, out/render/forest-12.png,"
-echo "  in wind (an animated PNG): out/render/forest-wind.png"
+echo "  in wind (an animated PNG): out/render/forest-wind.png, in autumn: out/render/forest-autumn.png"
 echo "Atlases: out/atlases/, contact sheets: out/contact/"

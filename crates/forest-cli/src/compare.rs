@@ -49,6 +49,18 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             "FLIP {:.4}  SSIM {:.4}  PSNR {:.2} dB  coverage IoU {iou}",
             m.flip_mean, m.ssim, m.psnr
         );
+        // Over transparent black: the covered pixels' mean colours, as `bench colour` takes
+        // each tree's.
+        let mean = crate::bench::colour::mean_colour;
+        if let (Some(_), Some(r), Some(t)) = (m.coverage_iou, mean(&a), mean(&b)) {
+            let lab = forest_format::colour::lab;
+            println!(
+                "mean colour ΔE {:.2} (CIELAB; L* {:.2} against {:.2})",
+                forest_format::colour::delta_e(t, r),
+                lab(t).x,
+                lab(r).x
+            );
+        }
     }
     Ok(())
 }

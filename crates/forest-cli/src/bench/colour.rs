@@ -225,8 +225,10 @@ pub fn run(b: &Bench) -> Result<Section> {
             );
         }
     }
+    let cost = cost(b, &forest, &cams, viewport)?;
     b.write("colour.csv", &table.csv())?;
     b.write("colour_trees.csv", &trees_table.csv())?;
+    b.write("colour_cost.csv", &cost.csv())?;
     let series = |c: usize| {
         methods
             .iter()
@@ -258,7 +260,7 @@ pub fn run(b: &Bench) -> Result<Section> {
             },
         )?;
     }
-    let text = summary(&table, viewport);
+    let text = summary(&table, &cost, viewport);
     Ok(Section {
         title: "Colour: each tree's mean colour against the reference's".into(),
         text,
@@ -293,8 +295,55 @@ fn species_label(path: &str) -> String {
     name.trim_end_matches(".atlas").to_string()
 }
 
+/// Rounds of interleaved measurements per camera and method in [`cost`].
+const COST_ROUNDS: usize = 3;
+
+/// What variation and a season cost: every method's median frame time over the accuracy
+/// forest's cameras with the forest varied (amount 1) in autumn, over its time in the models'
+/// own colours, both measured in turn in one run.
+fn cost(
+    b: &Bench,
+    forest: &Forest,
+    cams: &[(String, Camera)],
+    viewport: (u32, u32),
+) -> Result<Table> {
+    let mut table = Table::new(&["method", "frame_ms_plain", "frame_ms_varied", "time_ratio"]);
+    let species = forest
+        .species
+        .iter()
+        .map(|s| SpeciesColour::by_name(s))
+        .collect();
+    let varied = forest.clone().with_colouring(Colouring::new(1.0, species));
+    let target = Target::new(&b.ctx, viewport.0, viewport.1);
+    let mut plain_r = b.renderer(forest, viewport, 1.0, true, Background::Transparent)?;
+    let mut varied_r = b.renderer(&varied, viewport, 1.0, true, Background::Transparent)?;
+    varied_r.set_season(Some(2.0 / 3.0))?;
+    let frames = b.frames.max(1);
+    for m in super::every_method() {
+        let (mut plain, mut tinted) = (Vec::new(), Vec::new());
+        for (_, cam) in cams {
+            let cam = Camera {
+                epsilon: EPSILON,
+                ..*cam
+            };
+            for _ in 0..COST_ROUNDS {
+                plain.push(b.measure(&mut plain_r, m, &cam, &target, frames)?.1);
+                tinted.push(b.measure(&mut varied_r, m, &cam, &target, frames)?.1);
+            }
+        }
+        let (p, v) = (super::median(plain), super::median(tinted));
+        table.push(vec![
+            m.name().into(),
+            super::ms(p),
+            super::ms(v),
+            format!("{:.3}", v / p.max(1e-9)),
+        ]);
+    }
+    Ok(table)
+}
+
 /// The report's reading of the figures.
-fn summary(table: &Table, viewport: (u32, u32)) -> String {
+fn summary(table: &Table, cost: &Table, viewport: (u32, u32)) -> String {
     let col = |name: &str| table.header.iter().position(|h| *h == name).unwrap_or(0);
     let rows: Vec<String> = table
         .rows
@@ -317,9 +366,16 @@ fn summary(table: &Table, viewport: (u32, u32)) -> String {
          pixels, and `delta_e` the CIELAB distance between the method's and the reference's \
          (target: within {TARGET_DELTA_E}; `delta_l` the method's L* minus the reference's). \
          In the models' own colours, mean ΔE per method: {}. The second case varies every tree \
-         (amount 1, each its own value) in autumn; per tree in `colour_trees.csv`.",
+         (amount 1, each its own value) in autumn; per tree in `colour_trees.csv`. Frame time \
+         of the whole accuracy forest varied in autumn over its time in the models' own \
+         colours, measured in turn in one run (`colour_cost.csv`, target ≤ 1.03): {}.",
         viewport.0,
         viewport.1,
-        rows.join("; ")
+        rows.join("; "),
+        cost.rows
+            .iter()
+            .map(|r| format!("{} ×{}", r[0], r[3]))
+            .collect::<Vec<_>>()
+            .join(", ")
     )
 }

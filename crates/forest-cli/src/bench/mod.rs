@@ -5,7 +5,7 @@
 mod accuracy;
 mod budget;
 pub mod chart;
-mod colour;
+pub mod colour;
 mod fidelity;
 mod fidelity_variants;
 mod lighting;
