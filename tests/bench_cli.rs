@@ -83,6 +83,10 @@ fn every_table_has_its_columns(results: &Path) {
         header("colour_trees.csv"),
         "view,case,instance,species,distance_m,radius_px,method,delta_e,delta_l"
     );
+    assert_eq!(
+        header("colour_cost.csv"),
+        "method,frame_ms_plain,frame_ms_varied,time_ratio"
+    );
     let colour = std::fs::read_to_string(results.join("colour.csv")).unwrap();
     for m in [
         "quads",

@@ -5,6 +5,7 @@
 //! autumn (each tree its own value).
 
 use anyhow::Result;
+use forest_baselines::methods::Method;
 use forest_format::colour::{self, Colouring, SpeciesColour};
 use forest_format::forest::Forest;
 use forest_render::options::Background;
@@ -295,12 +296,17 @@ fn species_label(path: &str) -> String {
     name.trim_end_matches(".atlas").to_string()
 }
 
-/// Rounds of interleaved measurements per camera and method in [`cost`].
-const COST_ROUNDS: usize = 3;
+/// Rounds of interleaved measurements per camera in [`cost`]: few for the methods that draw
+/// every tree as geometry (seconds a frame on a CPU rasteriser), more for the others.
+fn cost_rounds(m: Method) -> usize {
+    if matches!(m, Method::Mesh(_)) { 2 } else { 6 }
+}
 
-/// What variation and a season cost: every method's median frame time over the accuracy
-/// forest's cameras with the forest varied (amount 1) in autumn, over its time in the models'
-/// own colours, both measured in turn in one run.
+/// What variation and a season cost: every method's median frame time at the accuracy
+/// forest's mid-range view and first walkthrough camera with the forest varied (amount 1) in
+/// autumn, over its time in the models' own colours, both measured in turn in one run (one
+/// measured frame each time: a full-geometry frame of the accuracy forest takes seconds on a
+/// CPU rasteriser).
 fn cost(
     b: &Bench,
     forest: &Forest,
@@ -318,17 +324,21 @@ fn cost(
     let mut plain_r = b.renderer(forest, viewport, 1.0, true, Background::Transparent)?;
     let mut varied_r = b.renderer(&varied, viewport, 1.0, true, Background::Transparent)?;
     varied_r.set_season(Some(2.0 / 3.0))?;
-    let frames = b.frames.max(1);
+    let timed: Vec<&Camera> = cams
+        .iter()
+        .filter(|(n, _)| n == "mid-range" || n == "walkthrough 0")
+        .map(|(_, c)| c)
+        .collect();
     for m in super::every_method() {
         let (mut plain, mut tinted) = (Vec::new(), Vec::new());
-        for (_, cam) in cams {
+        for cam in &timed {
             let cam = Camera {
                 epsilon: EPSILON,
-                ..*cam
+                ..**cam
             };
-            for _ in 0..COST_ROUNDS {
-                plain.push(b.measure(&mut plain_r, m, &cam, &target, frames)?.1);
-                tinted.push(b.measure(&mut varied_r, m, &cam, &target, frames)?.1);
+            for _ in 0..cost_rounds(m) {
+                plain.push(b.measure(&mut plain_r, m, &cam, &target, 1)?.1);
+                tinted.push(b.measure(&mut varied_r, m, &cam, &target, 1)?.1);
             }
         }
         let (p, v) = (super::median(plain), super::median(tinted));
