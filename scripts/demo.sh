@@ -39,7 +39,7 @@ done
 # and its shadow move; the hybrid's two forms move alike.
 $forest render out/forest-100k.forest -o out/render/forest-wind.png --view inside \
   --size 480x270 --shadows on --wind 60,9 --animate 3 --frame-rate 12
-$forest render out/forest-100k.forest -o out/render/forest-autumn.png --view hill --time 10 \
+$forest render out/forest-100k.forest -o out/render/forest-autumn.png --view inside --time 10 \
   --size 800x600 --shadows on --season autumn
 echo
 echo "Renders: out/render/forest-inside.png, out/render/forest-hill.png, out/render/forest-birds-eye.png,"
