@@ -221,7 +221,7 @@ pub struct SeasonArgs {
     /// The season the leaves are drawn in: a number from 0 to 1 (spring 0, summer 0.33,
     /// autumn 0.67, late autumn 1) or a name (spring, summer, autumn, late-autumn); each tree
     /// of a varied forest is a little ahead or behind [default: none, the models' own colours]
-    #[arg(long, value_parser = forest_format::colour::parse_season, allow_hyphen_values = true)]
+    #[arg(long, value_parser = forest_format::colour::parse_season, allow_negative_numbers = true)]
     pub season: Option<f32>,
 }
 

@@ -55,6 +55,7 @@ pub const SEASONS: [(&str, f32); 4] = [
 /// leaf's own luminance: the leaf becomes `tint · luminance(leaf)`) and how strongly it
 /// replaces the model's colour (0: not at all, 1: wholly).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SeasonKey {
     /// Linear RGB multiplier of the leaf's luminance, each 0 to 8.
     pub tint: [f32; 3],
@@ -124,11 +125,18 @@ impl SpeciesColour {
         },
     };
 
-    /// [`SpeciesColour::EVERGREEN`] for a species whose name (an atlas's, a path's) holds
-    /// one of [`EVERGREEN_NAMES`], else [`SpeciesColour::DECIDUOUS`].
+    /// [`SpeciesColour::EVERGREEN`] for a species whose name (an atlas folder's or a path's
+    /// last part, less `.atlas`) has one of [`EVERGREEN_NAMES`] as a word (`scots_pine`,
+    /// `Pine-2`; not `alpine`), else [`SpeciesColour::DECIDUOUS`].
     pub fn by_name(name: &str) -> SpeciesColour {
-        let lower = name.to_lowercase();
-        if EVERGREEN_NAMES.iter().any(|e| lower.contains(e)) {
+        let last = name
+            .rsplit(['/', '\\'])
+            .find(|p| !p.is_empty())
+            .unwrap_or(name)
+            .to_lowercase();
+        let stem = last.strip_suffix(".atlas").unwrap_or(&last);
+        let mut words = stem.split(|c: char| !c.is_alphabetic());
+        if words.any(|w| EVERGREEN_NAMES.contains(&w)) {
             SpeciesColour::EVERGREEN
         } else {
             SpeciesColour::DECIDUOUS
@@ -239,10 +247,16 @@ impl Colouring {
     /// The code the GPU's instance record carries for instance `k` ([`explicit_code`]; 0: its
     /// hash).
     pub fn code(&self, k: usize) -> u32 {
+        self.value(k).map_or(0, explicit_code)
+    }
+
+    /// Instance `k`'s explicit value (`None`: none, or a negative number, −0 included: its
+    /// hash).
+    pub fn value(&self, k: usize) -> Option<f32> {
         self.explicit
             .get(k)
-            .filter(|v| **v >= 0.0)
-            .map_or(0, |&v| explicit_code(v))
+            .copied()
+            .filter(|v| !v.is_sign_negative())
     }
 }
 
@@ -291,11 +305,19 @@ pub fn hash(key: u32) -> f32 {
     (h >> 8) as f32 / 16_777_216.0
 }
 
+/// One round of the PCG hash of a 32-bit key, all 32 bits (`tint_mix` in tint.wgsl).
+pub fn mix(key: u32) -> u32 {
+    let h = key.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    ((h >> ((h >> 28) + 4)) ^ h).wrapping_mul(277_803_737)
+}
+
 /// A tree's four numbers (`tree_randoms` in tint.wgsl): hue, saturation and brightness in
-/// `[−1, 1)`, the season's phase in `[−1, 1)`. Each is the hash of `key · 4 + 1 + i`
-/// (wrapping), so none is the hash the hybrid's band jitter takes of the instance.
+/// `[−1, 1)`, the season's phase in `[−1, 1)`. Each is the hash of `mix(key) · 4 + 1 + i`
+/// (wrapping): the mix first, so that every bit of an explicit code counts (times 4 drops the
+/// top two) and no tree's numbers are those of the hybrid's band jitter.
 pub fn randoms(key: u32) -> [f32; 4] {
-    std::array::from_fn(|i| 2.0 * hash(key.wrapping_mul(4).wrapping_add(1 + i as u32)) - 1.0)
+    let k = mix(key).wrapping_mul(4);
+    std::array::from_fn(|i| 2.0 * hash(k.wrapping_add(1 + i as u32)) - 1.0)
 }
 
 fn luminance(c: Vec3) -> f32 {
@@ -529,10 +551,20 @@ mod tests {
         assert!(mean.iter().all(|m| m.abs() < 0.05), "{mean:?}");
         let mut c = Colouring::new(1.0, vec![SpeciesColour::DECIDUOUS]);
         assert_eq!(c.code(3), 0);
-        c.explicit = vec![-1.0, 0.25, 0.25];
+        c.explicit = vec![-1.0, 0.25, 0.25, -0.0, 0.0];
         assert_eq!(c.code(0), 0);
         assert_eq!(c.code(1), c.code(2));
         assert_ne!(key(1, c.code(1)), 1);
+        // −0 is the hash; +0 an explicit value.
+        assert_eq!(c.code(3), 0);
+        assert_ne!(c.code(4), 0);
+        // An explicit value's numbers are not those of the hashed tree whose index its low
+        // bits spell (the top bits count).
+        for v in [0.0, 0.25, 0.5, 1.0] {
+            let code = explicit_code(v);
+            assert_ne!(randoms(code), randoms(code & 0x00ff_ffff), "value {v}");
+        }
+        c.explicit.truncate(3);
         assert!(c.check(1, 3).is_ok());
         assert!(c.check(1, 4).unwrap_err().contains("3 explicit"));
         c.explicit[2] = f32::NAN;
@@ -547,6 +579,14 @@ mod tests {
                 .unwrap_err()
                 .contains("autumn's strength is 2")
         );
+    }
+
+    #[test]
+    fn evergreens_are_told_by_a_word_of_the_atlas_name() {
+        let e = |n: &str| SpeciesColour::by_name(n) == SpeciesColour::EVERGREEN;
+        assert!(e("pine") && e("out/atlases/pine.atlas") && e("scots_pine.atlas"));
+        assert!(e("Spruce-2") && e("C:\\trees\\fir.atlas") && e("pine.atlas/"));
+        assert!(!e("alpine.atlas") && !e("first") && !e("pines/oak.atlas") && !e("oak"));
     }
 
     #[test]

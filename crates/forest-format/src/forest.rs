@@ -29,7 +29,8 @@ use crate::directions::hemisphere_directions;
 use crate::error::FormatError;
 use crate::terrain::Terrain;
 
-/// Binary forest format version (2: with a terrain; a forest without one is written as 1).
+/// Binary forest format version (3: with a colouring; 2: with a terrain and no colouring; a
+/// forest with neither is written as 1).
 pub const FOREST_VERSION: u32 = 3;
 const TERRAIN_MAGIC: &[u8; 4] = b"TERR";
 const COLOUR_MAGIC: &[u8; 4] = b"TINT";
@@ -373,8 +374,10 @@ impl Forest {
         Ok(forest)
     }
 
-    /// Write a forest (JSON when the name ends in `.json`, else binary), atomically.
+    /// Write a forest (JSON when the name ends in `.json`, else binary), atomically, once it
+    /// passes [`Forest::check`] (a forest its reader would refuse is not written).
     pub fn save(&self, path: &Path) -> Result<(), FormatError> {
+        self.check(path)?;
         let bytes = if path.extension().is_some_and(|e| e == "json") {
             let j = JsonForest {
                 species: self.species.clone(),
@@ -387,12 +390,7 @@ impl Forest {
                         position: i.position,
                         rotation_deg: i.rotation.to_degrees(),
                         scale: i.scale,
-                        colour: self
-                            .colouring
-                            .as_ref()
-                            .and_then(|c| c.explicit.get(k))
-                            .filter(|v| **v >= 0.0)
-                            .copied(),
+                        colour: self.colouring.as_ref().and_then(|c| c.value(k)),
                     })
                     .collect(),
                 presort_directions: Some(self.presort.directions.len() as u32),

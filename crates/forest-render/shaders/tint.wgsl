@@ -9,9 +9,15 @@ fn tint_key(instance: u32, code: u32) -> u32 {
     return select(code, instance, code == 0u);
 }
 
+// One round of the PCG hash, all 32 bits (forest_format::colour::mix).
+fn tint_mix(key: u32) -> u32 {
+    let h = key * 747796405u + 2891336453u;
+    return ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+}
+
 // A tree's four numbers in [-1, 1): hue, saturation, brightness, season phase.
 fn tree_randoms(key: u32) -> vec4<f32> {
-    let k = key * 4u;
+    let k = tint_mix(key) * 4u;
     return 2.0 * vec4<f32>(instance_hash(k + 1u), instance_hash(k + 2u),
                            instance_hash(k + 3u), instance_hash(k + 4u)) - 1.0;
 }

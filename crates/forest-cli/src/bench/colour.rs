@@ -319,9 +319,15 @@ fn cost(
         .iter()
         .map(|s| SpeciesColour::by_name(s))
         .collect();
-    let varied = forest.clone().with_colouring(Colouring::new(1.0, species));
+    // The plain forest in the models' own colours whatever --variation and --season say.
+    let plain = Forest {
+        colouring: None,
+        ..forest.clone()
+    };
+    let varied = plain.clone().with_colouring(Colouring::new(1.0, species));
     let target = Target::new(&b.ctx, viewport.0, viewport.1);
-    let mut plain_r = b.renderer(forest, viewport, 1.0, true, Background::Transparent)?;
+    let mut plain_r = b.renderer(&plain, viewport, 1.0, true, Background::Transparent)?;
+    plain_r.set_season(None)?;
     let mut varied_r = b.renderer(&varied, viewport, 1.0, true, Background::Transparent)?;
     varied_r.set_season(Some(2.0 / 3.0))?;
     let timed: Vec<&Camera> = cams

@@ -479,7 +479,12 @@ impl ForestRenderState {
             wind,
             season: lit.season,
         };
-        // A season out of range is said, and the models' own colours drawn.
+        poll_counters(ctx, v, note);
+        if let Some(last) = &v.last {
+            record = last.clone();
+        }
+        // A season out of range is said (every frame: the record above is a late one), and
+        // the models' own colours drawn.
         let frame = match forest_format::colour::check_season(frame.season) {
             Ok(()) => frame,
             Err(e) => {
@@ -490,10 +495,6 @@ impl ForestRenderState {
                 }
             }
         };
-        poll_counters(ctx, v, note);
-        if let Some(last) = &v.last {
-            record = last.clone();
-        }
         // Bevy's shadow cascades for this view: received, and cast into.
         let cascades = lit.cascades;
         receive_cascades(ctx, v, view.shadow_maps, cascades, &mut record);
