@@ -4,9 +4,9 @@
 
 mod common;
 
-use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
+use forest_baselines::Hybrid;
+use forest_baselines::geometry::MeshMethod;
 use forest_baselines::methods::{ForestRenderer, Method};
-use forest_baselines::{Hybrid, Near};
 use forest_format::forest::{Forest, Instance};
 use forest_format::noise::SplitMix64;
 use forest_format::wind::{SwayedTree, Wind};
@@ -144,31 +144,6 @@ fn renderer(ctx: &GpuContext, forest: &Forest, background: Background) -> Forest
     )
 }
 
-fn every_method() -> Vec<(&'static str, Method)> {
-    vec![
-        ("quads", Method::Quads),
-        ("impostor", Method::Impostor),
-        (
-            "geometry",
-            Method::Mesh(MeshMethod::Full { depth_sort: true }),
-        ),
-        ("reference", Method::Mesh(MeshMethod::Reference)),
-        (
-            "stochastic",
-            Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
-        ),
-        ("lods", Method::Mesh(MeshMethod::Lods(Lods::default()))),
-        ("hybrid", Method::Hybrid(Hybrid::default())),
-        (
-            "hybrid-at-switch",
-            Method::Hybrid(Hybrid {
-                near: Near::Metres(0.0),
-                ..Default::default()
-            }),
-        ),
-    ]
-}
-
 /// The frame `r` draws of `cam` in `wind`.
 fn frame(ctx: &GpuContext, r: &mut ForestRenderer, cam: &Camera, wind: Wind) -> image::RgbaImage {
     r.set_wind(wind).unwrap();
@@ -215,7 +190,7 @@ fn every_method_moves_the_tree_downwind_alike() {
         ..east
     };
     let mut shifts = Vec::new();
-    for (name, method) in every_method() {
+    for (name, method) in common::every_method() {
         let mut r = renderer(&ctx, &forest, Background::Transparent);
         r.set_method(&ctx, method).unwrap();
         let calm = frame(&ctx, &mut r, &cam, Wind::CALM);

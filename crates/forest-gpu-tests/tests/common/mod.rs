@@ -497,3 +497,32 @@ pub fn run_harness(
     assert_eq!(ctx.take_errors(), Vec::<String>::new());
     out
 }
+
+/// Every method by name, full geometry's reference and the hybrid at its switch among them.
+pub fn every_method() -> Vec<(&'static str, forest_baselines::methods::Method)> {
+    use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
+    use forest_baselines::methods::Method;
+    use forest_baselines::{Hybrid, Near};
+    vec![
+        ("quads", Method::Quads),
+        ("impostor", Method::Impostor),
+        (
+            "geometry",
+            Method::Mesh(MeshMethod::Full { depth_sort: true }),
+        ),
+        ("reference", Method::Mesh(MeshMethod::Reference)),
+        (
+            "stochastic",
+            Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
+        ),
+        ("lods", Method::Mesh(MeshMethod::Lods(Lods::default()))),
+        ("hybrid", Method::Hybrid(Hybrid::default())),
+        (
+            "hybrid-at-switch",
+            Method::Hybrid(Hybrid {
+                near: Near::Metres(0.0),
+                ..Default::default()
+            }),
+        ),
+    ]
+}
