@@ -1,5 +1,6 @@
 //! Every tree its own colour: the GPU colours every point as the CPU mirror
-//! (`forest_format::colour`) does, wood keeps its colour through the seasons, every method
+//! (`forest_format::colour`) does, wood keeps its colour through the seasons (in the model
+//! and, with a bark-only bush and pine, in every method's images), every method
 //! gives the same tree the same colour, and a forest without variation and without a season
 //! draws today's images bit for bit.
 
@@ -301,5 +302,116 @@ fn without_variation_or_a_season_every_method_draws_todays_images() {
             a.as_raw() != c.as_raw(),
             "{name}: amount 1 left the image as it was"
         );
+    }
+}
+
+/// Bush and pine without their leaves: every triangle of a translucent (leaf) material
+/// dropped. Returns the decoded atlases and the geometry methods' preparation of them.
+fn bark_only() -> (
+    Vec<forest_render::scene::SpeciesData>,
+    forest_baselines::geometry::PreparedGeometry,
+) {
+    let mut atlases = Vec::new();
+    let mut geometry = Vec::new();
+    for s in ["bush", "pine"] {
+        let mut mesh =
+            forest_bake::Mesh::load(&common::root().join(format!("assets/trees/{s}/{s}.obj")))
+                .unwrap();
+        let all = mesh.tris.len();
+        let materials = mesh.materials.clone();
+        mesh.tris
+            .retain(|t| materials[t.material as usize].translucency == 0.0);
+        assert!(
+            mesh.tris.len() > 100 && mesh.tris.len() < all,
+            "{s}: {} of {all} triangles are wood",
+            mesh.tris.len()
+        );
+        let atlas = forest_bake::bake_mesh(&mesh, s, &common::small_params(), &|_, _| {})
+            .unwrap()
+            .atlas;
+        geometry.push(forest_baselines::geometry::GeometrySpecies::new(
+            forest_bake::model::prepare(&mesh, None).into(),
+            &atlas.manifest,
+        ));
+        atlases.push(atlas);
+    }
+    (
+        common::species_of(&atlases),
+        forest_baselines::geometry::PreparedGeometry::with_cards(
+            &geometry,
+            forest_baselines::geometry::Cards::Cut,
+        ),
+    )
+}
+
+#[test]
+fn a_bark_only_model_keeps_its_colour_through_every_season() {
+    let ctx = common::ctx();
+    let (species, prepared) = bark_only();
+    // The bush (deciduous by its name) beside the pine (evergreen), without a colouring and
+    // with one at the natural amount (whose bark shifts per tree, but never with the season).
+    let pine = species[1].atlas.manifest.bounding_sphere;
+    let trees = |colouring: Option<Colouring>| {
+        let tree = |x: f32, species: u32| Instance {
+            position: [x, 0.0, 0.0],
+            rotation: 0.0,
+            scale: 1.0,
+            species,
+        };
+        let f = Forest::new(
+            vec!["bush".into(), "pine".into()],
+            vec![tree(-pine.radius, 0), tree(pine.radius, 1)],
+            15,
+        );
+        match colouring {
+            Some(c) => f.with_colouring(c),
+            None => f,
+        }
+    };
+    let view = Camera {
+        viewport: SIZE,
+        ..common::camera(
+            pine.center + Vec3::new(0.0, 0.0, -3.0 * pine.radius),
+            pine.center,
+            1.0,
+        )
+    };
+    let varied = Colouring::new(
+        1.0,
+        vec![SpeciesColour::DECIDUOUS, SpeciesColour::EVERGREEN],
+    );
+    for forest in [trees(None), trees(Some(varied))] {
+        let mut r: ForestRenderer = common::forest_renderer(
+            &ctx,
+            &species,
+            &prepared,
+            &forest,
+            SIZE,
+            Background::Transparent,
+            Atmosphere::CLEAR,
+        );
+        for (name, m) in common::every_method() {
+            r.set_method(&ctx, m).unwrap();
+            let mut draw = |season: Option<f32>| {
+                r.set_season(season).unwrap();
+                let target = Target::new(&ctx, SIZE.0, SIZE.1);
+                r.render_fitted(&ctx, &view, &target).unwrap();
+                assert_eq!(ctx.take_errors(), Vec::<String>::new());
+                target.read(&ctx)
+            };
+            let plain = draw(None);
+            let covered = plain.pixels().filter(|p| p[3] > 0).count();
+            assert!(covered > 100, "{name}: the wood covers {covered} pixels");
+            for season in [0.0, 1.0 / 3.0, 0.5, 2.0 / 3.0, 1.0] {
+                let img = draw(Some(season));
+                if img.as_raw() != plain.as_raw() {
+                    common::failure_images(&format!("bark-{name}-{season}"), &plain, &img);
+                }
+                assert!(
+                    img.as_raw() == plain.as_raw(),
+                    "{name}: the wood changed colour in season {season}"
+                );
+            }
+        }
     }
 }

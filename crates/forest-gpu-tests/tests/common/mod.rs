@@ -13,16 +13,18 @@ use glam::Vec3;
 /// Small atlases (64 px, 5 directions, 2 slabs): bush and pine.
 pub fn atlases() -> &'static [Atlas] {
     static A: OnceLock<Vec<Atlas>> = OnceLock::new();
-    A.get_or_init(|| {
-        let params = BakeParams {
-            directions: 5,
-            resolution: 64,
-            min_quad: 4,
-            spp: 2,
-            ..BakeParams::default()
-        };
-        bake(&params)
-    })
+    A.get_or_init(|| bake(&small_params()))
+}
+
+/// The bake parameters of [`atlases`]: 64 px, 5 directions, 2 slabs, 2 samples per pixel.
+pub fn small_params() -> BakeParams {
+    BakeParams {
+        directions: 5,
+        resolution: 64,
+        min_quad: 4,
+        spp: 2,
+        ..BakeParams::default()
+    }
 }
 
 /// Bush and pine baked with `params` (not cached); [`species_of`] decodes them.
