@@ -1,6 +1,7 @@
 // Pass 2, refine (run l − 1 times, input quads_in -> output quads_out): a quad whose
 // screen-projected edge is longer than ε pixels is replaced by its existing children (blank
-// ones were dropped at bake). Order is kept by a prefix sum over each quad's extra output.
+// ones were dropped at bake), unless all it and they may draw lies outside the view's sides
+// (quad_outside). Order is kept by a prefix sum over each quad's extra output.
 // When the output would overflow, the quads nearest the end of the stream (the nearest
 // trees) are refined first and the rest stay as they are, counted in state.overflow_refine.
 //
@@ -41,7 +42,7 @@ fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
 fn wants(q: Quad) -> u32 {
     let node = node_at(q.node);
     let mask = node.x >> 28u;
-    if (mask == 0u) { return 0u; }
+    if (mask == 0u || quad_outside(q)) { return 0u; }
     var clip: array<vec4<f32>, 4>;
     var behind = 0u;
     for (var c = 0u; c < 4u; c++) {

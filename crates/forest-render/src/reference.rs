@@ -278,6 +278,13 @@ fn clip_corner(t: &SceneTables, cam: &GpuCamera, q: &Quad, depth: [u8; 4], c: u3
 
 /// Clip-space position of image point `(u, v)` at slab depth `tt` of a quad's layer.
 fn clip_at(t: &SceneTables, cam: &GpuCamera, q: &Quad, u: f32, v: f32, tt: f32) -> Vec4 {
+    let w = world_at(t, q, u, v, tt);
+    let m = cam.view_proj.map(Vec4::from_array);
+    m[0] * w.x + m[1] * w.y + m[2] * w.z + m[3]
+}
+
+/// World position of image point `(u, v)` at slab depth `tt` of a quad's layer.
+fn world_at(t: &SceneTables, q: &Quad, u: f32, v: f32, tt: f32) -> Vec3 {
     let inst = &t.instances[q.instance as usize];
     let sp = &t.species[inst.species as usize];
     let f = &t.frames[(sp.dir_base + q.dir()) as usize];
@@ -287,9 +294,7 @@ fn clip_at(t: &SceneTables, cam: &GpuCamera, q: &Quad, u: f32, v: f32, tt: f32) 
         + xyz(f.right) * ((2.0 * u - 1.0) * r)
         + xyz(f.up) * ((1.0 - 2.0 * v) * r)
         + xyz(f.dir) * ((1.0 - 2.0 * d) * r);
-    let w = to_world(inst, p);
-    let m = cam.view_proj.map(Vec4::from_array);
-    m[0] * w.x + m[1] * w.y + m[2] * w.z + m[3]
+    to_world(inst, p)
 }
 
 fn edge_long(cam: &GpuCamera, a: Vec4, b: Vec4) -> bool {
@@ -309,7 +314,7 @@ fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
     }
     let node = t.nodes[q.node as usize];
     let mask = u32::from(node.mask());
-    if mask == 0 {
+    if mask == 0 || quad_outside(t, cam, q) {
         return 0;
     }
     let clip: Vec<Vec4> = (0..4)
@@ -328,6 +333,27 @@ fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
         long = error_long(t, cam, q, node);
     }
     if long { mask.count_ones() } else { 0 }
+}
+
+/// Whether everything a quad and its descendants may draw lies outside one of the view's
+/// side planes: the sphere around its image rectangle over the slab's whole depth, grown by
+/// half the quad's width and the wind's reach (see `quad_outside` in
+/// `shaders/quad_geometry.wgsl`). Such a quad is kept as it is, not refined.
+pub fn quad_outside(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> bool {
+    let inst = &t.instances[q.instance as usize];
+    let sp = &t.species[inst.species as usize];
+    let size = 1.0 / (1u32 << q.level()) as f32;
+    let u = (q.x() as f32 + 0.5) * size;
+    let v = (q.y() as f32 + 0.5) * size;
+    let c = world_at(t, q, u, v, 0.5);
+    let r = sp.sphere[3] * inst.scale;
+    let slab = 1.0 / sp.slabs as f32;
+    let height = ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3);
+    let reach = r * ((2.0 * size * size + slab * slab).sqrt() + size)
+        + forest_format::wind::reach(&cam.wind_uniform(), height);
+    cam.planes[..4]
+        .iter()
+        .any(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] < -reach)
 }
 
 /// Whether the node's depth error, as a displacement along its sampling direction at the
