@@ -42,7 +42,7 @@ fn quad_corner_clip(q: Quad, node: vec2<u32>, c: u32) -> vec4<f32> {
 fn wants(q: Quad) -> u32 {
     let node = node_at(q.node);
     let mask = node.x >> 28u;
-    if (mask == 0u || quad_outside(q)) { return 0u; }
+    if (mask == 0u) { return 0u; }
     var clip: array<vec4<f32>, 4>;
     var behind = 0u;
     for (var c = 0u; c < 4u; c++) {
@@ -58,7 +58,8 @@ fn wants(q: Quad) -> u32 {
     if (!long && (stream_flags(camera) & FLAG_DEPTH_ERROR) != 0u) {
         long = error_long(q, node);
     }
-    if (!long) { return 0u; }
+    // Tested last: only a quad that would refine pays for the test.
+    if (!long || quad_outside(q)) { return 0u; }
     return countOneBits(mask);
 }
 

@@ -178,10 +178,16 @@ fn xyz(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
 
+/// The farthest the frame's wind moves any point of the tree (metres; `wind_reach` of
+/// `wind_height` in the shaders).
+fn wind_reach(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> f32 {
+    let height = ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3);
+    forest_format::wind::reach(&cam.wind_uniform(), height)
+}
+
 fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> bool {
     let c = to_world(inst, xyz(sp.sphere));
-    let height = ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3);
-    let r = sp.sphere[3] * inst.scale + forest_format::wind::reach(&cam.wind_uniform(), height);
+    let r = sp.sphere[3] * inst.scale + wind_reach(cam, inst, sp);
     cam.planes
         .iter()
         .all(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] >= -r)
@@ -314,7 +320,7 @@ fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
     }
     let node = t.nodes[q.node as usize];
     let mask = u32::from(node.mask());
-    if mask == 0 || quad_outside(t, cam, q) {
+    if mask == 0 {
         return 0;
     }
     let clip: Vec<Vec4> = (0..4)
@@ -332,7 +338,11 @@ fn wants(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> u32 {
     if !long && flags(cam) & FLAG_DEPTH_ERROR != 0 {
         long = error_long(t, cam, q, node);
     }
-    if long { mask.count_ones() } else { 0 }
+    if long && !quad_outside(t, cam, q) {
+        mask.count_ones()
+    } else {
+        0
+    }
 }
 
 /// Whether everything a quad and its descendants may draw lies outside one of the view's
@@ -348,9 +358,7 @@ pub fn quad_outside(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> bool {
     let c = world_at(t, q, u, v, 0.5);
     let r = sp.sphere[3] * inst.scale;
     let slab = 1.0 / sp.slabs as f32;
-    let height = ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3);
-    let reach = r * ((2.0 * size * size + slab * slab).sqrt() + size)
-        + forest_format::wind::reach(&cam.wind_uniform(), height);
+    let reach = r * ((2.0 * size * size + slab * slab).sqrt() + size) + wind_reach(cam, inst, sp);
     cam.planes[..4]
         .iter()
         .any(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] < -reach)
