@@ -16,9 +16,8 @@ use forest_render::ForestView;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
+use forest_baselines::geometry::MeshMethod;
 use forest_baselines::methods::{ForestRenderer, Method, MethodStats};
-use forest_baselines::{Hybrid, Near};
 use forest_format::shading::Lighting;
 use forest_render::options::{Atmosphere, Background};
 use forest_render::shadow::ShadowOptions;
@@ -118,33 +117,18 @@ fn folder() -> PathBuf {
     common::root().join("crates/forest-gpu-tests/golden")
 }
 
+/// Every method, with full geometry drawn unsorted too, after the sorted.
 fn methods(switch: f32) -> Vec<(&'static str, Method)> {
-    vec![
-        ("quads", Method::Quads),
-        ("impostor", Method::Impostor),
-        (
-            "geometry",
-            Method::Mesh(MeshMethod::Full { depth_sort: true }),
-        ),
+    let mut methods = common::every_method_switching_at(switch);
+    let sorted = methods.iter().position(|(n, _)| *n == "geometry").unwrap();
+    methods.insert(
+        sorted + 1,
         (
             "geometry-unsorted",
             Method::Mesh(MeshMethod::Full { depth_sort: false }),
         ),
-        ("reference", Method::Mesh(MeshMethod::Reference)),
-        (
-            "stochastic",
-            Method::Mesh(MeshMethod::Stochastic(Stochastic::default())),
-        ),
-        ("lods", Method::Mesh(MeshMethod::Lods(Lods::default()))),
-        ("hybrid", Method::Hybrid(Hybrid::default())),
-        (
-            "hybrid-at-switch",
-            Method::Hybrid(Hybrid {
-                near: Near::Metres(switch),
-                ..Default::default()
-            }),
-        ),
-    ]
+    );
+    methods
 }
 
 /// The test cameras at the golden size, and one whose view centre lies at `switch` metres.

@@ -502,6 +502,13 @@ pub fn run_harness(
 
 /// Every method by name, full geometry's reference and the hybrid at its switch among them.
 pub fn every_method() -> Vec<(&'static str, forest_baselines::methods::Method)> {
+    every_method_switching_at(0.0)
+}
+
+/// [`every_method`], the hybrid at its switch drawing geometry nearer than `switch` metres.
+pub fn every_method_switching_at(
+    switch: f32,
+) -> Vec<(&'static str, forest_baselines::methods::Method)> {
     use forest_baselines::geometry::{Lods, MeshMethod, Stochastic};
     use forest_baselines::methods::Method;
     use forest_baselines::{Hybrid, Near};
@@ -522,7 +529,7 @@ pub fn every_method() -> Vec<(&'static str, forest_baselines::methods::Method)> 
         (
             "hybrid-at-switch",
             Method::Hybrid(Hybrid {
-                near: Near::Metres(0.0),
+                near: Near::Metres(switch),
                 ..Default::default()
             }),
         ),
