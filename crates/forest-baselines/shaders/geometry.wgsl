@@ -33,8 +33,9 @@ fn geo_classify(@builtin(global_invocation_id) gid: vec3<u32>) {
     let inst = instances[i];
     let sp = geo_species[inst.species];
     let c = to_world(inst, sp.sphere.xyz);
-    // Grown by the farthest the wind moves any of its points.
-    let r = sp.sphere.w * inst.scale + wind_reach(wind_height(sp.sphere, inst.scale));
+    // Grown by the farthest the wind moves any of its points now.
+    let r = sp.sphere.w * inst.scale
+        + wind_reach_now(inst.position, wind_height(sp.sphere, inst.scale), i);
     for (var k = 0u; k < 6u; k++) {
         let pl = camera.planes[k];
         if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) {

@@ -177,10 +177,19 @@ impl Wind {
         ]
     }
 
-    /// The farthest any point of a tree of `height` metres moves (metres): what its bounding
-    /// sphere grows by, so that no tree is culled while a part of it is on screen.
+    /// The farthest any point of a tree of `height` metres moves at any instant (metres): a
+    /// static bound, for a host's own bounding boxes. The culls use the tighter
+    /// [`Wind::reach_now`].
     pub fn reach(&self, height: f32) -> f32 {
         reach(&self.uniform(), height)
+    }
+
+    /// The farthest any point of `tree` is moved at this instant (metres): at most
+    /// [`Wind::reach`] of its height, and on average a fifth of it, since it takes the
+    /// gust at the tree's foot and the phase of its sway now instead of their worst. What
+    /// every cull grows the tree's bounding sphere by.
+    pub fn reach_now(&self, tree: &SwayedTree) -> f32 {
+        reach_now(&self.uniform(), tree)
     }
 
     /// Where point `p` (world, metres) of `tree` is in this wind.
@@ -189,7 +198,7 @@ impl Wind {
     }
 }
 
-/// [`Wind::reach`] from the uniform's vectors (`wind.wgsl`'s `wind_reach`).
+/// [`Wind::reach`] from the uniform's vectors (the static bound; the shaders use `wind_reach_now`).
 pub fn reach(w: &[[f32; 4]; 2], height: f32) -> f32 {
     let [_, _, speed, gust] = w[0];
     if speed <= 0.0 {
@@ -231,24 +240,37 @@ fn gusts(dir: Vec2, speed: f32, time: f32, at: Vec2) -> f32 {
         + 0.4 * (TAU * s / short + 2.1 + 0.7 * (TAU * c / 29.0).sin()).sin()
 }
 
-/// [`Wind::swayed`] from the uniform's vectors (`wind.wgsl`'s `swayed`).
-pub fn swayed(w: &[[f32; 4]; 2], p: Vec3, tree: &SwayedTree) -> Vec3 {
+/// A tree's bend at the frame's instant: the top's offset over the height (world x, z, a
+/// fraction of the height), the speed `u` it feels (m/s) and its sway's phase in [0, 1)
+/// (`wind.wgsl`'s `wind_bend`). `None` in calm.
+fn bend(w: &[[f32; 4]; 2], foot: Vec3, height: f32, seed: u32) -> Option<(Vec2, f32, f32)> {
     let [dx, dz, speed, gust] = w[0];
     let time = w[1][0];
     if speed <= 0.0 {
-        return p;
+        return None;
     }
     let dir = Vec2::new(dx, dz);
-    let foot = tree.foot;
-    let height = tree.height.max(1e-3);
     let u = (speed * (1.0 + gust * gusts(dir, speed, time, Vec2::new(foot.x, foot.z)))).max(0.0);
     let lean = lean_of(u);
     // The sway about the lean, at the tree's own frequency and phase.
     let freq = (2.2 / height.sqrt()).clamp(0.15, 2.0);
-    let phase = hash01(tree.seed);
+    let phase = hash01(seed);
     let along = lean * (0.25 + 0.5 * gust) * (TAU * (freq * time + phase)).sin();
     let across = lean * (0.1 + 0.3 * gust) * (TAU * (1.37 * freq * time + 2.0 * phase) + 1.0).sin();
-    let top = Vec3::new(dx, 0.0, dz) * (lean + along) + Vec3::new(-dz, 0.0, dx) * across;
+    let top = dir * (lean + along) + Vec2::new(-dz, dx) * across;
+    Some((top, u, phase))
+}
+
+/// [`Wind::swayed`] from the uniform's vectors (`wind.wgsl`'s `swayed`).
+pub fn swayed(w: &[[f32; 4]; 2], p: Vec3, tree: &SwayedTree) -> Vec3 {
+    let [dx, dz, _, _] = w[0];
+    let time = w[1][0];
+    let foot = tree.foot;
+    let height = tree.height.max(1e-3);
+    let Some((top, u, phase)) = bend(w, foot, height, tree.seed) else {
+        return p;
+    };
+    let top = Vec3::new(top.x, 0.0, top.y);
     let q = p - foot;
     // Linear in height on both sides of the foot, so that a card reaching below it (a
     // billboard over the bounding sphere) moves as the points it shows.
@@ -267,6 +289,34 @@ pub fn swayed(w: &[[f32; 4]; 2], p: Vec3, tree: &SwayedTree) -> Vec3 {
     } else {
         p
     }
+}
+
+/// [`Wind::reach_now`] from the uniform's vectors (`wind.wgsl`'s `wind_reach_now`).
+///
+/// A point `q` from the foot is offset by `o`, `|o| ≤ O = |top| · height · R + |f| · F · u ·
+/// R` (`R` = [`MAX_RELATIVE_HEIGHT`], `F` = [`FLUTTER`], `f` the flutter's direction), then
+/// put back at its distance from the foot. That turns `q` by the angle `θ` it sees `q + o`
+/// under, and moves it by the chord `2 |q| sin(θ/2) ≤ |o| / cos(θ/2)`. Since `|o| / |q| ≤ K =
+/// |top| + |f| · F · u · R / height` (the bend is linear in the point's height; the flutter
+/// grows with its height and its distance from the axis), `sin θ ≤ K`, and for `K < 1` the
+/// chord is at most `O / √((1 + √(1 − K²)) / 2)`; otherwise at most `2 O`. A hundredth more
+/// covers the rounding of either side.
+pub fn reach_now(w: &[[f32; 4]; 2], tree: &SwayedTree) -> f32 {
+    let height = tree.height.max(1e-3);
+    let Some((top, u, _)) = bend(w, tree.foot, height, tree.seed) else {
+        return 0.0;
+    };
+    let [dx, dz, _, _] = w[0];
+    let f = Vec3::new(0.4 * dx, 0.6, 0.4 * dz).length() * FLUTTER * u * MAX_RELATIVE_HEIGHT;
+    let t = top.length();
+    let most = t * height * MAX_RELATIVE_HEIGHT + f;
+    let k = t + f / height;
+    let turn = if k < 1.0 {
+        1.0 / ((1.0 + (1.0 - k * k).sqrt()) * 0.5).sqrt()
+    } else {
+        2.0
+    };
+    1.01 * turn * most
 }
 
 /// Parse a wind given as `TOWARDS,SPEED` (as `--wind` takes it): the azimuth it blows
@@ -310,6 +360,7 @@ mod tests {
         let p = Vec3::new(4.0, 9.0, -1.0);
         assert_eq!(Wind::CALM.swayed(p, &tree()), p);
         assert_eq!(Wind::CALM.reach(12.0), 0.0);
+        assert_eq!(Wind::CALM.reach_now(&tree()), 0.0);
         let storm = Wind::new(70.0, 30.0).at(12.5);
         assert_eq!(storm.swayed(tree().foot, &tree()), tree().foot);
     }
@@ -357,6 +408,64 @@ mod tests {
                 assert!((w.swayed(p, &t) - p).length() <= reach, "{k}");
             }
         }
+    }
+
+    /// The instant's reach holds every point of the tree, at every instant, in any wind and
+    /// for any tree (a sapling to a sequoia, a crown far wider than tall), including points
+    /// near the foot, below it and above the bounding sphere; it never exceeds the static
+    /// reach, and in a gusty wind it is on average well under it.
+    #[test]
+    fn the_instants_reach_holds_every_point_and_is_tighter_than_the_static_one() {
+        let mut rng = crate::noise::SplitMix64(11);
+        let mut unit = || rng.next_f32();
+        let (mut ratio, mut n) = (0.0f64, 0usize);
+        for case in 0..60 {
+            let height = 0.3 + 80.0 * unit() * unit();
+            let t = SwayedTree {
+                foot: Vec3::new(200.0 * unit() - 100.0, 5.0 * unit(), 200.0 * unit() - 100.0),
+                height,
+                radius: height * (0.05 + 1.5 * unit()),
+                seed: case,
+            };
+            let wind = Wind {
+                towards_deg: 360.0 * unit(),
+                speed: if case % 7 == 0 {
+                    MAX_SPEED
+                } else {
+                    MAX_SPEED * unit()
+                },
+                gustiness: if case % 5 == 0 { 1.0 } else { unit() },
+                time: 0.0,
+            };
+            let reach = wind.reach(height);
+            for k in 0..80 {
+                let w = wind.at(k as f32 * 0.173 + 20.0 * unit());
+                let now = w.reach_now(&t);
+                assert!(now <= reach * 1.0001, "{case}/{k}: {now} over {reach}");
+                ratio += (now / reach.max(1e-9)) as f64;
+                n += 1;
+                for _ in 0..40 {
+                    let r = height * 1.6 * unit();
+                    let d = Vec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5).normalize_or_zero();
+                    let d = if unit() < 0.2 {
+                        Vec3::Y * d.y.signum()
+                    } else {
+                        d
+                    };
+                    let p = t.foot + d * r;
+                    let moved = (w.swayed(p, &t) - p).length();
+                    assert!(
+                        moved <= now,
+                        "{case}/{k}: {moved} m beyond the reach {now} m"
+                    );
+                }
+            }
+        }
+        let mean = ratio / n as f64;
+        assert!(
+            mean < 0.35,
+            "the instant's reach is {mean} of the static one on average"
+        );
     }
 
     #[test]

@@ -100,7 +100,7 @@ pub const TARGETS: &[Target] = &[
         name: "wind",
         run: wind,
         bound: DATA_BOUND,
-        covers: "`--wind`, `--wind-gustiness`, `--wind-time` and the displacement they give (`wind::parse_towards_speed`, `Wind::validate`, `Wind::swayed` within `Wind::reach`)",
+        covers: "`--wind`, `--wind-gustiness`, `--wind-time` and the displacement they give (`wind::parse_towards_speed`, `Wind::validate`, `Wind::swayed` within `Wind::reach_now`, itself within `Wind::reach`)",
     },
     Target {
         name: "image",
@@ -279,7 +279,13 @@ fn wind(data: &[u8]) -> bool {
         radius,
         seed: at(4, 0.0).abs().min(u32::MAX as f32) as u32,
     };
-    let reach = w.reach(height);
+    // The instant's reach, which the culls use, is within the static one.
+    let reach = w.reach_now(&tree);
+    assert!(
+        reach <= w.reach(height) * (1.0 + 1e-4),
+        "{w:?}, {tree:?}: reach now {reach} m over the static {} m",
+        w.reach(height)
+    );
     for p in rest.get(5..).unwrap_or_default().chunks_exact(3) {
         // Points of the tree: within its bounding sphere about the foot.
         let local = glam::Vec3::new(p[0], p[1], p[2]).clamp_length_max(height.max(radius));

@@ -96,10 +96,11 @@ fn instance_in_order(i: u32) -> u32 {
 
 // Whether the instance's bounding sphere touches the frustum (and, in a light view, whether
 // its shadow can reach the view's receivers).
-fn visible(inst: Instance, sp: Species) -> bool {
+fn visible(inst: Instance, sp: Species, id: u32) -> bool {
     let c = to_world(inst, sp.sphere.xyz);
-    // Grown by the farthest the wind moves any of its points.
-    let r = sp.sphere.w * inst.scale + wind_reach(wind_height(sp.sphere, inst.scale));
+    // Grown by the farthest the wind moves any of its points now.
+    let r = sp.sphere.w * inst.scale
+        + wind_reach_now(inst.position, wind_height(sp.sphere, inst.scale), id);
     for (var k = 0u; k < 6u; k++) {
         let pl = camera.planes[k];
         if (pl.x * c.x + pl.y * c.y + pl.z * c.z + pl.w < -r) { return false; }
@@ -305,7 +306,7 @@ fn tree_count(i: u32) -> u32 {
     if (i >= scene.instances) { return 0u; }
     let inst_id = instance_in_order(i);
     let inst = instances[inst_id];
-    if (!visible(inst, species[inst.species])) { return 0u; }
+    if (!visible(inst, species[inst.species], inst_id)) { return 0u; }
     atomicAdd(&state.visible, 1u);
     return tree_quads(inst_id, false, 0u, 0u, 0u, false);
 }
@@ -404,7 +405,7 @@ fn cull_emit_body(wg: u32, t: u32, last: bool) {
         if (i >= scene.instances) { continue; }
         let inst_id = instance_in_order(i);
         let inst = instances[inst_id];
-        if (visible(inst, species[inst.species])) {
+        if (visible(inst, species[inst.species], inst_id)) {
             _ = tree_quads(inst_id, true, data[i], skip, front, last);
         }
     }

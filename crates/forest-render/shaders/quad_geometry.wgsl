@@ -58,7 +58,7 @@ fn quad_outside(q: Quad) -> bool {
     let r = sp.sphere.w * inst.scale;
     let slab = 1.0 / f32(sp.slabs);
     let reach = r * (sqrt(2.0 * size * size + slab * slab) + size)
-        + wind_reach(wind_height(sp.sphere, inst.scale));
+        + wind_reach_now(inst.position, wind_height(sp.sphere, inst.scale), q.instance);
     for (var k = 0u; k < 4u; k++) {
         let pl = camera.planes[k];
         if (dot(pl.xyz, c) + pl.w < -reach) { return true; }

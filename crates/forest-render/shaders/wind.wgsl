@@ -1,6 +1,6 @@
 // Wind: where the frame's wind (camera.wind, camera.wind_time) moves a tree's point. Every
-// method moves its vertices through `swayed`, its culls grow their spheres by `wind_reach`.
-// Mirrors forest_format::wind (swayed, reach, hash, the constants), operation for operation.
+// method moves its vertices through `swayed`, its culls grow their spheres by `wind_reach_now`.
+// Mirrors forest_format::wind (swayed, bend, reach_now, hash, the constants), operation for operation.
 // Used in a module that declares `camera`.
 
 #import common
@@ -41,34 +41,21 @@ fn wind_gusts(dir: vec2<f32>, speed: f32, time: f32, at: vec2<f32>) -> f32 {
         + 0.4 * sin(WIND_TAU * s / short + 2.1 + 0.7 * sin(WIND_TAU * c / 29.0));
 }
 
-// The farthest any point of a tree `height` metres tall moves in the frame's wind (metres).
-fn wind_reach(height: f32) -> f32 {
-    let speed = camera.wind.z;
-    let gust = camera.wind.w;
-    if (speed <= 0.0) { return 0.0; }
-    let u = speed * (1.0 + gust);
-    let lean = wind_lean(u);
-    let top = height * (lean * (1.25 + 0.8 * gust)) * WIND_MAX_RELATIVE_HEIGHT;
-    return 2.0 * (top + WIND_FLUTTER * u * WIND_MAX_RELATIVE_HEIGHT);
-}
-
 // A tree's height above its foot (metres): its bounding sphere's top (object space, the
 // foot at y = 0), scaled (forest_format::wind::SwayedTree::from_sphere).
 fn wind_height(sphere: vec4<f32>, scale: f32) -> f32 {
     return max((sphere.y + sphere.w) * scale, 1e-3);
 }
 
-// Where point `p` (world) of the tree standing at `foot` (world), `height` metres tall with a
-// crown of `radius` metres, instance `seed`, is in the frame's wind.
-fn swayed(p: vec3<f32>, foot: vec3<f32>, height_in: f32, radius: f32, seed: u32) -> vec3<f32> {
+// A tree's bend at the frame's instant (forest_format::wind::bend): the top's offset over the
+// height (world x, z), the speed it feels (m/s) and its sway's phase in [0, 1). Calm: zero.
+fn wind_bend(foot: vec3<f32>, height: f32, seed: u32) -> vec4<f32> {
     let dx = camera.wind.x;
     let dz = camera.wind.y;
     let speed = camera.wind.z;
     let gust = camera.wind.w;
     let time = camera.wind_time.x;
-    if (speed <= 0.0) { return p; }
     let dir = vec2<f32>(dx, dz);
-    let height = max(height_in, 1e-3);
     let u = max(speed * (1.0 + gust * wind_gusts(dir, speed, time, foot.xz)), 0.0);
     let lean = wind_lean(u);
     let freq = clamp(2.2 / sqrt(height), 0.15, 2.0);
@@ -76,7 +63,39 @@ fn swayed(p: vec3<f32>, foot: vec3<f32>, height_in: f32, radius: f32, seed: u32)
     let along = lean * (0.25 + 0.5 * gust) * sin(WIND_TAU * (freq * time + phase));
     let across = lean * (0.1 + 0.3 * gust)
         * sin(WIND_TAU * (1.37 * freq * time + 2.0 * phase) + 1.0);
-    let top = vec3<f32>(dx, 0.0, dz) * (lean + along) + vec3<f32>(-dz, 0.0, dx) * across;
+    let top = dir * (lean + along) + vec2<f32>(-dz, dx) * across;
+    return vec4<f32>(top, u, phase);
+}
+
+// The farthest any point of the tree standing at `foot`, `height_in` metres tall, instance
+// `seed`, is moved at the frame's instant (metres; forest_format::wind::reach_now, whose
+// comment derives the bound): what the culls grow its bounding sphere by.
+fn wind_reach_now(foot: vec3<f32>, height_in: f32, seed: u32) -> f32 {
+    if (camera.wind.z <= 0.0) { return 0.0; }
+    let height = max(height_in, 1e-3);
+    let b = wind_bend(foot, height, seed);
+    let f = length(vec3<f32>(0.4 * camera.wind.x, 0.6, 0.4 * camera.wind.y)) * WIND_FLUTTER
+        * b.z * WIND_MAX_RELATIVE_HEIGHT;
+    let t = length(b.xy);
+    let most = t * height * WIND_MAX_RELATIVE_HEIGHT + f;
+    let k = t + f / height;
+    var turn = 2.0;
+    if (k < 1.0) { turn = 1.0 / sqrt((1.0 + sqrt(1.0 - k * k)) * 0.5); }
+    return 1.01 * turn * most;
+}
+
+// Where point `p` (world) of the tree standing at `foot` (world), `height` metres tall with a
+// crown of `radius` metres, instance `seed`, is in the frame's wind.
+fn swayed(p: vec3<f32>, foot: vec3<f32>, height_in: f32, radius: f32, seed: u32) -> vec3<f32> {
+    let dx = camera.wind.x;
+    let dz = camera.wind.y;
+    let time = camera.wind_time.x;
+    if (camera.wind.z <= 0.0) { return p; }
+    let height = max(height_in, 1e-3);
+    let b = wind_bend(foot, height, seed);
+    let top = vec3<f32>(b.x, 0.0, b.y);
+    let u = b.z;
+    let phase = b.w;
     let q = p - foot;
     let rel = clamp(q.y / height, -WIND_MAX_RELATIVE_HEIGHT, WIND_MAX_RELATIVE_HEIGHT);
     let rim = min(length(q.xz) / max(radius, 1e-3), 1.0);

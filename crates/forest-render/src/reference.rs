@@ -178,16 +178,21 @@ fn xyz(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
 
-/// The farthest the frame's wind moves any point of the tree (metres; `wind_reach` of
-/// `wind_height` in the shaders).
-fn wind_reach(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> f32 {
-    let height = ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3);
-    forest_format::wind::reach(&cam.wind_uniform(), height)
+/// The farthest the frame's wind moves any point of instance `id` now (metres;
+/// `wind_reach_now` of `wind_height` in the shaders).
+fn wind_reach(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies, id: u32) -> f32 {
+    let tree = forest_format::wind::SwayedTree {
+        foot: Vec3::from(inst.position),
+        height: ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3),
+        radius: sp.sphere[3] * inst.scale,
+        seed: id,
+    };
+    forest_format::wind::reach_now(&cam.wind_uniform(), &tree)
 }
 
-fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies) -> bool {
+fn visible(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies, id: u32) -> bool {
     let c = to_world(inst, xyz(sp.sphere));
-    let r = sp.sphere[3] * inst.scale + wind_reach(cam, inst, sp);
+    let r = sp.sphere[3] * inst.scale + wind_reach(cam, inst, sp, id);
     cam.planes
         .iter()
         .all(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] >= -r)
@@ -358,7 +363,8 @@ pub fn quad_outside(t: &SceneTables, cam: &GpuCamera, q: &Quad) -> bool {
     let c = world_at(t, q, u, v, 0.5);
     let r = sp.sphere[3] * inst.scale;
     let slab = 1.0 / sp.slabs as f32;
-    let reach = r * ((2.0 * size * size + slab * slab).sqrt() + size) + wind_reach(cam, inst, sp);
+    let reach = r * ((2.0 * size * size + slab * slab).sqrt() + size)
+        + wind_reach(cam, inst, sp, q.instance);
     cam.planes[..4]
         .iter()
         .any(|pl| pl[0] * c.x + pl[1] * c.y + pl[2] * c.z + pl[3] < -reach)
@@ -431,7 +437,7 @@ pub fn run_with(t: &SceneTables, cam: &GpuCamera, capacity: u32, iterations: u32
             t.presort[presort * n + i]
         };
         let inst = &t.instances[id as usize];
-        if visible(cam, inst, &t.species[inst.species as usize]) {
+        if visible(cam, inst, &t.species[inst.species as usize], id) {
             r.visible += 1;
             for q in tree_quads(t, cam, id) {
                 if q.composite() {

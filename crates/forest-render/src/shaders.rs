@@ -46,7 +46,7 @@ pub const COUNT_OFF_WGSL: &str = include_str!("../shaders/count_off.wgsl");
 pub const COUNT_ON_WGSL: &str = include_str!("../shaders/count_on.wgsl");
 /// The overdraw view's heat map (a module of its own).
 pub const OVERDRAW_WGSL: &str = include_str!("../shaders/overdraw.wgsl");
-/// Where the frame's wind moves a tree's points (`swayed`, `wind_reach`; in a module that
+/// Where the frame's wind moves a tree's points (`swayed`, `wind_reach_now`; in a module that
 /// declares `camera`).
 pub const WIND_WGSL: &str = include_str!("../shaders/wind.wgsl");
 /// Each tree's own colour and the seasons (`tree_albedo`, `tint_key`; in a module that
