@@ -5,9 +5,9 @@ use anyhow::Result;
 use forest_baselines::geometry::{MeshMethod, Stochastic};
 use forest_baselines::methods::Method;
 use forest_format::forest::{Forest, Instance};
-use forest_render::Camera;
 use forest_render::options::Background;
 use forest_render::target::Target;
+use forest_render::{Camera, ForestView};
 use glam::Vec3;
 
 use super::accuracy::{look_at, nearest_tree, reference};
@@ -131,9 +131,16 @@ pub fn run(b: &Bench) -> Result<Section> {
         let cams: Vec<Camera> = (0..frames)
             .map(|f| camera(f as f32 / (frames - 1).max(1) as f32))
             .collect();
+        // In a wind, the move's frames are its successive instants, 1/RATE s apart: the trees
+        // sway as the camera moves, in the reference as in each method.
+        let at = |f: usize| b.wind.at(b.wind.time + f as f32 / super::wind::RATE);
         let refs = cams
             .iter()
-            .map(|c| reference(b, r, c))
+            .enumerate()
+            .map(|(f, c)| {
+                r.set_wind(at(f))?;
+                reference(b, r, c)
+            })
             .collect::<Result<Vec<_>>>()?;
         let ref_ff = consecutive_flips(&refs)?;
         for (mi, &method) in methods.iter().enumerate() {
@@ -147,8 +154,9 @@ pub fn run(b: &Bench) -> Result<Section> {
             let mut imgs = Vec::new();
             let mut flips = Vec::new();
             let mut times = Vec::new();
-            for (c, rf) in cams.iter().zip(&refs) {
+            for (f, (c, rf)) in cams.iter().zip(&refs).enumerate() {
                 // Consecutive frames of one move: each is measured as it comes.
+                r.set_wind(at(f))?;
                 let (_, t) = b.measure(r, method, c, &target, 0)?;
                 let img = target.read(&b.ctx);
                 flips.push(forest_metrics::compare(rf, &img)?.flip_mean);
@@ -204,7 +212,8 @@ pub fn run(b: &Bench) -> Result<Section> {
             .unwrap_or_default()
     };
     let text = format!(
-        "Six hard cases, each a short camera move of {frames} frames ({}x{}, ε 4): (a) 1–3 m \
+        "Six hard cases, each a short camera move of {frames} frames ({}x{}, ε 4; in a wind, \
+         successive instants {:.0} ms apart): (a) 1–3 m \
          from a tree, where the quad stream's layered depth images show parallax; (b) a view \
          direction halfway between presort and sampling directions; (c) under the canopy \
          looking up, below the sampled hemisphere; (d) a cluster of 40 trees around the \
@@ -219,6 +228,7 @@ pub fn run(b: &Bench) -> Result<Section> {
          impostors {}; stochastic {}; LODs {}; hybrid {}.",
         viewport.0,
         viewport.1,
+        1000.0 / super::wind::RATE,
         b.switch_summary(),
         worst("quads"),
         worst("impostor"),
