@@ -70,6 +70,9 @@ struct QuadVertex {
     // Share [lo, hi) of the blend (x, y), the instance (z) and the tree's quad share (w, see
     // quad_share: below WEIGHT_ONE in the hybrid's transition band).
     share: vec4<u32>,
+    // The tree's colouring (see tree_tint): its key (x) and species + 1 (y; 0: drawn in the
+    // atlas's own colours).
+    tint: vec2<u32>,
     // A composited quad's parallax: the uv shift per unit of stack depth behind its plane,
     // along the view ray (0 for other quads).
     parallax: vec2<f32>,
@@ -116,6 +119,7 @@ struct QuadOut {
     // Interpolated over the quad from its corners' marches.
     @location(7) sun_vis: f32,
     @location(8) @interpolate(flat) tree: vec4<f32>,
+    @location(9) @interpolate(flat) tint: vec2<u32>,
 }
 
 // A composited quad's inter-stage variables (QuadVertex's fields of the same names).
@@ -150,6 +154,7 @@ struct Fragment {
     frame_right: vec3<f32>,
     frame_up: vec3<f32>,
     sun_vis: f32,
+    tint: vec2<u32>,
 }
 
 // 1 inside a slab image, 0 outside (a shifted sample must not repeat the edge texels).
@@ -222,7 +227,7 @@ fn vs_quad(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> 
     let i = kept_composites(state.composites, state.overflow_cull) + qi;
     let v = quad_vertex(vi, i, true);
     return QuadOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right, v.frame_up,
-                   v.sun_vis, v.tree);
+                   v.sun_vis, v.tree, v.tint);
 }
 
 // The opaque pass, before every blended quad: the plain quads of each tree's first aspect in
@@ -256,7 +261,7 @@ fn vs_quad_opaque(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u
     let push = 2.0 * v.tree.w / f32(max(slabs, 1u));
     let p = camera.eye + (v.world - camera.eye) * (1.0 + push / max(reach, push));
     return QuadOut(camera.view_proj * vec4<f32>(p, 1.0), v.uv, v.ids, v.alpha, v.share, v.world,
-                   v.frame_right, v.frame_up, v.sun_vis, v.tree);
+                   v.frame_right, v.frame_up, v.sun_vis, v.tree, v.tint);
 }
 // Mirrors passes::draw::OPAQUE_SHARE_MIN.
 const OPAQUE_SHARE_MIN: u32 = 128u;
@@ -383,6 +388,7 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
     let form = quad_share(camera.forms, distance(camera.form_eye.xyz, to_world(inst, sp.sphere.xyz)),
                           sp.switch_unit * inst.scale, q.instance);
     out.share = vec4<u32>(lo, hi, q.instance, form);
+    out.tint = tree_tint(q.instance, inst);
     out.frame_right = to_world_dir(inst, f.right.xyz);
     out.frame_up = to_world_dir(inst, f.up.xyz);
     let sun_obj = to_object_dir(inst, camera.sun);
@@ -418,6 +424,19 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
     return out;
 }
 
+// How instance `id` (record `inst`) is coloured: its tint key (x) and its species + 1 (y), or
+// (0, 0) where tree_albedo would return the atlas's albedo unchanged (no per-tree amplitude
+// for its species and no season). Taken per vertex for plain quads, so that their fragments
+// read no instance or species record where nothing is coloured (those reads cost 12 % of the
+// quad draw on lavapipe, Table 1's scene).
+fn tree_tint(id: u32, inst: Instance) -> vec2<u32> {
+    let c = species[inst.species].colour;
+    if (all(c.amplitude == vec4<f32>(0.0)) && !(camera.season.x > 0.0)) {
+        return vec2<u32>(0u);
+    }
+    return vec2<u32>(tint_key(id, inst.colour), inst.species + 1u);
+}
+
 // The radiance of a texel (premultiplied albedo and coverage `c`, premultiplied surface `g`)
 // under the frame's light: premultiplied, linear.
 fn lit_texel(in: Fragment, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
@@ -428,10 +447,9 @@ fn lit_texel(in: Fragment, c: vec4<f32>, g: vec4<f32>) -> vec4<f32> {
     let n = normalize(local.x * in.frame_right + local.y * in.frame_up + local.z * frame_dir);
     let sky = min(g.z * inv, 1.0);
     let tau = min(g.w * inv, 1.0);
-    // The tree's own colour (share.z: its instance).
-    let inst = instances[in.share.z];
-    let a = tree_albedo(c.rgb * inv, tau, tint_key(in.share.z, inst.colour),
-                        species[inst.species].colour);
+    // The tree's own colour, where it has one.
+    var a = c.rgb * inv;
+    if (in.tint.y != 0u) { a = tree_albedo(a, tau, in.tint.x, species[in.tint.y - 1u].colour); }
     return vec4<f32>(shade_light(a, n, in.sun_vis, sky, tau) * c.a, c.a);
 }
 
@@ -472,7 +490,7 @@ fn quad_colour(in: QuadOut) -> vec4<f32> {
     let g = textureSample(surface, colour_sampler, in.uv, in.ids.x);
     // The crown's own shadow (the march) times the other casters' (the sun's shadow map).
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, in.sun_vis * tree_shadow(in.world, in.tree));
+                     in.frame_up, in.sun_vis * tree_shadow(in.world, in.tree), in.tint);
     return shade(f, lit_texel(f, c, g));
 }
 
@@ -513,7 +531,8 @@ fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
     let vis = sun_transmittance_coarse(opacity, colour_sampler, in.species, in.sphere,
                                        in.sun_obj.w, p, in.sun_obj.xyz);
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, vis * tree_shadow(in.world, in.tree));
+                     in.frame_up, vis * tree_shadow(in.world, in.tree),
+                     tree_tint(in.share.z, instances[in.share.z]));
     let out = shade(f, lit_texel(f, c, g));
     count_shown(in.clip, out.a);
     return out;
