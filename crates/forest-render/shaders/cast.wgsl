@@ -57,8 +57,8 @@ fn vs_cast_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi
     -> CompositeOut {
     let v = quad_vertex(vi, qi, false);
     return CompositeOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right,
-                        v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back, v.species,
-                        v.sphere, v.sun_obj, v.tree);
+                        v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back,
+                        vec3<u32>(v.species, v.tint), v.sphere, v.sun_obj, v.tree);
 }
 
 @fragment

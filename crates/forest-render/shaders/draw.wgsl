@@ -136,7 +136,9 @@ struct CompositeOut {
     @location(8) @interpolate(flat) depths: vec4<f32>,
     @location(9) obj_front: vec3<f32>,
     @location(10) obj_back: vec3<f32>,
-    @location(11) @interpolate(flat) species: u32,
+    // The species (x) and the tree's tint (y, z: QuadVertex's tint), in one location: a
+    // sixteenth would pass the 15 inter-stage variables downlevel devices offer.
+    @location(11) @interpolate(flat) species: vec3<u32>,
     @location(12) @interpolate(flat) sphere: vec4<f32>,
     @location(13) @interpolate(flat) sun_obj: vec4<f32>,
     @location(14) @interpolate(flat) tree: vec4<f32>,
@@ -270,7 +272,8 @@ const OPAQUE_SHARE_MIN: u32 = 128u;
 fn vs_composite(@builtin(vertex_index) vi: u32, @builtin(instance_index) qi: u32) -> CompositeOut {
     let v = quad_vertex(vi, qi, true);
     return CompositeOut(v.clip, v.uv, v.ids, v.alpha, v.share, v.world, v.frame_right,
-                        v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back, v.species,
+                        v.frame_up, v.parallax, v.depths, v.obj_front, v.obj_back,
+                        vec3<u32>(v.species, v.tint),
                         v.sphere, v.sun_obj, v.tree);
 }
 
@@ -426,9 +429,9 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
 
 // How instance `id` (record `inst`) is coloured: its tint key (x) and its species + 1 (y), or
 // (0, 0) where tree_albedo would return the atlas's albedo unchanged (no per-tree amplitude
-// for its species and no season). Taken per vertex for plain quads, so that their fragments
+// for its species and no season). Taken per vertex, so that a quad's fragments
 // read no instance or species record where nothing is coloured (those reads cost 12 % of the
-// quad draw on lavapipe, Table 1's scene).
+// quad draw on lavapipe, Table 1's scene). Composited quads carry it beside their species.
 fn tree_tint(id: u32, inst: Instance) -> vec2<u32> {
     let c = species[inst.species].colour;
     if (all(c.amplitude == vec4<f32>(0.0)) && !(camera.season.x > 0.0)) {
@@ -528,11 +531,10 @@ fn fs_composite(in: CompositeOut) -> @location(0) vec4<f32> {
     // The march starts where the pixel's coverage lies: on the front slab's plane, moved
     // towards the second's by the share the slabs behind the front one add.
     let p = mix(in.obj_front, in.obj_back, (c.a - front) / max(c.a, 1e-6));
-    let vis = sun_transmittance_coarse(opacity, colour_sampler, in.species, in.sphere,
+    let vis = sun_transmittance_coarse(opacity, colour_sampler, in.species.x, in.sphere,
                                        in.sun_obj.w, p, in.sun_obj.xyz);
     let f = Fragment(in.clip, in.uv, in.ids, in.alpha, in.share, in.world, in.frame_right,
-                     in.frame_up, vis * tree_shadow(in.world, in.tree),
-                     tree_tint(in.share.z, instances[in.share.z]));
+                     in.frame_up, vis * tree_shadow(in.world, in.tree), in.species.yz);
     let out = shade(f, lit_texel(f, c, g));
     count_shown(in.clip, out.a);
     return out;
