@@ -433,10 +433,7 @@ fn quad_vertex(vi: u32, qi: u32, shaded: bool) -> QuadVertex {
 // read no instance or species record where nothing is coloured (those reads cost 12 % of the
 // quad draw on lavapipe, Table 1's scene). Composited quads carry it beside their species.
 fn tree_tint(id: u32, inst: Instance) -> vec2<u32> {
-    let c = species[inst.species].colour;
-    if (all(c.amplitude == vec4<f32>(0.0)) && !(camera.season.x > 0.0)) {
-        return vec2<u32>(0u);
-    }
+    if (!tree_coloured(species[inst.species].colour)) { return vec2<u32>(0u); }
     return vec2<u32>(tint_key(id, inst.colour), inst.species + 1u);
 }
 

@@ -31,11 +31,17 @@ fn season_key(c: TreeColour, s: f32) -> vec4<f32> {
     return c.autumn + (c.late_autumn - c.autumn) * min(t - 2.0, 1.0);
 }
 
+// Whether a species coloured `c` changes any albedo in the camera's season (else
+// tree_albedo returns it as it is).
+fn tree_coloured(c: TreeColour) -> bool {
+    return any(c.amplitude != vec4<f32>(0.0)) || camera.season.x > 0.0;
+}
+
 // The albedo every method draws for albedo `a` (linear, not premultiplied) and translucency
 // `tau` of the tree `key` of a species coloured `c`, in the camera's season.
 fn tree_albedo(a: vec3<f32>, tau: f32, key: u32, c: TreeColour) -> vec3<f32> {
+    if (!tree_coloured(c)) { return a; }
     let season_on = camera.season.x > 0.0;
-    if (all(c.amplitude == vec4<f32>(0.0)) && !season_on) { return a; }
     let r = tree_randoms(key);
     let leafness = clamp(tau / TINT_LEAF_TRANSLUCENCY, 0.0, 1.0);
     let k = vec3<f32>(0.57735026);

@@ -181,12 +181,13 @@ fn xyz(v: [f32; 4]) -> Vec3 {
 /// The farthest the frame's wind moves any point of instance `id` now (metres;
 /// `wind_reach_now` of `wind_height` in the shaders).
 fn wind_reach(cam: &GpuCamera, inst: &GpuInstance, sp: &GpuSpecies, id: u32) -> f32 {
-    let tree = forest_format::wind::SwayedTree {
-        foot: Vec3::from(inst.position),
-        height: ((sp.sphere[1] + sp.sphere[3]) * inst.scale).max(1e-3),
-        radius: sp.sphere[3] * inst.scale,
-        seed: id,
-    };
+    let tree = forest_format::wind::SwayedTree::from_sphere(
+        Vec3::from(inst.position),
+        inst.scale,
+        sp.sphere[1],
+        sp.sphere[3],
+        id,
+    );
     forest_format::wind::reach_now(&cam.wind_uniform(), &tree)
 }
 
