@@ -67,9 +67,9 @@ fn every_table_has_its_columns(results: &Path) {
     assert!(header("storage.csv").starts_with("method,species,disk_bytes,gpu_bytes"));
     assert_eq!(
         header("wind.csv"),
-        "case,distance_m,method,flip_static,flip_wind,wind_over_static,motion_px,\
-         motion_over_reference,change_over_reference,flicker_frames,frame_ms_calm,frame_ms_wind,\
-         time_ratio"
+        "case,distance_m,method,flip_static,flip_wind,wind_over_static,motion_step,motion_px,\
+         motion_over_reference,motion_1_over_reference,change_over_reference,flicker_frames,\
+         frame_ms_calm,frame_ms_wind,time_ratio"
     );
     assert_eq!(
         header("wind_switch.csv"),

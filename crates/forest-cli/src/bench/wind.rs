@@ -133,19 +133,43 @@ fn mean(v: &[f32]) -> f32 {
 /// Side of the tiles [`motion`] follows (pixels).
 const TILE: u32 = 16;
 
-/// How far the trees' outlines move between consecutive frames of transparent renders
-/// (pixels a frame): in each 16×16-pixel tile, the shift that best carries one frame's
-/// coverage onto the next's (Lucas–Kanade: the least-squares solution of
-/// `∇a · δ = −∂a/∂t` over the tile), its length averaged over the tiles weighted by how
-/// well their edges pin it (the smaller eigenvalue of the tile's structure tensor), then over
-/// the frame pairs. A shift, not a difference: a method whose edges are softer or whose
-/// detail is finer changes its pixels by other amounts for the same motion, but its outlines
-/// move as far.
-fn motion(imgs: &[image::RgbaImage]) -> f32 {
+/// The most frames between the two images [`motion`] compares: 0.1 s at [`RATE`]. The wind
+/// moves nothing faster than 3 Hz (the flutter; the sway is at most 2 Hz), which turns by at
+/// most a third of a cycle in that time, so a shift over 3 frames is within 14 % of 3 frames'
+/// motion.
+pub const MAX_MOTION_STEP: usize = 3;
+
+/// The shift (pixels) the reference's outlines should make between the two images [`motion`]
+/// compares. Lucas–Kanade's linearisation holds for shifts well under a pixel (at a shift of
+/// a pixel it measured the sharp 1x geometry's outlines moving 0.77 of the reference's,
+/// against 0.94 between consecutive frames), while a shift of a few hundredths of a pixel is
+/// the size of the 4×4 reference's sampling noise: far away its outlines moved 0.031 px
+/// between consecutive frames but 0.016 px a frame over 3 frames (lengths of noisy shifts
+/// add up, never cancel), where the impostor's moved 0.0118 and 0.0114 px a frame.
+pub const MOTION_SHIFT_PX: f32 = 0.3;
+
+/// Frames between the images [`motion`] compares for a sequence whose reference moves
+/// `reference_px` pixels between consecutive frames: about [`MOTION_SHIFT_PX`], 1 to
+/// [`MAX_MOTION_STEP`], and less than `frames`.
+pub fn motion_step(reference_px: f32, frames: usize) -> usize {
+    let step = (MOTION_SHIFT_PX / reference_px.max(1e-6)).round();
+    (step.clamp(1.0, MAX_MOTION_STEP as f32) as usize).min(frames.saturating_sub(1).max(1))
+}
+
+/// How far the trees' outlines move in a frame (pixels), measured between frames `step`
+/// apart (1 to the sequence's length − 1) and divided by `step`: in each 16×16-pixel tile,
+/// the shift that best carries one image's coverage onto the other's (Lucas–Kanade: the
+/// least-squares solution of `∇a · δ = −∂a/∂t` over the tile), its length averaged over the
+/// tiles weighted by how well their edges pin it (the smaller eigenvalue of the tile's
+/// structure tensor), then over the pairs. A shift, not a difference: a method whose edges
+/// are softer or whose detail is finer changes its pixels by other amounts for the same
+/// motion, but its outlines move as far.
+fn motion(imgs: &[image::RgbaImage], step: usize) -> f32 {
+    let step = step.clamp(1, imgs.len().saturating_sub(1).max(1));
     let per_pair: Vec<f32> = imgs
-        .windows(2)
+        .windows(step + 1)
         .map(|w| {
-            let (a, b) = (&w[0], &w[1]);
+            let (a, b) = (&w[0], &w[step]);
             let (width, height) = a.dimensions();
             let at =
                 |img: &image::RgbaImage, x: u32, y: u32| f64::from(img.get_pixel(x, y)[3]) / 255.0;
@@ -184,7 +208,7 @@ fn motion(imgs: &[image::RgbaImage]) -> f32 {
                 }
             }
             if weight > 0.0 {
-                (sum / weight) as f32
+                (sum / weight / step as f64) as f32
             } else {
                 0.0
             }
@@ -259,8 +283,10 @@ pub fn run(b: &Bench) -> Result<Section> {
         "flip_static",
         "flip_wind",
         "wind_over_static",
+        "motion_step",
         "motion_px",
         "motion_over_reference",
+        "motion_1_over_reference",
         "change_over_reference",
         "flicker_frames",
         "frame_ms_calm",
@@ -283,7 +309,9 @@ pub fn run(b: &Bench) -> Result<Section> {
             refs.push(reference(b, &mut r, &cam)?);
         }
         let ref_changes = super::stability::consecutive_flips(&refs)?;
-        let ref_motion = motion(&refs);
+        let ref_motion_1 = motion(&refs, 1);
+        let step = motion_step(ref_motion_1, refs.len());
+        let ref_motion = motion(&refs, step);
         for (mi, &method) in methods.iter().enumerate() {
             r.set_wind(Wind::CALM)?;
             let (_, calm_ms) = b.measure(&mut r, method, &cam, &target, b.frames)?;
@@ -302,8 +330,9 @@ pub fn run(b: &Bench) -> Result<Section> {
             }
             let own = super::stability::consecutive_flips(&imgs)?;
             let flip_wind = mean(&flips);
-            let moved = motion(&imgs);
-            let motion = moved / ref_motion.max(1e-9);
+            let moved = motion(&imgs, step);
+            let motion_ratio = moved / ref_motion.max(1e-9);
+            let motion_1 = motion(&imgs, 1) / ref_motion_1.max(1e-9);
             let change = mean(&own) / mean(&ref_changes).max(1e-9);
             let flicker = own
                 .iter()
@@ -312,9 +341,10 @@ pub fn run(b: &Bench) -> Result<Section> {
                 .count();
             println!(
                 "wind, {} ({:.1} m), {}: FLIP {flip_static:.4} calm, {flip_wind:.4} in wind \
-                 (×{:.3}); outlines move {moved:.3} px a frame, ×{motion:.2} the reference's \
-                 ({ref_motion:.3} px), pixels change ×{change:.2} as much; {flicker} flicker \
-                 frames",
+                 (×{:.3}); outlines move {moved:.3} px a frame, ×{motion_ratio:.2} the \
+                 reference's ({ref_motion:.3} px, over {step} frames; between consecutive frames \
+                 ×{motion_1:.2}), \
+                 pixels change ×{change:.2} as much; {flicker} flicker frames",
                 case.name,
                 case.distance,
                 method.name(),
@@ -325,7 +355,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 .push((f64::from(case.distance), f64::from(flip_wind)));
             motion_series[mi]
                 .points
-                .push((f64::from(case.distance), f64::from(motion)));
+                .push((f64::from(case.distance), f64::from(motion_ratio)));
             table.push(vec![
                 case.name.into(),
                 format!("{:.1}", case.distance),
@@ -333,8 +363,10 @@ pub fn run(b: &Bench) -> Result<Section> {
                 format!("{flip_static:.5}"),
                 format!("{flip_wind:.5}"),
                 format!("{:.3}", flip_wind / flip_static.max(1e-9)),
+                step.to_string(),
                 format!("{moved:.4}"),
-                format!("{motion:.3}"),
+                format!("{motion_ratio:.3}"),
+                format!("{motion_1:.3}"),
                 format!("{change:.3}"),
                 flicker.to_string(),
                 ms(calm_ms),
@@ -365,7 +397,8 @@ pub fn run(b: &Bench) -> Result<Section> {
     b.chart(
         "wind_motion",
         &Chart {
-            title: "Wind: each method's frame-to-frame change over the reference's".into(),
+            title: "Wind: how far each method's outlines move in a frame, over the reference's"
+                .into(),
             x_label: "distance (m)".into(),
             y_label: "motion ratio (1: as the reference; under 0.5: frozen)".into(),
             log_x: true,
@@ -495,9 +528,15 @@ fn summary(
          switch ({}x{}, ε 4). `flip_static` is each method's mean FLIP against the 4×4 reference in \
          calm air at the same camera, `flip_wind` its mean over the animated frames against the \
          reference animated alike; `wind_over_static` their ratio (target ≤ 1.15; worst: \
-         {worst_ratio}). `motion_over_reference` is the method's mean frame-to-frame FLIP over \
-         the reference's: under 0.5 a frozen band, above 1 flicker the reference has not \
-         (frozen: {}). `flicker_frames` counts frames whose change exceeds the reference's by \
+         {worst_ratio}). `motion_px` is how far the method's outlines move in a frame (the \
+         Lucas–Kanade shift of 16-pixel tiles' coverage between frames `motion_step` apart, \
+         over the step, which is chosen for the reference's outlines to move about \
+         {MOTION_SHIFT_PX} px, 1 to {MAX_MOTION_STEP} frames: between consecutive frames the \
+         far motion is as small as the reference's sampling noise), `motion_over_reference` \
+         that over the reference's: \
+         under 0.5 a frozen band (frozen: {}); `motion_1_over_reference` the same between \
+         consecutive frames, `change_over_reference` the mean FLIP between consecutive frames \
+         over the reference's. `flicker_frames` counts frames whose change exceeds the reference's by \
          more than {POP_MARGIN}. `time_ratio` is the median frame time in wind over calm, \
          measured in one run (target ≤ 1.15; the highest: {slowest}; on a CPU rasteriser the \
          frame times are noisy). A tree of each species at its switch distance, seen across \
@@ -522,4 +561,58 @@ fn summary(
             frozen.join(", ")
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Transparent images of soft-edged discs (coverage falling from 1 to 0 between 3.5 and 6.5 px from the centre) centred on a grid,
+    /// all moved by `(dx, dy)` pixels a frame: an outline motion known exactly.
+    fn discs(frames: usize, dx: f32, dy: f32) -> Vec<image::RgbaImage> {
+        (0..frames)
+            .map(|f| {
+                image::RgbaImage::from_fn(64, 48, |x, y| {
+                    let (cx, cy) = (8.0 + dx * f as f32, 8.0 + dy * f as f32);
+                    let (px, py) = (
+                        (x as f32 - cx).rem_euclid(16.0),
+                        (y as f32 - cy).rem_euclid(16.0),
+                    );
+                    let r = (px.min(16.0 - px)).hypot(py.min(16.0 - py));
+                    let a = ((6.5 - r) / 3.0).clamp(0.0, 1.0);
+                    image::Rgba([0, 0, 0, (a * 255.0).round() as u8])
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn motion_finds_a_known_shift_at_every_step() {
+        for (dx, dy) in [(0.1, 0.0), (0.05, -0.08), (0.0, 0.2)] {
+            let truth = f32::hypot(dx, dy);
+            let imgs = discs(4, dx, dy);
+            for step in 1..=3 {
+                let m = motion(&imgs, step);
+                assert!(
+                    (m - truth).abs() < 0.1 * truth,
+                    "({dx}, {dy}) px a frame over {step} frames: measured {m}"
+                );
+            }
+        }
+        assert_eq!(
+            motion(&discs(4, 0.0, 0.0), 1),
+            0.0,
+            "still images move nothing"
+        );
+    }
+
+    #[test]
+    fn the_motion_step_spans_about_a_third_of_a_pixel_within_its_bounds() {
+        assert_eq!(motion_step(0.5, 60), 1);
+        assert_eq!(motion_step(0.15, 60), 2);
+        assert_eq!(motion_step(0.03, 60), MAX_MOTION_STEP);
+        assert_eq!(motion_step(0.0, 60), MAX_MOTION_STEP);
+        assert_eq!(motion_step(0.03, 3), 2, "within the sequence");
+        assert_eq!(motion_step(0.03, 1), 1);
+    }
 }
