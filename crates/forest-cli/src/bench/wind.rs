@@ -343,8 +343,7 @@ pub fn run(b: &Bench) -> Result<Section> {
                 "wind, {} ({:.1} m), {}: FLIP {flip_static:.4} calm, {flip_wind:.4} in wind \
                  (×{:.3}); outlines move {moved:.3} px a frame, ×{motion_ratio:.2} the \
                  reference's ({ref_motion:.3} px, over {step} frames; between consecutive frames \
-                 ×{motion_1:.2}), \
-                 pixels change ×{change:.2} as much; {flicker} flicker frames",
+                 ×{motion_1:.2}), pixels change ×{change:.2} as much; {flicker} flicker frames",
                 case.name,
                 case.distance,
                 method.name(),
@@ -533,10 +532,10 @@ fn summary(
          over the step, which is chosen for the reference's outlines to move about \
          {MOTION_SHIFT_PX} px, 1 to {MAX_MOTION_STEP} frames: between consecutive frames the \
          far motion is as small as the reference's sampling noise), `motion_over_reference` \
-         that over the reference's: \
-         under 0.5 a frozen band (frozen: {}); `motion_1_over_reference` the same between \
-         consecutive frames, `change_over_reference` the mean FLIP between consecutive frames \
-         over the reference's. `flicker_frames` counts frames whose change exceeds the reference's by \
+         that over the reference's: under 0.5 a frozen band (frozen: {}); \
+         `motion_1_over_reference` the same between consecutive frames, \
+         `change_over_reference` the mean FLIP between consecutive frames over the \
+         reference's. `flicker_frames` counts frames whose change exceeds the reference's by \
          more than {POP_MARGIN}. `time_ratio` is the median frame time in wind over calm, \
          measured in one run (target ≤ 1.15; the highest: {slowest}; on a CPU rasteriser the \
          frame times are noisy). A tree of each species at its switch distance, seen across \
@@ -567,8 +566,9 @@ fn summary(
 mod tests {
     use super::*;
 
-    /// Transparent images of soft-edged discs (coverage falling from 1 to 0 between 3.5 and 6.5 px from the centre) centred on a grid,
-    /// all moved by `(dx, dy)` pixels a frame: an outline motion known exactly.
+    /// Transparent images of soft-edged discs centred on a 16-pixel grid (coverage falling
+    /// from 1 to 0 between 3.5 and 6.5 px from the centre), all moved by `(dx, dy)` pixels a
+    /// frame: an outline motion known exactly.
     fn discs(frames: usize, dx: f32, dy: f32) -> Vec<image::RgbaImage> {
         (0..frames)
             .map(|f| {
